@@ -1,0 +1,62 @@
+"""``python -m hlp_drake.dataset summary``: trial and success counts per category of the VR dataset."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Sequence
+from typing import Any
+
+from hlp_drake.atomic import write_text_atomic
+from hlp_drake.cli import run_cli
+from hlp_drake.dataset.dataset import Dataset
+from hlp_drake.dataset.records import CATEGORIES
+
+
+def summarise(dataset: Dataset) -> dict[str, Any]:
+    """``{"categories": {name: {"trials", "successes"}}, "subjects": N, "problems": [...]}``."""
+    categories = {}
+    for category in CATEGORIES:
+        records = dataset.select(category=category)
+        categories[category] = {"trials": len(records), "successes": sum(r.success for r in records)}
+    return {
+        "source": str(dataset.source.path),
+        "subjects": len(dataset.subjects),
+        "categories": categories,
+        "problems": dataset.problems,
+    }
+
+
+def format_summary(summary: dict[str, Any]) -> str:
+    lines = [
+        f"VR dataset at {summary['source']}: {summary['subjects']} subjects",
+        f"{'category':<14}{'trials':>8}{'successes':>11}{'rate':>8}",
+    ]
+    for name, counts in summary["categories"].items():
+        rate = f"{100.0 * counts['successes'] / counts['trials']:.1f}%" if counts["trials"] else "-"
+        lines.append(f"{name:<14}{counts['trials']:>8}{counts['successes']:>11}{rate:>8}")
+    if summary["problems"]:
+        lines.append(f"{len(summary['problems'])} unreadable or invalid files (their trials are left out)")
+    return "\n".join(lines)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m hlp_drake.dataset", description=__doc__)
+    commands = parser.add_subparsers(dest="command", required=True)
+    summary = commands.add_parser("summary", help="trial and success counts per category")
+    summary.add_argument("--dataset", help="the archive or the unpacked dataset/ folder (default: $HLP_DATASET)")
+    summary.add_argument("--json", help="also write the summary as JSON to this file")
+    args = parser.parse_args(argv)
+    dataset = Dataset(args.dataset)
+    result = summarise(dataset)
+    for problem in result["problems"]:
+        print(f"warning: {problem['path']}: {problem['reason']}", file=sys.stderr)
+    print(format_summary(result))
+    if args.json:
+        write_text_atomic(args.json, json.dumps(result, indent=2) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(run_cli(main))

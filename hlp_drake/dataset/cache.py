@@ -1,0 +1,231 @@
+"""One pass over the dataset's files -> a cache: ``index.json`` plus one memory-mapped ``tracks.npy``.
+
+The first load parses every CSV (streaming through the archive if that is the source); later loads
+read the small index and map the track array, so a trial's arrays are only touched when it is used.
+The cache is keyed by the source's fingerprint and ``CACHE_VERSION`` and written atomically.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import sys
+import tempfile
+from collections import defaultdict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from tqdm import tqdm
+
+from hlp_drake.dataset.convert import scene_from_layouts
+from hlp_drake.dataset.parse import (
+    optional_float,
+    parse_interactions,
+    parse_layout,
+    parse_movement,
+    parse_table,
+)
+from hlp_drake.dataset.records import TRACKERS, category_of, trial_key
+from hlp_drake.dataset.source import PARTICIPANTS_FILE, Source
+from hlp_drake.errors import HlpError
+
+CACHE_VERSION = 1
+CACHE_ENV_VAR = "HLP_CACHE"
+_TRIAL_FILE = re.compile(r"^(sub_\d+)/T(\d{3})/(scene|movement)/(.+)$")
+_MOVEMENT = re.compile(r"^(.+)_movement_T\d{3}\.csv$")
+RESULTS_FILE = "trial_results.csv"
+RESULT_COLUMNS = ["trial_num", "outcome"]
+
+
+def default_cache_root() -> Path:
+    """``$HLP_CACHE``, else ``$XDG_CACHE_HOME/hlp_drake``, else ``~/.cache/hlp_drake``."""
+    if os.environ.get(CACHE_ENV_VAR):
+        return Path(os.environ[CACHE_ENV_VAR]).expanduser()
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "hlp_drake"
+
+
+class _Collector:
+    """Accumulates parsed files and problems during the pass over the source."""
+
+    def __init__(self, source: Source) -> None:
+        self.source = source
+        self.problems: list[dict[str, str]] = []
+        self.participants: dict[str, dict[str, str]] | None = None
+        self.results: dict[str, list[dict[str, str]]] = {}
+        self.trial_files: dict[tuple[str, int], dict[str, Any]] = defaultdict(dict)
+        self.broken: set[tuple[str, int]] = set()
+        self.blocks: list[np.ndarray] = []
+        self.rows = 0
+
+    def problem(self, relative: str, reason: str) -> None:
+        self.problems.append({"path": self.source.describe(relative), "reason": reason})
+
+    def add(self, relative: str, content: bytes | OSError) -> None:
+        match = _TRIAL_FILE.match(relative)
+        if isinstance(content, OSError):
+            self.problem(relative, f"cannot read: {content}")
+            if match:
+                self.broken.add((match.group(1), int(match.group(2))))
+            return
+        try:
+            if relative == PARTICIPANTS_FILE:
+                rows = parse_table(content, ["ppid", "handedness"])
+                self.participants = {r["ppid"].strip(): r for r in rows}
+            elif relative.count("/") == 1 and relative.endswith("/" + RESULTS_FILE):
+                self.results[relative.split("/")[0]] = parse_table(content, RESULT_COLUMNS)
+            elif match:
+                self._add_trial_file(match, content)
+        except ValueError as error:
+            self.problem(relative, str(error))
+            if match:
+                self.broken.add((match.group(1), int(match.group(2))))
+
+    def _add_trial_file(self, match: re.Match, content: bytes) -> None:
+        subject, number, folder, name = match.group(1), int(match.group(2)), match.group(3), match.group(4)
+        files = self.trial_files[(subject, number)]
+        if folder == "scene":
+            if name.startswith("scene_layout_"):
+                files["scene_layout"] = parse_layout(content)
+            elif name.startswith("grid_objects_layout_"):
+                files["objects_layout"] = parse_layout(content)
+            return
+        if name.startswith("interaction_log_"):
+            files["interactions"] = parse_interactions(content)
+            return
+        movement = _MOVEMENT.match(name)
+        if movement:
+            block = parse_movement(content, movement.group(1))
+            files.setdefault("tracks", {})[movement.group(1)] = [self.rows, len(block)]
+            self.blocks.append(block)
+            self.rows += len(block)
+
+
+def _assemble(collector: _Collector) -> list[dict[str, Any]]:
+    """Join trial_results rows with their trial folders; every rejected trial becomes a problem."""
+    participants = collector.participants
+    if participants is None:
+        collector.problem(PARTICIPANTS_FILE, "missing: handedness unknown for every subject")
+        participants = {}
+    trials = []
+    listed: set[tuple[str, int]] = set()
+    subjects = sorted({s for s, _ in collector.trial_files} | set(collector.results))
+    for subject in subjects:
+        if subject not in collector.results:
+            collector.problem(f"{subject}/{RESULTS_FILE}", "missing or unreadable: the subject's trials are skipped")
+            continue
+        handedness = (participants.get(subject, {}).get("handedness") or "unknown").strip().lower()
+        if subject not in participants and collector.participants is not None:
+            collector.problem(PARTICIPANTS_FILE, f"no row for {subject}: handedness unknown")
+        for line, row in enumerate(collector.results[subject], start=2):
+            where = f"{subject}/{RESULTS_FILE}"
+            try:
+                number = int(row["trial_num"])
+                category = category_of(number)
+                times = [optional_float(row.get(c)) for c in
+                         ("start_time", "end_time", "start_moved_time", "target_reached_time")]
+            except (TypeError, ValueError) as error:
+                collector.problem(where, f"line {line}: {error}")
+                continue
+            key = (subject, number)
+            listed.add(key)
+            entry = _trial_entry(collector, key, category, handedness, row, times)
+            if entry is not None:
+                trials.append(entry)
+    for key in sorted(set(collector.trial_files) - listed):
+        if key[0] in collector.results:
+            collector.problem(trial_key(*key), f"folder not listed in {key[0]}/{RESULTS_FILE}: skipped")
+    return trials
+
+
+def _trial_entry(
+    collector: _Collector, key: tuple[str, int], category: str, handedness: str,
+    row: dict[str, str], times: list[float | None],
+) -> dict[str, Any] | None:
+    subject, number = key
+    folder = trial_key(subject, number)
+    if key in collector.broken:
+        return None  # already reported with the broken file's path
+    files = collector.trial_files.get(key)
+    if files is None:
+        collector.problem(folder, f"listed in {RESULTS_FILE} but its folder is missing")
+        return None
+    missing = [f"{folder}/scene/{name}_T{number:03d}.csv"
+               for field, name in (("scene_layout", "scene_layout"), ("objects_layout", "grid_objects_layout"))
+               if field not in files]
+    if "interactions" not in files:
+        missing.append(f"{folder}/movement/interaction_log_T{number:03d}.csv")
+    if "objects_layout" in files:
+        tracks = files.get("tracks", {})
+        missing += [f"{folder}/movement/{name}_movement_T{number:03d}.csv"
+                    for name in [*TRACKERS, *(r[0] for r in files["objects_layout"])] if name not in tracks]
+    if missing:
+        for path in missing:
+            collector.problem(path, "missing: trial skipped")
+        return None
+    try:
+        scene_from_layouts(files["scene_layout"], files["objects_layout"], folder)
+    except (ValueError, HlpError) as error:
+        collector.problem(f"{folder}/scene/grid_objects_layout_T{number:03d}.csv", f"invalid scene: {error}")
+        return None
+    return {
+        "subject": subject,
+        "trial": number,
+        "category": category,
+        "outcome": (row.get("outcome") or "").strip(),
+        "handedness": handedness,
+        "trial_name": (row.get("trial_name") or "").strip(),
+        "times": times,
+        "scene_layout": files["scene_layout"],
+        "objects_layout": files["objects_layout"],
+        "tracks": files["tracks"],
+        "interactions": files["interactions"],
+    }
+
+
+def build_cache(source: Source, directory: Path, *, progress: bool = True) -> None:
+    """Parse the whole source once and write the cache into ``directory`` (atomically)."""
+    collector = _Collector(source)
+    with tqdm(desc="reading VR dataset (first load, cached afterwards)", unit="B", unit_scale=True,
+              disable=not progress, file=sys.stderr, mininterval=1.0) as bar:
+        for relative, content in source.files(bar):
+            collector.add(relative, content)
+    trials = _assemble(collector)
+    tracks = np.concatenate(collector.blocks) if collector.blocks else np.empty((0, 7))
+    index = {
+        "version": CACHE_VERSION,
+        "source": str(source.path),
+        "rows": int(tracks.shape[0]),
+        "trials": trials,
+        "problems": collector.problems,
+    }
+    directory.parent.mkdir(parents=True, exist_ok=True)
+    staging = Path(tempfile.mkdtemp(prefix=f".{directory.name}.", dir=directory.parent))
+    try:
+        np.save(staging / "tracks.npy", tracks)
+        (staging / "index.json").write_text(json.dumps(index), encoding="utf-8")
+        if directory.exists():
+            shutil.rmtree(directory)
+        os.rename(staging, directory)
+    except OSError:
+        if not (directory / "index.json").exists():
+            raise
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+
+
+def load_cache(directory: Path) -> tuple[dict[str, Any], np.ndarray]:
+    """Read a cache; raise ``ValueError`` if it is absent, stale or damaged."""
+    try:
+        index = json.loads((directory / "index.json").read_text(encoding="utf-8"))
+        tracks = np.load(directory / "tracks.npy", mmap_mode="r", allow_pickle=False)
+    except (OSError, ValueError) as error:
+        raise ValueError(f"unreadable cache: {error}") from None
+    if not isinstance(index, dict) or index.get("version") != CACHE_VERSION:
+        raise ValueError("cache version differs")
+    if tracks.ndim != 2 or tracks.shape != (index.get("rows"), 7):
+        raise ValueError("track array does not match the index")
+    return index, tracks

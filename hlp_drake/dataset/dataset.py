@@ -1,0 +1,139 @@
+"""``Dataset``: the VR study's trials, loaded lazily from a cache built on first use."""
+
+from __future__ import annotations
+
+import os
+import sys
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hlp_drake.dataset.cache import build_cache, default_cache_root, load_cache
+from hlp_drake.dataset.convert import TableFrame, scene_from_layouts
+from hlp_drake.dataset.records import TRACKERS, Interaction, Trial, TrialRecord, trial_key
+from hlp_drake.dataset.source import Source, resolve_source
+from hlp_drake.errors import DatasetError
+
+
+class Dataset:
+    """The VR dataset: trial metadata at once, each trial's tracks and scene on request.
+
+    Args:
+        path: the archive or the unpacked folder; None reads ``HLP_DATASET``.
+        cache_dir: where caches live (default ``$HLP_CACHE`` or ``~/.cache/hlp_drake``).
+        progress: show a progress bar while the cache is built.
+
+    Attributes:
+        source: where the data was read from.
+        cache_status: "warm" (read from an existing cache) or "built" (parsed now).
+        problems: unreadable, missing or invalid files as ``{"path", "reason"}``; their trials are
+            left out of ``records`` and ``trials``.
+
+    Raises:
+        DatasetError: no dataset at ``path``, or the archive cannot be read.
+    """
+
+    def __init__(
+        self,
+        path: str | os.PathLike[str] | None = None,
+        *,
+        cache_dir: str | os.PathLike[str] | None = None,
+        progress: bool = True,
+    ) -> None:
+        self.source: Source = resolve_source(path)
+        root = Path(cache_dir) if cache_dir is not None else default_cache_root()
+        self.cache_path = root / f"vr-{self.source.fingerprint()[:16]}"
+        try:
+            index, tracks = load_cache(self.cache_path)
+            self.cache_status = "warm"
+        except ValueError as error:
+            if self.cache_path.exists():
+                print(f"rebuilding the dataset cache at {self.cache_path} ({error})", file=sys.stderr)
+            build_cache(self.source, self.cache_path, progress=progress)
+            try:
+                index, tracks = load_cache(self.cache_path)
+            except ValueError as again:
+                raise DatasetError(f"{self.cache_path}: cannot write a usable cache: {again}") from None
+            self.cache_status = "built"
+        self._tracks = tracks
+        self._entries: dict[str, dict[str, Any]] = {
+            trial_key(e["subject"], e["trial"]): e for e in index["trials"]
+        }
+        self.problems: list[dict[str, str]] = index["problems"]
+        self.records: list[TrialRecord] = [_record(e) for e in self._entries.values()]
+
+    def __len__(self) -> int:
+        return len(self.records)
+
+    def __contains__(self, key: str) -> bool:
+        return key in self._entries
+
+    @property
+    def subjects(self) -> list[str]:
+        return sorted({r.subject for r in self.records})
+
+    def select(
+        self,
+        *,
+        category: str | None = None,
+        success: bool | None = None,
+        subjects: Iterable[str] | None = None,
+    ) -> list[TrialRecord]:
+        """Records filtered by category, outcome and subject."""
+        wanted = set(subjects) if subjects is not None else None
+        return [
+            r
+            for r in self.records
+            if (category is None or r.category == category)
+            and (success is None or r.success == success)
+            and (wanted is None or r.subject in wanted)
+        ]
+
+    def trial(self, key: str) -> Trial:
+        """Load one trial, e.g. ``dataset.trial("sub_01/T050")``.
+
+        Raises:
+            KeyError: no such trial (or it was left out as a problem).
+        """
+        entry = self._entries.get(key)
+        if entry is None:
+            raise KeyError(f"no trial {key!r} in the dataset")
+        frame = TableFrame(entry["scene_layout"])
+        tracks = {
+            name: frame.track(TRACKERS.get(name, name), self._block(span))
+            for name, span in entry["tracks"].items()
+        }
+        return Trial(
+            record=_record(entry),
+            scene=scene_from_layouts(entry["scene_layout"], entry["objects_layout"], key),
+            trackers={TRACKERS[n]: t for n, t in tracks.items() if n in TRACKERS},
+            objects={n: t for n, t in tracks.items() if n not in TRACKERS},
+            interactions=tuple(Interaction(*row) for row in entry["interactions"]),
+        )
+
+    def trials(self, records: Iterable[TrialRecord] | None = None) -> Iterator[Trial]:
+        """Load the trials of ``records`` (default: all) one at a time."""
+        for record in self.records if records is None else records:
+            yield self.trial(record.key)
+
+    def _block(self, span: list[int]) -> np.ndarray:
+        start, rows = span
+        return np.asarray(self._tracks[start : start + rows])
+
+
+def _record(entry: dict[str, Any]) -> TrialRecord:
+    start, end, moved, reached = entry["times"]
+    return TrialRecord(
+        subject=entry["subject"],
+        trial=entry["trial"],
+        category=entry["category"],
+        outcome=entry["outcome"],
+        handedness=entry["handedness"],
+        trial_name=entry["trial_name"],
+        start_time=start,
+        end_time=end,
+        start_moved_time=moved,
+        target_reached_time=reached,
+    )

@@ -1,0 +1,96 @@
+"""Parsers for the dataset's CSV files; each raises ``ValueError`` with a readable reason."""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+
+import numpy as np
+
+MOVEMENT_COLUMNS = 7  # time, pos_x, pos_y, pos_z, rot_x, rot_y, rot_z
+LAYOUT_HEADER = ["object", "x", "y", "z", "width", "height", "depth"]
+LOG_HEADER = ["start_time", "end_time", "dominant_object", "non_dominant_object", "interaction_type"]
+
+
+def _text(data: bytes) -> str:
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as error:
+        raise ValueError(f"not UTF-8 text ({error.reason} at byte {error.start})") from None
+
+
+def _rows(data: bytes, header: list[str]) -> list[list[str]]:
+    rows = list(csv.reader(io.StringIO(_text(data))))
+    if not rows:
+        raise ValueError("empty file")
+    if [h.strip() for h in rows[0]] != header:
+        raise ValueError(f"unexpected header {rows[0]!r} (expected {header!r})")
+    return [row for row in rows[1:] if row]
+
+
+def _float(text: str, where: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise ValueError(f"{where}: not a number: {text!r}") from None
+
+
+def parse_movement(data: bytes, name: str) -> np.ndarray:
+    """A movement file -> (N, 7) float64 array (time, pos xyz, rot xyz; Unity frame, degrees)."""
+    text = _text(data)
+    header, _, body = text.partition("\n")
+    columns = [c.strip() for c in header.split(",")]
+    prefix = "" if name.endswith("Tracker") else f"{name}_"
+    expected = ["time"] + [f"{prefix}{k}_{a}" for k in ("pos", "rot") for a in "xyz"]
+    if columns != expected:
+        raise ValueError(f"unexpected header {header.strip()!r} (expected {','.join(expected)!r})")
+    if not body.strip():
+        return np.empty((0, MOVEMENT_COLUMNS))
+    try:
+        values = np.loadtxt(io.StringIO(body), delimiter=",", ndmin=2, dtype=np.float64)
+    except ValueError as error:
+        raise ValueError(f"malformed row: {error}") from None
+    if values.shape[1] != MOVEMENT_COLUMNS:
+        raise ValueError(f"rows have {values.shape[1]} columns, expected {MOVEMENT_COLUMNS}")
+    return values
+
+
+def parse_layout(data: bytes) -> list[list]:
+    """A scene or object layout file -> rows ``[name, x, y, z, width, height, depth]`` (Unity frame)."""
+    parsed = []
+    for i, row in enumerate(_rows(data, LAYOUT_HEADER), start=2):
+        if len(row) != len(LAYOUT_HEADER):
+            raise ValueError(f"line {i}: {len(row)} fields, expected {len(LAYOUT_HEADER)}")
+        values = [_float(v, f"line {i}") for v in row[1:]]
+        if not all(math.isfinite(v) for v in values):
+            raise ValueError(f"line {i}: non-finite value in {row!r}")
+        parsed.append([row[0].strip(), *values])
+    return parsed
+
+
+def parse_interactions(data: bytes) -> list[list]:
+    """An interaction log -> rows ``[start, end or None, dominant, non_dominant, type]``."""
+    parsed = []
+    for i, row in enumerate(_rows(data, LOG_HEADER), start=2):
+        if len(row) != len(LOG_HEADER):
+            raise ValueError(f"line {i}: {len(row)} fields, expected {len(LOG_HEADER)}")
+        end = _float(row[1], f"line {i}") if row[1].strip() else None
+        parsed.append([_float(row[0], f"line {i}"), end, row[2].strip(), row[3].strip(), row[4].strip()])
+    return parsed
+
+
+def parse_table(data: bytes, required: list[str]) -> list[dict[str, str]]:
+    """A CSV with a header (trial_results.csv, participant_list.csv) -> rows as dicts."""
+    reader = csv.DictReader(io.StringIO(_text(data)))
+    missing = [c for c in required if c not in (reader.fieldnames or [])]
+    if missing:
+        raise ValueError(f"missing columns {missing}")
+    return [row for row in reader if any(v for v in row.values() if v)]
+
+
+def optional_float(text: str | None) -> float | None:
+    """'' or None -> None, else the number (raises ValueError)."""
+    if text is None or not text.strip():
+        return None
+    return float(text)

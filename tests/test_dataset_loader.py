@@ -1,0 +1,174 @@
+"""The dataset loader on a tiny synthetic copy: formats, conversion, cache, and every bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from conftest import run_module
+from hlp_drake.dataset import Dataset
+from hlp_drake.errors import DatasetError
+from synthetic_dataset import hand_positions, write_archive, write_dataset
+
+
+@pytest.fixture
+def folder(tmp_path):
+    return write_dataset(tmp_path / "dataset")
+
+
+def load(path, tmp_path) -> Dataset:
+    return Dataset(path, cache_dir=tmp_path / "cache", progress=False)
+
+
+def test_records_categories_and_handedness(folder, tmp_path):
+    ds = load(folder, tmp_path)
+    assert ds.problems == []
+    assert [(r.key, r.category, r.outcome, r.handedness) for r in ds.records] == [
+        ("sub_01/T005", "practice", "Success", "right"),
+        ("sub_01/T010", "structured", "Success", "right"),
+        ("sub_01/T011", "structured", "ArmInteraction", "right"),
+    ]
+    assert [r.key for r in ds.select(category="structured", success=True)] == ["sub_01/T010"]
+
+
+def test_trial_is_converted_into_the_world_frame(folder, tmp_path):
+    trial = load(folder, tmp_path).trial("sub_01/T010")
+    unity = hand_positions()
+    hand = trial.trackers["hand"]
+    # world x = Unity z - front edge (-0.35), world y = -Unity x, world z = Unity y
+    np.testing.assert_allclose(hand.position[:, 0], unity[:, 2] + 0.35, atol=1e-12)
+    np.testing.assert_allclose(hand.position[:, 1], -unity[:, 0], atol=1e-12)
+    np.testing.assert_allclose(hand.position[:, 2], unity[:, 1], atol=1e-12)
+    np.testing.assert_allclose(hand.yaw, -np.radians(10.0 * np.arange(6)), atol=1e-12)
+    assert set(trial.trackers) == {"hand", "wrist", "elbow", "upper_arm"}
+    assert set(trial.objects) == {"Target"} | {o.name for o in trial.scene.obstacles}
+    short = trial.scene.obstacle("FailOnTouchObstacleShort")
+    assert (short.x, short.y, *short.size) == pytest.approx((0.245, -0.1275, 0.05, 0.05, 0.12))
+    assert trial.scene.start == pytest.approx((0.1, 0.0))
+    assert trial.scene.target.position == pytest.approx((0.525, 0.0))
+    assert trial.interactions[1].end_time is None and trial.interactions[1].kind == "PickedUp"
+
+
+def test_archive_and_folder_give_the_same_trials(folder, tmp_path):
+    archive = write_archive(folder, tmp_path / "hlp-vr-dataset.tar.xz")
+    from_folder = load(folder, tmp_path)
+    from_archive = load(archive, tmp_path)
+    from_parent = load(tmp_path, tmp_path)  # a folder holding the archive, like ../shared/data
+    assert from_archive.records == from_folder.records == from_parent.records
+    a, b = from_archive.trial("sub_01/T010"), from_folder.trial("sub_01/T010")
+    assert a.scene == b.scene
+    np.testing.assert_array_equal(a.objects["Target"].position, b.objects["Target"].position)
+
+
+def test_second_load_comes_from_the_cache_and_edits_invalidate_it(folder, tmp_path):
+    assert load(folder, tmp_path).cache_status == "built"
+    assert load(folder, tmp_path).cache_status == "warm"
+    log = folder / "sub_01" / "T010" / "movement" / "interaction_log_T010.csv"
+    log.write_text(log.read_text() + "100.05,100.06,Hand,FailOnTouchObstacleMed,Pushed\n")
+    again = load(folder, tmp_path)
+    assert again.cache_status == "built"
+    assert again.trial("sub_01/T010").interactions[-1].kind == "Pushed"
+
+
+def test_damaged_cache_is_rebuilt(folder, tmp_path):
+    ds = load(folder, tmp_path)
+    tracks = ds.cache_path / "tracks.npy"
+    tracks.write_bytes(tracks.read_bytes()[:100])
+    rebuilt = load(folder, tmp_path)
+    assert rebuilt.cache_status == "built"
+    assert len(rebuilt.trial("sub_01/T010").trackers["hand"]) == 6
+
+
+def test_truncated_movement_file_is_reported_by_path_and_only_its_trial_dropped(folder, tmp_path):
+    path = folder / "sub_01" / "T010" / "movement" / "ElbowTracker_movement_T010.csv"
+    path.write_text(path.read_text()[:-12])  # cut the last line in the middle
+    ds = load(folder, tmp_path)
+    assert [p["path"] for p in ds.problems] == [str(path)]
+    assert "sub_01/T010" not in ds and "sub_01/T011" in ds
+
+
+def test_missing_file_and_missing_folder_are_reported(folder, tmp_path):
+    import shutil
+
+    missing = folder / "sub_01" / "T011" / "movement" / "Target_movement_T011.csv"
+    missing.unlink()
+    shutil.rmtree(folder / "sub_01" / "T005")
+    ds = load(folder, tmp_path)
+    reasons = {p["path"]: p["reason"] for p in ds.problems}
+    assert reasons[str(folder / "sub_01/T011/movement/Target_movement_T011.csv")].startswith("missing")
+    assert "folder is missing" in reasons[str(folder / "sub_01/T005")]
+    assert [r.key for r in ds.records] == ["sub_01/T010"]
+
+
+def test_unreadable_and_non_numeric_files_are_reported(folder, tmp_path):
+    layout = folder / "sub_01" / "T010" / "scene" / "grid_objects_layout_T010.csv"
+    layout.write_text(layout.read_text().replace("0.1275", "abc"))
+    log = folder / "sub_01" / "T011" / "movement" / "interaction_log_T011.csv"
+    log.write_bytes(b"\xff\xfe garbage")
+    ds = load(folder, tmp_path)
+    reasons = {p["path"]: p["reason"] for p in ds.problems}
+    assert "not a number" in reasons[str(layout)]
+    assert "UTF-8" in reasons[str(log)]
+    assert [r.key for r in ds.records] == ["sub_01/T005"]
+
+
+def test_nan_samples_are_kept_as_nan(folder, tmp_path):
+    path = folder / "sub_01" / "T010" / "movement" / "HandTracker_movement_T010.csv"
+    lines = path.read_text().splitlines()
+    fields = lines[3].split(",")
+    fields[1] = "NaN"
+    lines[3] = ",".join(fields)
+    path.write_text("\n".join(lines) + "\n")
+    hand = load(folder, tmp_path).trial("sub_01/T010").trackers["hand"]
+    assert np.isnan(hand.position[2, 1]) and not np.isnan(hand.position[1, 1])
+
+
+def test_overlapping_objects_in_a_layout_reject_the_trial(folder, tmp_path):
+    layout = folder / "sub_01" / "T010" / "scene" / "grid_objects_layout_T010.csv"
+    layout.write_text(layout.read_text().replace("0.2575", "0.1375"))
+    ds = load(folder, tmp_path)
+    assert "overlap" in ds.problems[0]["reason"] and "sub_01/T010" not in ds
+
+
+def test_bad_paths_raise_one_clear_error(tmp_path, monkeypatch):
+    monkeypatch.delenv("HLP_DATASET", raising=False)
+    with pytest.raises(DatasetError, match="no dataset given"):
+        Dataset(cache_dir=tmp_path)
+    with pytest.raises(DatasetError, match="no such file or directory"):
+        Dataset(tmp_path / "nowhere", cache_dir=tmp_path)
+    (tmp_path / "notes.txt").write_text("hello")
+    with pytest.raises(DatasetError, match="not a tar archive"):
+        Dataset(tmp_path / "notes.txt", cache_dir=tmp_path)
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(DatasetError, match="no VR dataset here"):
+        Dataset(tmp_path / "empty", cache_dir=tmp_path)
+    broken = tmp_path / "broken.tar.xz"
+    write_archive(write_dataset(tmp_path / "d"), broken)
+    broken.write_bytes(broken.read_bytes()[:400])
+    with pytest.raises(DatasetError, match="cannot read the archive"):
+        Dataset(broken, cache_dir=tmp_path / "c")
+
+
+def test_summary_cli_missing_dataset_is_one_line(tmp_path):
+    result = run_module("hlp_drake.dataset", "summary", "--dataset", str(tmp_path / "nope"), "--json",
+                        str(tmp_path / "out.json"))
+    assert result.returncode == 2
+    assert result.stderr.count("\n") == 1 and result.stderr.startswith("error: ")
+    assert "Traceback" not in result.stderr
+    assert not (tmp_path / "out.json").exists()
+
+
+def test_summary_cli_reports_problems_and_counts(folder, tmp_path):
+    (folder / "sub_01" / "T011" / "movement" / "Target_movement_T011.csv").unlink()
+    out = tmp_path / "summary.json"
+    result = run_module("hlp_drake.dataset", "summary", "--dataset", str(folder), "--json", str(out),
+                        env={"HLP_CACHE": str(tmp_path / "cache")})
+    assert result.returncode == 0, result.stderr
+    assert "warning:" in result.stderr and "Target_movement_T011.csv" in result.stderr
+    import json
+
+    summary = json.loads(out.read_text())
+    assert summary["subjects"] == 1
+    assert summary["categories"]["practice"] == {"trials": 1, "successes": 1}
+    assert summary["categories"]["structured"] == {"trials": 1, "successes": 1}
+    assert len(summary["problems"]) == 1

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import hashlib
+import json
 import os
 import subprocess
 import sys
@@ -11,6 +13,36 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[1]
 DEFAULT_ARCHIVE = REPO.parent / "shared" / "data" / "hlp-vr-dataset.tar.xz"
+
+
+@pytest.fixture(scope="session", autouse=True)
+def offline_drake(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Let Drake's Parser start under DRAKE_ALLOW_NETWORK=none without ever providing drake_models.
+
+    Drake's default PackageMap registers the remote package ``drake_models`` and, when networking is
+    disabled, refuses to construct unless that package sits in Drake's download cache. The tests get
+    a private cache (``TEST_TMPDIR``, which Drake reads first) holding an *empty* ``drake_models``
+    package, so any model that really uses ``package://drake_models/...`` still fails to load.
+    """
+    import pydrake
+
+    root = tmp_path_factory.mktemp("drake_cache")
+    params_file = Path(pydrake.__file__).parent / "share/drake/multibody/parsing/drake_models.json"
+    params = json.loads(params_file.read_text())
+    names = [params["sha256"]]
+    if params.get("strip_prefix"):
+        names.append(f"{params['sha256']}-{hashlib.sha256(params['strip_prefix'].encode()).hexdigest()}")
+    manifest = (
+        '<?xml version="1.0"?>\n<package format="2"><name>drake_models</name><version>0.0.0</version>'
+        "<description>empty offline stand-in for tests</description>"
+        '<maintainer email="none@example.org">none</maintainer><license>MIT</license></package>\n'
+    )
+    for name in names:
+        package = root / ".cache" / "drake" / "package_map" / name
+        package.mkdir(parents=True)
+        (package / "package.xml").write_text(manifest)
+    os.environ["TEST_TMPDIR"] = str(root)
+    return root
 
 
 def real_dataset_path() -> Path | None:

@@ -14,10 +14,23 @@ def test_model_package_resolves_through_drake():
 
     from hlp_drake.systems import MODELS_PACKAGE, configure_parser, models_directory
 
-    parser = configure_parser(Parser(MultibodyPlant(time_step=0.0)))
+    plant = MultibodyPlant(time_step=0.0)
+    parser = configure_parser(Parser(plant))
     assert Path(parser.package_map().GetPath(MODELS_PACKAGE)) == models_directory()
     configure_parser(parser)  # idempotent
     assert (models_directory() / "package.xml").is_file()
+
+
+def test_nothing_can_use_the_remote_drake_models_package():
+    import pytest
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import MultibodyPlant
+
+    sdf = """<?xml version="1.0"?><sdf version="1.7"><model name="m"><include>
+        <uri>package://drake_models/ycb/003_cracker_box.sdf</uri></include></model></sdf>"""
+    plant = MultibodyPlant(time_step=0.0)
+    with pytest.raises(RuntimeError, match=r"Unable to find uri\[package://drake_models/"):
+        Parser(plant).AddModelsFromString(sdf, "sdf")
 
 
 def readme_block(heading: str) -> str:

@@ -73,3 +73,21 @@ def test_summary_cli_on_the_real_dataset(dataset_path, tmp_path):
     assert summary["subjects"] == 24
     assert summary["categories"]["practice"] == {"trials": 216, "successes": 155}
     assert summary["categories"]["structured"] == {"trials": 2160, "successes": 1805}
+
+
+def test_task_space_gaps_match_the_reference_statistics(dataset):
+    """Reference 2.2, measured over the 8 gaps of all successful structured trials."""
+    from hlp_drake.taskspace import TaskSpace
+
+    widths = []
+    for record in dataset.select(category=STRUCTURED, success=True):
+        space = TaskSpace(dataset.scene(record.key))
+        assert [len(g) for g in space.gaps] == [4, 4]
+        widths += [g.width for gaps in space.gaps for g in gaps]
+    widths = np.array(widths)
+    assert len(widths) == 8 * 1805
+    assert widths.min() == pytest.approx(0.005, abs=1e-4)
+    assert np.median(widths) == pytest.approx(0.090, abs=1e-3)
+    assert widths.max() == pytest.approx(0.378, abs=1e-3)
+    assert np.mean(widths < 0.05) == pytest.approx(0.193, abs=0.002)
+    assert np.mean(widths < 0.075) == pytest.approx(0.384, abs=0.002)

@@ -15,6 +15,7 @@ from hlp_drake.dataset.convert import TableFrame, scene_from_layouts
 from hlp_drake.dataset.records import TRACKERS, Interaction, Trial, TrialRecord, trial_key
 from hlp_drake.dataset.source import Source, resolve_source
 from hlp_drake.errors import DatasetError
+from hlp_drake.scene.model import Scene
 
 
 class Dataset:
@@ -91,15 +92,24 @@ class Dataset:
             and (wanted is None or r.subject in wanted)
         ]
 
+    def scene(self, key: str) -> Scene:
+        """The Scene of one trial, without loading its tracks."""
+        entry = self._entry(key)
+        return scene_from_layouts(entry["scene_layout"], entry["objects_layout"], key)
+
+    def _entry(self, key: str) -> dict[str, Any]:
+        entry = self._entries.get(key)
+        if entry is None:
+            raise KeyError(f"no trial {key!r} in the dataset")
+        return entry
+
     def trial(self, key: str) -> Trial:
         """Load one trial, e.g. ``dataset.trial("sub_01/T050")``.
 
         Raises:
             KeyError: no such trial (or it was left out as a problem).
         """
-        entry = self._entries.get(key)
-        if entry is None:
-            raise KeyError(f"no trial {key!r} in the dataset")
+        entry = self._entry(key)
         frame = TableFrame(entry["scene_layout"])
         tracks = {
             name: frame.track(TRACKERS.get(name, name), self._block(span))
@@ -107,7 +117,7 @@ class Dataset:
         }
         return Trial(
             record=_record(entry),
-            scene=scene_from_layouts(entry["scene_layout"], entry["objects_layout"], key),
+            scene=self.scene(key),
             trackers={TRACKERS[n]: t for n, t in tracks.items() if n in TRACKERS},
             objects={n: t for n, t in tracks.items() if n not in TRACKERS},
             interactions=tuple(Interaction(*row) for row in entry["interactions"]),

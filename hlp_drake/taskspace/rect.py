@@ -16,11 +16,6 @@ class Rect:
     x_max: float
     y_max: float
 
-    @classmethod
-    def around(cls, x: float, y: float, depth: float, width: float) -> Rect:
-        """Centred on (x, y), ``depth`` along x and ``width`` along y."""
-        return cls(x - depth / 2.0, y - width / 2.0, x + depth / 2.0, y + width / 2.0)
-
     @property
     def depth(self) -> float:
         return self.x_max - self.x_min

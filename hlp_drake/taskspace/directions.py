@@ -20,7 +20,7 @@ _SECTORS = ("FF", "FL", "LL", "BL", "BB", "BR", "RR", "FR")
 
 
 def _sign(value: float) -> int:
-    return (value > 0) - (value < 0)
+    return int(value > 0) - int(value < 0)
 
 
 def direction_of(dx: float, dy: float, *, faithful: bool = False) -> str | None:

@@ -1,0 +1,68 @@
+"""Segment many trials of the VR dataset: the kept demonstrations and the rejections with reasons."""
+
+from __future__ import annotations
+
+import re
+from collections import Counter
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+from tqdm import tqdm
+
+from hlp_drake.dataset.dataset import Dataset
+from hlp_drake.dataset.records import STRUCTURED, TrialRecord
+from hlp_drake.segmentation.demonstration import Demonstration, Rejection
+from hlp_drake.segmentation.modes import DEFAULT_MODE, Mode, check_mode
+from hlp_drake.segmentation.segment import Rejected, segment_trial
+
+_TRIAL_IN_PATH = re.compile(r"(sub_\d+)[/\\]T(\d{3})")
+
+
+@dataclass
+class SegmentationResult:
+    """Kept demonstrations (in record order) and rejected trials."""
+
+    mode: Mode
+    demonstrations: list[Demonstration] = field(default_factory=list)
+    rejections: list[Rejection] = field(default_factory=list)
+
+    def reasons(self) -> Counter[str]:
+        """How many trials were rejected for each reason (numbers and names folded into a pattern)."""
+        return Counter(_reason_kind(r.reason) for r in self.rejections)
+
+    def flag_counts(self) -> Counter[tuple[int, ...]]:
+        return Counter(d.flags for d in self.demonstrations)
+
+
+def _reason_kind(reason: str) -> str:
+    reason = re.sub(r"FailOnTouchObstacle\S+", "<obstacle>", reason)
+    return re.sub(r"\d+", "N", reason)
+
+
+def demonstration_records(dataset: Dataset, subjects: Iterable[str] | None = None) -> list[TrialRecord]:
+    """The trials the method learns from: successful structured trials (T010-T099)."""
+    return dataset.select(category=STRUCTURED, success=True, subjects=subjects)
+
+
+def segment_dataset(dataset: Dataset, *, mode: Mode = DEFAULT_MODE, records: list[TrialRecord] | None = None,
+                    progress: bool = False) -> SegmentationResult:
+    """Segment ``records`` (default: all successful structured trials) of ``dataset``.
+
+    Trials the dataset loader already left out (unreadable or invalid files) are reported as
+    rejections too, with the loader's reason.
+    """
+    result = SegmentationResult(check_mode(mode))
+    if records is None:
+        records = demonstration_records(dataset)
+        for problem in dataset.problems:
+            match = _TRIAL_IN_PATH.search(problem["path"])
+            if match and 10 <= int(match.group(2)) <= 99:
+                key = f"{match.group(1)}/T{match.group(2)}"
+                result.rejections.append(Rejection(key, f"unreadable data: {problem['reason']}"))
+    for record in tqdm(records, desc=f"segmenting ({mode})", unit="trial", disable=not progress):
+        trial = dataset.trial(record.key)
+        try:
+            result.demonstrations.append(segment_trial(trial, mode=mode))
+        except Rejected as rejected:
+            result.rejections.append(Rejection(record.key, rejected.reason))
+    return result

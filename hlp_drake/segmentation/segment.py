@@ -1,0 +1,201 @@
+"""Segment a successful demonstration into per-row decisions and keypoints (reference section 3)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from hlp_drake.dataset.records import Trial
+from hlp_drake.segmentation.arm import arm_angles, link_lengths, medial_direction
+from hlp_drake.segmentation.demonstration import GAP, OBJECT, Demonstration, Keypoint, RowDecision
+from hlp_drake.segmentation.modes import DEFAULT_MODE, Mode, is_faithful
+from hlp_drake.segmentation.motion import first_moved_per_row, motion_period
+from hlp_drake.taskspace import DIRECTIONS, Rect, TaskSpace, direction_blocks, direction_of
+
+ARM_TRACKERS = ("hand", "elbow", "upper_arm")
+SEGMENT_START_FALLBACK = 20  # frames before the approach when the previous keypoint is later (original)
+ROUNDING = 0.01  # m, the original rounds the row-2 trajectory to 1 cm for gap directions
+
+
+@dataclass(frozen=True)
+class _Entry:
+    """A keypoint before its angles are computed; ``origin`` is the frame its direction starts at."""
+
+    kind: str
+    row: int | None
+    frame: int
+    origin: int
+    rounded: bool = False  # the original's 1-cm rounded path for row-2 gap directions
+
+
+class Rejected(Exception):
+    """Segmentation left the trial out; ``reason`` says why in one line."""
+
+    def __init__(self, reason: str) -> None:
+        super().__init__(reason)
+        self.reason = reason
+
+
+def _checked_tracks(trial: Trial, names: list[str]) -> dict[str, np.ndarray]:
+    """Planar positions of the arm trackers and the objects ``names``; reject bad or missing tracks."""
+    tracks = {}
+    for name in ARM_TRACKERS:
+        if name not in trial.trackers:
+            raise Rejected(f"no {name} track")
+        tracks[name] = trial.trackers[name].position[:, :2]
+    for name in names:
+        if name not in trial.objects:
+            raise Rejected(f"no movement track for {name}")
+        tracks[name] = trial.objects[name].position[:, :2]
+    frames = len(tracks["hand"])
+    if frames < 2:
+        raise Rejected(f"hand track truncated to {frames} frame(s)")
+    for name, positions in tracks.items():
+        if len(positions) != frames:
+            raise Rejected(f"{name} track has {len(positions)} frames, hand track {frames}")
+        if not np.all(np.isfinite(positions)):
+            raise Rejected(f"{name} track contains NaN or infinite positions")
+    return tracks
+
+
+def _inside(points: np.ndarray, rect: Rect) -> np.ndarray:
+    """Strictly inside (the original's test for gap passage)."""
+    return (
+        (points[:, 0] > rect.x_min) & (points[:, 0] < rect.x_max)
+        & (points[:, 1] > rect.y_min) & (points[:, 1] < rect.y_max)
+    )
+
+
+def _moving_direction(space: TaskSpace, name: str, initial: np.ndarray, final: np.ndarray,
+                      *, faithful: bool) -> str:
+    """Direction class of a moved obstacle (reference 3.7; bug B9 in faithful mode)."""
+    if faithful:
+        # Largest overlap of the obstacle, placed at its pose at the end of the whole trial, with
+        # the eight blocks around its initial footprint; no overlap at all -> FF (first class).
+        rect = space.rects[name]
+        dx, dy = final - np.asarray(rect.center)
+        moved = Rect(rect.x_min + dx, rect.y_min + dy, rect.x_max + dx, rect.y_max + dy)
+        overlaps = [block.overlap(moved) for block in direction_blocks(rect, space.alpha).values()]
+        return DIRECTIONS[int(np.argmax(overlaps))]
+    label = direction_of(*(final - initial))
+    if label is None:
+        raise Rejected(f"moved obstacle {name} is released where it started")
+    return label
+
+
+def segment_trial(trial: Trial, *, mode: Mode = DEFAULT_MODE, space: TaskSpace | None = None) -> Demonstration:
+    """Segment one successful demonstration.
+
+    Args:
+        trial: a loaded trial.
+        mode: "fixed" (the paper's intent) or "faithful" (the released code, bugs included).
+        space: the task space of ``trial.scene`` if already built.
+
+    Raises:
+        Rejected: the trial cannot be segmented (bad tracks, or the original's rejection rules).
+    """
+    faithful = is_faithful(mode)
+    space = space or TaskSpace(trial.scene)
+    target_name = trial.scene.target.name
+    row_of = {name: row.index for row in space.rows for name in row.members}
+    moved = first_moved_per_row(trial.interactions, row_of, faithful=faithful)
+    tracks = _checked_tracks(trial, [*moved.values(), target_name])
+    hand, elbow, shoulder = tracks["hand"], tracks["elbow"], tracks["upper_arm"]
+
+    # 3.1 go part: up to the closest approach to the target.
+    target_xy = np.array([trial.scene.target.x, trial.scene.target.y])
+    goal = int(np.argmin(np.sum((hand - target_xy) ** 2, axis=1)))
+    go = hand[: goal + 1]
+
+    # 3.3 gap passage flags.
+    gap_flags = tuple(tuple(bool(_inside(go, gap.rect).any()) for gap in gaps) for gaps in space.gaps)
+
+    # 3.5 motion periods; 3.8 rejection rules, in the original's order.
+    periods = {name: motion_period(tracks[name], faithful=faithful) for name in [*moved.values(), target_name]}
+    moved_count = sum(p is not None for p in periods.values())
+    if len(moved) >= 2 and moved_count < len(moved) + 1:
+        raise Rejected(f"{len(moved)} rows with a moved obstacle but only {moved_count} objects moved (incl. target)")
+    if periods[target_name] is None:
+        raise Rejected("the target never moved")
+    if moved and moved_count < 2:
+        raise Rejected("an obstacle was picked up or pushed but did not move")
+    for name in moved.values():
+        if periods[name] is None:
+            raise Rejected(f"obstacle {name} was picked up or pushed but did not move")
+
+    # 3.6 keypoint frames and, per keypoint, the frame its direction is measured from.
+    lengths = link_lengths(shoulder, elbow, hand)
+    entries = [_Entry("start", None, 0, 0)]
+    decisions = []
+    previous = 0  # frame of the previous row's last keypoint
+    for row, flags in zip(space.rows, gap_flags):
+        name = moved.get(row.index)
+        if name is not None:
+            approach, release = periods[name]
+            origin = 0 if row.index == 1 else previous
+            if origin > approach:
+                origin = max(approach - SEGMENT_START_FALLBACK, 0)
+            entries += [_Entry("approach", row.index, approach, origin), _Entry("release", row.index, release, approach)]
+            initial = np.array(space.rects[name].center)
+            final = tracks[name][-1] if faithful else tracks[name][release]
+            decisions.append(RowDecision(row.index, OBJECT, obstacle=name,
+                                         direction=_moving_direction(space, name, initial, final, faithful=faithful)))
+            previous = release
+            continue
+        gaps = space.gaps[row.index - 1]
+        inside = [np.flatnonzero(_inside(go, gap.rect)) for gap in gaps]
+        passed = [(frames[0], i) for i, frames in enumerate(inside) if len(frames)]
+        if not passed:
+            raise Rejected(f"the hand passed no gap of row {row.index} and moved no obstacle there")
+        # The original takes the leftmost flagged gap; the fixed mode the one the hand entered first.
+        frame, index = passed[0] if faithful else min(passed)
+        if faithful and row.index > 1:
+            # Row 2's gap direction starts where the 1-cm-rounded path is nearest the previous row.
+            rounded_depth = np.round(go[:, 0] / ROUNDING) * ROUNDING
+            origin = int(np.argmin(np.abs(rounded_depth - space.rows[row.index - 2].x)))
+            entries.append(_Entry("gap", row.index, frame, origin, rounded=True))
+        else:
+            entries.append(_Entry("gap", row.index, frame, 0 if row.index == 1 else previous))
+        decisions.append(RowDecision(row.index, GAP, gap=gaps[index].index))
+        previous = frame
+    target_frame = min(periods[target_name][0], goal)
+    entries.append(_Entry("target", None, target_frame, previous))
+
+    # Directions, arm angles and normalised displacements.
+    medial = medial_direction(trial.record.handedness == "left", faithful=faithful)
+    keypoints = []
+    for k, entry in enumerate(entries):
+        frame = entry.frame
+        if k == 0:
+            direction, displacement = None, (0.0, 0.0)
+        else:
+            before = entries[k - 1].frame
+            if not faithful:
+                direction = direction_of(*(hand[frame] - hand[before]))
+            elif entry.rounded:
+                a, b = (np.round(hand[f] / ROUNDING) * ROUNDING for f in (entry.origin, frame))
+                direction = direction_of(*(b - a), faithful=True)
+            else:
+                direction = direction_of(*(hand[frame] - hand[entry.origin]), faithful=True)
+            # The original's last displacement ends at the goal frame, not the target keypoint.
+            end = goal if (faithful and entry.kind == "target") else frame
+            step = (hand[end] - hand[before]) / lengths.total
+            displacement = (float(step[0]), float(step[1]))
+        q = arm_angles(shoulder[frame], elbow[frame], hand[frame], medial)
+        keypoints.append(
+            Keypoint(entry.kind, entry.row, frame, (float(hand[frame, 0]), float(hand[frame, 1])), direction,
+                     (float(q[0]), float(q[1])), displacement)
+        )
+    return Demonstration(
+        key=trial.key,
+        mode=mode,
+        scene=trial.scene,
+        left_handed=trial.record.handedness == "left",
+        decisions=tuple(decisions),
+        keypoints=tuple(keypoints),
+        gap_flags=gap_flags,
+        link_lengths=lengths,
+        goal_frame=goal,
+        hand_path=go.copy(),
+    )

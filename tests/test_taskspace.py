@@ -73,7 +73,9 @@ def test_free_space_counts_neighbours_and_walls():
     free = dict(zip(DIRECTIONS, space.free_space(first.name)))
     assert free["LL"] == pytest.approx(1.0 - 0.05 / (1.5 * width))
     assert free["RR"] == pytest.approx(1.0)
-    assert free_fractions([Rect(0, 0, 1, 1)], [Rect(0.5, 0, 2, 1)]) == pytest.approx([0.5])
+    assert free_fractions([[0, 0, 1, 1]], [[0.5, 0, 2, 1]]) == pytest.approx([0.5])
+    # Overlaps are summed, not merged (the original's rule).
+    assert free_fractions([[0, 0, 1, 1]], [[0.5, 0, 2, 1], [0.5, 0, 2, 1]]) == pytest.approx([0.0])
 
 
 def test_connecting_space_lies_between_rows():

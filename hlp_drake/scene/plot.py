@@ -16,21 +16,21 @@ from hlp_drake.scene.rows import find_rows
 ROW_COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2")
 
 
-def _page(x: float, y: float) -> tuple[float, float]:
+def page_xy(x: float, y: float) -> tuple[float, float]:
     """World (x, y) -> page (horizontal, vertical): horizontal = -y (left on the left), vertical = x."""
     return (-y, x)
 
 
 def _draw_object(axes: Axes, obj: SceneObject, colour: str, label: str | None) -> None:
     if obj.shape == "cylinder":
-        patch = Circle(_page(obj.x, obj.y), obj.size[0] / 2.0)
+        patch = Circle(page_xy(obj.x, obj.y), obj.size[0] / 2.0)
     else:
         corners = list(footprint(obj).exterior.coords)[:-1]
-        patch = PolygonPatch([_page(x, y) for x, y in corners], closed=True)
+        patch = PolygonPatch([page_xy(x, y) for x, y in corners], closed=True)
     patch.set(facecolor=colour, edgecolor="black", linewidth=0.8, alpha=0.85)
     axes.add_patch(patch)
     if label:
-        px, py = _page(obj.x, obj.y)
+        px, py = page_xy(obj.x, obj.y)
         axes.annotate(label, (px, py), ha="center", va="center", fontsize=6)
 
 
@@ -58,10 +58,10 @@ def draw_scene(axes: Axes, scene: Scene, *, labels: bool = True) -> None:
         short = obstacle.name.replace("FailOnTouchObstacle", "")
         _draw_object(axes, obstacle, row_of.get(obstacle.name, "grey"), short if labels else None)
     _draw_object(axes, scene.target, "#d62728", "target" if labels else None)
-    sx, sy = _page(*scene.start)
+    sx, sy = page_xy(*scene.start)
     axes.plot([sx], [sy], marker="o", color="black", markersize=7, zorder=5)
     arrow = 0.06
-    dx, dy = _page(math.cos(scene.start_yaw) * arrow, math.sin(scene.start_yaw) * arrow)
+    dx, dy = page_xy(math.cos(scene.start_yaw) * arrow, math.sin(scene.start_yaw) * arrow)
     axes.annotate("", xy=(sx + dx, sy + dy), xytext=(sx, sy), arrowprops={"arrowstyle": "->"})
     axes.annotate("start", (sx, sy), xytext=(6, -10), textcoords="offset points", fontsize=8)
     margin = 0.05

@@ -37,3 +37,11 @@ def direction_of(dx: float, dy: float, *, faithful: bool = False) -> str | None:
         return _BY_SIGNS[(_sign(dx), _sign(dy))]
     sector = int(math.floor(math.atan2(dy, dx) / (math.pi / 4.0) + 0.5)) % 8
     return _SECTORS[sector]
+
+
+def mirror_direction(name: str | None) -> str | None:
+    """The direction seen in a mirror along the forward axis (left and right swapped)."""
+    if name is None:
+        return None
+    dx, dy = DIRECTION_VECTORS[name]
+    return _BY_SIGNS[(dx, -dy)]

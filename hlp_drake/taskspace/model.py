@@ -43,27 +43,80 @@ class Gap:
         return self.rect.width
 
 
+@dataclass(frozen=True)
+class Node:
+    """A candidate of a row the hand can use: one of its gaps, or one of its obstacles to move.
+
+    Attributes:
+        row: the row index.
+        kind: "gap" or "object".
+        center: (x, y) of the gap's or the obstacle's footprint centre.
+        gap: the gap's index in its row (gaps only).
+        obstacle: the obstacle's name (objects only).
+    """
+
+    row: int
+    kind: str
+    center: tuple[float, float]
+    gap: int | None = None
+    obstacle: str | None = None
+
+    @property
+    def element(self) -> str:
+        return self.obstacle if self.kind == "object" else str(self.gap)
+
+
+def rect_array(rects: list[Rect] | tuple[Rect, ...]) -> np.ndarray:
+    """(n, 4) array of (x_min, y_min, x_max, y_max)."""
+    return np.array([(r.x_min, r.y_min, r.x_max, r.y_max) for r in rects], dtype=float).reshape(-1, 4)
+
+
+def overlap_areas(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Overlap areas of rectangle arrays ``a`` (..., 4) and ``b`` (..., 4), broadcast."""
+    dx = np.minimum(a[..., 2], b[..., 2]) - np.maximum(a[..., 0], b[..., 0])
+    dy = np.minimum(a[..., 3], b[..., 3]) - np.maximum(a[..., 1], b[..., 1])
+    return np.clip(dx, 0.0, None) * np.clip(dy, 0.0, None)
+
+
+# Per direction (order DIRECTIONS): which of (x_min, x_max, x_max + alpha*depth, x_min - alpha*depth)
+# bounds a block along x, and likewise along y.
+_BLOCK_X = {1: (1, 2), 0: (0, 1), -1: (3, 0)}
+_BLOCK_INDEX = np.array(
+    [[*_BLOCK_X[DIRECTION_VECTORS[n][0]], *_BLOCK_X[DIRECTION_VECTORS[n][1]]] for n in DIRECTIONS]
+)
+
+
+def block_array(rects: np.ndarray, alpha: float = ALPHA) -> np.ndarray:
+    """(n, 8, 4) direction blocks (order DIRECTIONS) around each of the (n, 4) rectangles."""
+    r = np.asarray(rects, dtype=float).reshape(-1, 4)
+    d = alpha * (r[:, 2] - r[:, 0])
+    w = alpha * (r[:, 3] - r[:, 1])
+    xs = np.stack([r[:, 0], r[:, 2], r[:, 2] + d, r[:, 0] - d], axis=1)
+    ys = np.stack([r[:, 1], r[:, 3], r[:, 3] + w, r[:, 1] - w], axis=1)
+    i = _BLOCK_INDEX
+    return np.stack([xs[:, i[:, 0]], ys[:, i[:, 2]], xs[:, i[:, 1]], ys[:, i[:, 3]]], axis=-1)
+
+
 def direction_blocks(rect: Rect, alpha: float = ALPHA) -> dict[str, Rect]:
     """The eight regions around ``rect``, each touching it; cardinal ones keep its side's extent."""
-    d, w = alpha * rect.depth, alpha * rect.width
-    x_ranges = {1: (rect.x_max, rect.x_max + d), 0: (rect.x_min, rect.x_max), -1: (rect.x_min - d, rect.x_min)}
-    y_ranges = {1: (rect.y_max, rect.y_max + w), 0: (rect.y_min, rect.y_max), -1: (rect.y_min - w, rect.y_min)}
-    blocks = {}
-    for name in DIRECTIONS:
-        sx, sy = DIRECTION_VECTORS[name]
-        (x0, x1), (y0, y1) = x_ranges[sx], y_ranges[sy]
-        blocks[name] = Rect(x0, y0, x1, y1)
-    return blocks
+    blocks = block_array(rect_array([rect]), alpha)[0]
+    return {name: Rect(*map(float, b)) for name, b in zip(DIRECTIONS, blocks)}
 
 
-def free_fractions(regions: dict[str, Rect] | list[Rect], occluders: list[Rect]) -> np.ndarray:
-    """Per region: 1 - (sum of overlap areas with ``occluders``) / region area (original 2.4).
+def free_fractions(blocks: np.ndarray, occluders: np.ndarray) -> np.ndarray:
+    """Per block: 1 - (sum of overlap areas with the occluders) / block area (original 2.4).
+
+    Args:
+        blocks: (..., 4) rectangles, e.g. the (n, 8, 4) output of ``block_array``.
+        occluders: (m, 4) rectangles.
 
     Overlaps are summed, not merged, as in the original; with non-overlapping occluders (valid
     scenes) the two agree.
     """
-    values = regions.values() if isinstance(regions, dict) else regions
-    return np.array([1.0 - sum(r.overlap(o) for o in occluders) / r.area for r in values])
+    blocks = np.asarray(blocks, dtype=float)
+    occupied = overlap_areas(blocks[..., None, :], np.asarray(occluders, dtype=float)).sum(axis=-1)
+    area = (blocks[..., 2] - blocks[..., 0]) * (blocks[..., 3] - blocks[..., 1])
+    return 1.0 - occupied / area
 
 
 class TaskSpace:
@@ -118,6 +171,13 @@ class TaskSpace:
             result.append(gaps)
         return result
 
+    def nodes(self, row: int) -> list[Node]:
+        """Row ``row``'s candidates: its gaps left to right, then its obstacles in scene order."""
+        members = set(self.rows[row - 1].members)
+        gaps = [Node(row, "gap", gap.center, gap=gap.index) for gap in self.gaps[row - 1]]
+        objects = [Node(row, "object", self.rects[n].center, obstacle=n) for n in self.obstacle_names if n in members]
+        return gaps + objects
+
     def connecting_space(self, row: int) -> Rect:
         """The free band between row ``row`` and row ``row + 1`` across the table."""
         near, far = self.rows[row - 1], self.rows[row]
@@ -138,4 +198,5 @@ class TaskSpace:
 
     def free_space(self, name: str, occluders: list[Rect] | None = None) -> np.ndarray:
         """Free fraction of each direction block of ``name`` (order ``DIRECTIONS``)."""
-        return free_fractions(self.blocks(name), self.occluders() if occluders is None else occluders)
+        blocks = block_array(rect_array([self.rects[name]]), self.alpha)[0]
+        return free_fractions(blocks, rect_array(self.occluders() if occluders is None else occluders))

@@ -1,0 +1,71 @@
+"""Path-segment features Xc between a node of one row and a node of the next (reference 4.4)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hlp_drake.features.plane import HAND_WIDTH, paper_angle, table_diagonal
+from hlp_drake.segmentation.modes import Mode, is_faithful
+from hlp_drake.taskspace import Node, Rect, TaskSpace, rect_array
+from hlp_drake.taskspace.band import band_coverage, band_coverage_sampled
+
+SEGMENT_FEATURES = ("lateral_span", "slope_difference", "band_collision", "target_overlap")
+TARGET_BAND = 0.05  # half-width of the lateral window around the target (the original uses 0.05)
+
+
+def _misread_wall(wall: Rect) -> Rect:
+    """Bug B3: the original passes a wall's corner-format rectangle where a centre format is read,
+    so the wall is centred on its near-left corner."""
+    hd, hw = wall.depth / 2.0, wall.width / 2.0
+    return Rect(wall.x_min - hd, wall.y_max - hw, wall.x_min + hd, wall.y_max + hw)
+
+
+def segment_feature_matrix(space: TaskSpace, near: list[Node], far: list[Node], *, mode: Mode,
+                           training: bool = False) -> np.ndarray:
+    """Xc of every pair (a in ``near``, b in ``far``), a-major: (len(near) * len(far), 4).
+
+    1 lateral span |b_y - a_y| / N; 2 the segment's lateral-per-depth slope minus the start-target
+    line's; 3 the collision of a 5 cm band around the segment with the obstacles (without a's and
+    b's own) and the back, left and right walls; 4 the lateral overlap of the segment with the
+    target's +-0.05 m window, / N. N is the table diagonal, except in faithful training where the
+    original divides by the table width (bug B1). The band is exact (shapely, true normal) in fixed
+    mode and the original's sampled estimate, with its tilted offset vector (B5) and misplaced
+    walls (B3), in faithful mode.
+    """
+    faithful = is_faithful(mode)
+    table = space.scene.table
+    norm = table.width if (faithful and training) else table_diagonal(table)
+    pa = np.repeat(np.array([n.center for n in near], float).reshape(-1, 2), len(far), axis=0)
+    pb = np.tile(np.array([n.center for n in far], float).reshape(-1, 2), (len(near), 1))
+    start, target = np.asarray(space.scene.start, float), np.asarray(space.target.center, float)
+    d = pb - pa
+    # Lateral coordinates grow to the right (-y), as the original's x does.
+    span = np.abs(d[:, 1]) / norm
+    slope = -d[:, 1] / d[:, 0] - (-(target[1] - start[1])) / (target[0] - start[0])
+    names = space.obstacle_names
+    walls = [space.walls[w] for w in ("back", "left", "right")]
+    rects = rect_array([space.rects[n] for n in names] + ([_misread_wall(w) for w in walls] if faithful else walls))
+    half = HAND_WIDTH / 2.0
+    if faithful:
+        theta = paper_angle(d)
+        offsets = np.column_stack([np.cos(theta), -np.sin(theta)])  # the original's (sin, cos) in its frame
+        coverage = band_coverage_sampled(pa, pb, offsets, half, half, rects)
+    else:
+        length = np.linalg.norm(d, axis=1, keepdims=True)
+        offsets = np.column_stack([-d[:, 1], d[:, 0]]) / np.where(length > 0.0, length, 1.0)
+        coverage = band_coverage(pa, pb, offsets, half, half, rects)
+    # Each pair's own obstacles are not occluders of its segment.
+    own = np.zeros_like(coverage, dtype=bool)
+    ends = [n.obstacle for n in near for _ in far], [n.obstacle for _ in near for n in far]
+    for column, name in enumerate(names):
+        own[:, column] = [name in pair for pair in zip(*ends)]
+    collision = np.where(own, 0.0, coverage).sum(axis=1) / (~own).sum(axis=1)
+    lateral_a, lateral_b, lateral_t = -pa[:, 1], -pb[:, 1], -target[1]
+    low, high = np.minimum(lateral_a, lateral_b), np.maximum(lateral_a, lateral_b)
+    overlap = np.clip(np.minimum(high, lateral_t + TARGET_BAND) - np.maximum(low, lateral_t - TARGET_BAND), 0.0, None)
+    return np.column_stack([span, slope, collision, overlap / norm])
+
+
+def segment_features(space: TaskSpace, a: Node, b: Node, *, mode: Mode, training: bool = False) -> np.ndarray:
+    """Xc of the hand moving from node ``a`` to node ``b``: (4,). See ``segment_feature_matrix``."""
+    return segment_feature_matrix(space, [a], [b], mode=mode, training=training)[0]

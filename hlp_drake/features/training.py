@@ -1,0 +1,154 @@
+"""The five training sets (state-action pairs) of the decision learners, from segmented demonstrations."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+
+from hlp_drake.features.arm import ARM_FEATURES, arm_features
+from hlp_drake.features.direction import DIRECTION_FEATURES, direction_features, direction_index
+from hlp_drake.features.scene_features import GAP_FEATURES, OBJECT_FEATURES, gap_features, object_features
+from hlp_drake.features.segment import SEGMENT_FEATURES, segment_feature_matrix
+from hlp_drake.segmentation.demonstration import GAP, OBJECT, Demonstration
+from hlp_drake.segmentation.modes import Mode, check_mode, is_faithful
+from hlp_drake.taskspace import Node, TaskSpace
+
+
+@dataclass
+class LabelledSet:
+    """Features ``X`` (n, k), labels ``y`` (n,) or (n, 2), and the subject and trial of each row."""
+
+    columns: tuple[str, ...]
+    X: np.ndarray
+    y: np.ndarray
+    subjects: np.ndarray
+    keys: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.y)
+
+    def subset(self, subjects: Iterable[str]) -> LabelledSet:
+        """The rows of the given subjects."""
+        mask = np.isin(self.subjects, list(subjects))
+        return LabelledSet(self.columns, self.X[mask], self.y[mask], self.subjects[mask], self.keys[mask])
+
+
+@dataclass
+class TrainingData:
+    """Gap (Xg), object (Xo), direction (Xd), segment (Xc) and arm (Xa) training sets."""
+
+    mode: Mode
+    gap: LabelledSet
+    object: LabelledSet
+    direction: LabelledSet
+    segment: LabelledSet
+    arm: LabelledSet
+
+    def subset(self, subjects: Iterable[str]) -> TrainingData:
+        subjects = list(subjects)
+        return TrainingData(self.mode, *(getattr(self, n).subset(subjects) for n in
+                                         ("gap", "object", "direction", "segment", "arm")))
+
+
+class _Builder:
+    """Accumulates the rows of one labelled set."""
+
+    def __init__(self, columns: tuple[str, ...]) -> None:
+        self.columns, self.X, self.y, self.keys = columns, [], [], []
+
+    def add(self, key: str, X: np.ndarray, y: np.ndarray) -> None:
+        X = np.atleast_2d(X)
+        self.X.append(X)
+        self.y.append(np.asarray(y, dtype=float).reshape(len(X), -1))
+        self.keys += [key] * len(X)
+
+    def build(self) -> LabelledSet:
+        width = len(self.columns)
+        X = np.vstack(self.X) if self.X else np.zeros((0, width))
+        y = np.vstack(self.y) if self.y else np.zeros((0, 1))
+        y = y[:, 0] if y.shape[1] == 1 else y
+        keys = np.array(self.keys, dtype=object)
+        subjects = np.array([k.split("/")[0] for k in self.keys], dtype=object)
+        return LabelledSet(self.columns, X, y, subjects, keys)
+
+
+def _chosen(node: Node, decision) -> bool:
+    if node.kind == GAP:
+        return decision.decision == GAP and node.gap == decision.gap
+    return decision.decision == OBJECT and node.obstacle == decision.obstacle
+
+
+def _segment_labels(space: TaskSpace, demo: Demonstration, row: int, near: list[Node], far: list[Node],
+                    *, faithful: bool) -> np.ndarray:
+    """(len(near), len(far)) 0/1 matrix with a 1 at the pair of nodes the demonstrator used."""
+    labels = np.zeros((len(near), len(far)))
+    d_near, d_far = demo.decisions[row - 1], demo.decisions[row]
+    if faithful and d_near.decision == OBJECT and d_far.decision == GAP:
+        # Bug B2: the cell is transposed: (near gap with the far gap's index, far obstacle with the
+        # near obstacle's position in its row).
+        near_gaps = [n for n in near if n.kind == GAP]
+        near_objects = [n for n in near if n.kind == OBJECT]
+        far_objects = [n for n in far if n.kind == OBJECT]
+        i = d_far.gap - 1
+        j = [n.obstacle for n in near_objects].index(d_near.obstacle)
+        if i < len(near_gaps) and j < len(far_objects):
+            labels[near.index(near_gaps[i]), far.index(far_objects[j])] = 1.0
+        return labels
+    i = next(k for k, n in enumerate(near) if _chosen(n, d_near))
+    j = next(k for k, n in enumerate(far) if _chosen(n, d_far))
+    labels[i, j] = 1.0
+    return labels
+
+
+def training_data(demonstrations: Iterable[Demonstration], *, mode: Mode | None = None) -> TrainingData:
+    """Build the five training sets from demonstrations segmented in ``mode``.
+
+    - gap: every gap of a trial that used at least one gap (label: the gap passed; 0 in rows where
+      an obstacle was moved);
+    - object: every obstacle of a trial that moved at least one (label: the row's moved obstacle);
+    - direction: one row per moved obstacle (label: direction class index);
+    - segment: every (node of row r, node of row r+1) pair (label: the pair the hand used);
+    - arm: consecutive keypoints (label: the next keypoint's (q1, q2)).
+    """
+    gap, obj = _Builder(GAP_FEATURES), _Builder(OBJECT_FEATURES)
+    direction, segment, arm = _Builder(DIRECTION_FEATURES), _Builder(SEGMENT_FEATURES), _Builder(ARM_FEATURES)
+    for demo in demonstrations:
+        mode = check_mode(mode or demo.mode)
+        if demo.mode != mode:
+            raise ValueError(f"{demo.key} was segmented in {demo.mode} mode, not {mode}")
+        faithful = is_faithful(mode)
+        space = TaskSpace(demo.scene)
+        flags = demo.flags
+        if not all(flags):
+            labels = []
+            for decision, row_flags, gaps in zip(demo.decisions, demo.gap_flags, space.gaps):
+                if decision.decision == OBJECT:
+                    labels += [0.0] * len(gaps)
+                elif faithful:
+                    labels += [float(f) for f in row_flags]
+                else:
+                    labels += [float(g.index == decision.gap) for g in gaps]
+            gap.add(demo.key, gap_features(space), labels)
+        if any(flags):
+            moved = {d.obstacle for d in demo.decisions if d.decision == OBJECT}
+            obj.add(demo.key, object_features(space), [float(n in moved) for n in space.obstacle_names])
+        for k, keypoint in enumerate(demo.keypoints):
+            if keypoint.kind != "approach":
+                continue
+            decision = demo.decisions[keypoint.row - 1]
+            features = direction_features(space, decision.obstacle, hand=demo.keypoints[k - 1].position, mode=mode,
+                                          training=True, hand_to_object=keypoint.direction)
+            direction.add(demo.key, features, [direction_index(decision.direction)])
+        for row in range(1, len(space.rows)):
+            near, far = space.nodes(row), space.nodes(row + 1)
+            labels = _segment_labels(space, demo, row, near, far, faithful=faithful)
+            features = segment_feature_matrix(space, near, far, mode=mode, training=True)
+            segment.add(demo.key, features, labels.reshape(-1))
+        scale = demo.link_lengths.total if faithful else 1.0  # bug B4: divided by the arm length twice
+        mirror = demo.left_handed and not faithful
+        for before, after in zip(demo.keypoints, demo.keypoints[1:]):
+            displacement = np.asarray(after.displacement) / scale
+            arm.add(demo.key, arm_features(before.arm, displacement, after.direction, mirror=mirror), [after.arm])
+    return TrainingData(mode or "fixed", gap.build(), obj.build(), direction.build(), segment.build(), arm.build())

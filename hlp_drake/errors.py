@@ -22,3 +22,7 @@ class SceneError(HlpError):
 
 class DatasetError(HlpError):
     """The VR dataset cannot be found or read."""
+
+
+class ModelError(HlpError):
+    """A saved model file is missing, foreign, damaged or tampered with."""

@@ -45,11 +45,12 @@ class TrainingData:
     direction: LabelledSet
     segment: LabelledSet
     arm: LabelledSet
+    people: LabelledSet  # per demonstration: X = (upper arm, forearm) lengths, y = start (q1, q2)
 
     def subset(self, subjects: Iterable[str]) -> TrainingData:
         subjects = list(subjects)
         return TrainingData(self.mode, *(getattr(self, n).subset(subjects) for n in
-                                         ("gap", "object", "direction", "segment", "arm")))
+                                         ("gap", "object", "direction", "segment", "arm", "people")))
 
 
 class _Builder:
@@ -114,6 +115,7 @@ def training_data(demonstrations: Iterable[Demonstration], *, mode: Mode | None 
     """
     gap, obj = _Builder(GAP_FEATURES), _Builder(OBJECT_FEATURES)
     direction, segment, arm = _Builder(DIRECTION_FEATURES), _Builder(SEGMENT_FEATURES), _Builder(ARM_FEATURES)
+    people = _Builder(("upper_arm", "forearm"))
     for demo in demonstrations:
         mode = check_mode(mode or demo.mode)
         if demo.mode != mode:
@@ -146,9 +148,11 @@ def training_data(demonstrations: Iterable[Demonstration], *, mode: Mode | None 
             labels = _segment_labels(space, demo, row, near, far, faithful=faithful)
             features = segment_feature_matrix(space, near, far, mode=mode, training=True)
             segment.add(demo.key, features, labels.reshape(-1))
+        people.add(demo.key, np.array([demo.link_lengths.upper_arm, demo.link_lengths.forearm]), [demo.keypoints[0].arm])
         scale = demo.link_lengths.total if faithful else 1.0  # bug B4: divided by the arm length twice
         mirror = demo.left_handed and not faithful
         for before, after in zip(demo.keypoints, demo.keypoints[1:]):
             displacement = np.asarray(after.displacement) / scale
             arm.add(demo.key, arm_features(before.arm, displacement, after.direction, mirror=mirror), [after.arm])
-    return TrainingData(mode or "fixed", gap.build(), obj.build(), direction.build(), segment.build(), arm.build())
+    return TrainingData(mode or "fixed", gap.build(), obj.build(), direction.build(), segment.build(), arm.build(),
+                        people.build())

@@ -1,0 +1,62 @@
+"""Direction classifier Cd: which way a person moves an obstacle (8 classes, reference 5.2)."""
+
+from __future__ import annotations
+
+import numpy as np
+from sklearn.base import BaseEstimator, ClassifierMixin
+from sklearn.svm import SVC
+from sklearn.utils.validation import check_is_fitted, validate_data
+
+from hlp_drake.learners.balance import oversample
+from hlp_drake.learners.encoding import expand_directions
+
+CATEGORICAL = (8, 9)  # hand_to_object, object_to_target class indices in Xd
+
+
+class DirectionClassifier(ClassifierMixin, BaseEstimator):
+    """One-vs-one linear SVM over 8 free fractions + two one-hot direction classes.
+
+    Every class is oversampled to the largest; prediction is by one-vs-one votes (ties: the
+    smaller class index).
+    """
+
+    def __init__(self, C: float = 1.0, random_state: int = 0) -> None:
+        self.C = C
+        self.random_state = random_state
+
+    def fit(self, X: np.ndarray, y: np.ndarray) -> DirectionClassifier:
+        X, y = validate_data(self, X, y)
+        y = y.astype(int)
+        Xb, yb = oversample(expand_directions(X, CATEGORICAL), y, np.random.default_rng(self.random_state))
+        svc = SVC(C=self.C, kernel="linear", decision_function_shape="ovo").fit(Xb, yb)
+        self.classes_ = svc.classes_
+        self.coef_ = svc.coef_
+        self.intercept_ = svc.intercept_
+        return self
+
+    def _pairs(self) -> list[tuple[int, int]]:
+        n = len(self.classes_)
+        return [(i, j) for i in range(n) for j in range(i + 1, n)]
+
+    def votes(self, X: np.ndarray) -> np.ndarray:
+        """(n, classes) one-vs-one votes."""
+        check_is_fitted(self)
+        X = validate_data(self, X, reset=False)
+        scores = expand_directions(X, CATEGORICAL) @ self.coef_.T + self.intercept_
+        votes = np.zeros((len(X), len(self.classes_)))
+        for k, (i, j) in enumerate(self._pairs()):
+            votes[:, i] += scores[:, k] > 0
+            votes[:, j] += scores[:, k] <= 0
+        return votes
+
+    def predict(self, X: np.ndarray) -> np.ndarray:
+        return self.classes_[np.argmax(self.votes(X), axis=1)]
+
+    def get_state(self) -> dict[str, np.ndarray]:
+        check_is_fitted(self)
+        return {"classes": self.classes_, "coef": self.coef_, "intercept": self.intercept_}
+
+    def set_state(self, state: dict[str, np.ndarray]) -> DirectionClassifier:
+        self.classes_, self.coef_, self.intercept_ = state["classes"], state["coef"], state["intercept"]
+        self.n_features_in_ = 10
+        return self

@@ -1,0 +1,31 @@
+"""Typed settings of the human-like planner."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from hlp_drake.segmentation.modes import Mode
+
+
+@dataclass(frozen=True)
+class PlannerConfig:
+    """Settings of ``plan``.
+
+    Attributes:
+        mode: feature mode; must match the models' training mode.
+        max_gaps_per_row, max_objects_per_row: at most this many accepted candidates per row
+            (the best-scoring ones), so planning time depends on these caps, not on the number
+            of objects. The original keeps every accepted candidate (with 3 obstacles a row
+            never has more than 4 gaps and 3 obstacles).
+        max_paths: at most this many candidate paths are rolled out (best segment scores first).
+        min_gap_width: gaps narrower than this are never candidates (m; 0 keeps all, as the
+            original).
+        arm_band: half-width of the band swept by an arm link, m.
+    """
+
+    mode: Mode = "fixed"
+    max_gaps_per_row: int = 3
+    max_objects_per_row: int = 2
+    max_paths: int = 24
+    min_gap_width: float = 0.0
+    arm_band: float = 0.025

@@ -1,0 +1,205 @@
+"""The human-like planner: Algorithm 1 of the paper over the task space of any scene (reference 6)."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hlp_drake.features import (
+    arm_features,
+    direction_features,
+    gap_features,
+    object_features,
+    segment_feature_matrix,
+    table_diagonal,
+)
+from hlp_drake.learners.models import DecisionModels
+from hlp_drake.planner.config import PlannerConfig
+from hlp_drake.planner.human_arm import arm_joints, sweep_collision
+from hlp_drake.planner.plan import HighLevelPlan, PlanCandidate, PlanKeypoint
+from hlp_drake.planner.relocation import relocated
+from hlp_drake.scene.model import Scene
+from hlp_drake.scene.validation import scene_problems
+from hlp_drake.segmentation.modes import is_faithful
+from hlp_drake.taskspace import DIRECTIONS, Node, TaskSpace, direction_of, rect_array
+from hlp_drake.features.segment import _misread_wall
+
+VR_DIAGONAL = 0.95268  # the table the models were trained on; arm lengths scale with the table
+
+
+@dataclass
+class _Path:
+    nodes: tuple[Node, ...]
+    score: float
+    keypoints: list[PlanKeypoint] = field(default_factory=list)
+    removed: list[set[str]] = field(default_factory=list)  # per segment: obstacles gone by then
+    arms: list[np.ndarray] = field(default_factory=list)
+    cost: float = 0.0
+
+
+def _row_candidates(nodes: list[Node], scores: dict[str, float], widths: dict[int, float], config: PlannerConfig,
+                    kind: str, cap: int) -> list[Node]:
+    """Accepted candidates of one kind (score > 0, best ``cap``), else the single best one."""
+    pool = [n for n in nodes if n.kind == kind and (kind == "object" or widths[id(n)] >= config.min_gap_width)]
+    if not pool:
+        return []
+    ranked = sorted(pool, key=lambda n: -scores[n.element])
+    accepted = [n for n in ranked if scores[n.element] > 0][:cap] or ranked[:1]
+    return [n for n in pool if n in accepted]  # keep the row's order (left to right / scene order)
+
+
+def _enumerate_paths(candidates: list[list[Node]], segment_scores: list[np.ndarray], max_paths: int) -> list[_Path]:
+    """Node sequences (one per row) along accepted row-to-row segments, best summed score first."""
+    accepted = []
+    for scores in segment_scores:
+        ok = scores > 0
+        if not ok.any():  # the original accepts the two best pairs when none is accepted
+            best = np.argsort(-scores, axis=None)[:2]
+            ok = np.zeros_like(ok)
+            ok.flat[best] = True
+        accepted.append(ok)
+    paths = [_Path((n,), 0.0) for n in candidates[0]]
+    for r, ok in enumerate(accepted):
+        extended = []
+        for path in paths:
+            i = candidates[r].index(path.nodes[-1])
+            for j in np.flatnonzero(ok[i]):
+                extended.append(_Path(path.nodes + (candidates[r + 1][j],), path.score + float(segment_scores[r][i, j])))
+        extended.sort(key=lambda p: -p.score)
+        paths = extended[:max_paths]
+    return paths
+
+
+def _no_plan(scene: Scene, reason: str, started: float) -> HighLevelPlan:
+    return HighLevelPlan(scene.name, (), reason=reason, planning_time_s=time.perf_counter() - started)
+
+
+def plan(scene: Scene, models: DecisionModels, config: PlannerConfig | None = None, *,
+         start_arm: tuple[float, float] | None = None,
+         link_lengths: tuple[float, float] | None = None) -> HighLevelPlan:
+    """Plan how a person would reach the target of ``scene``.
+
+    Args:
+        scene: the scene (any number of rows).
+        models: fitted decision models (trained in ``config.mode``).
+        config: planner settings.
+        start_arm: the arm's (q1, q2) at the start (default: the demonstrators' median).
+        link_lengths: (upper arm, forearm) (default: the demonstrators' median scaled to the table).
+
+    Returns:
+        The plan, or a plan with ``reason`` set (never an exception for a bad scene).
+    """
+    started = time.perf_counter()
+    config = config or PlannerConfig(mode=models.mode)
+    if config.mode != models.mode:
+        return _no_plan(scene, f"models were trained in {models.mode} mode, the planner runs in {config.mode}", started)
+    problems = scene_problems(scene)
+    if problems:
+        return _no_plan(scene, "invalid scene: " + "; ".join(problems), started)
+    faithful = is_faithful(config.mode)
+    space = TaskSpace(scene)
+    scale = table_diagonal(scene.table) / VR_DIAGONAL
+    upper, fore = link_lengths if link_lengths is not None else tuple(np.asarray(models.link_lengths_) * scale)
+    arm_total = upper + fore
+    q0 = np.asarray(start_arm if start_arm is not None else models.start_arm_, float)
+    start = np.asarray(scene.start, float)
+    target = np.asarray(space.target.center, float)
+
+    # 1. Classify every gap and obstacle once.
+    gaps = [g for row in space.gaps for g in row]
+    gap_scores = models.gap.decision_function(gap_features(space)) if gaps else np.zeros(0)
+    object_scores = models.object.decision_function(object_features(space)) if space.obstacle_names else np.zeros(0)
+    details = {
+        "gap_scores": {f"{g.row}:{g.index}": float(s) for g, s in zip(gaps, gap_scores)},
+        "object_scores": dict(zip(space.obstacle_names, map(float, object_scores))),
+    }
+
+    # 2. Candidates per row.
+    candidates: list[list[Node]] = []
+    for row in space.rows:
+        nodes = space.nodes(row.index)
+        scores = {f"{g.row}:{g.index}": s for g, s in zip(gaps, gap_scores)}
+        by_element = {n.element: (scores[f"{row.index}:{n.gap}"] if n.kind == "gap" else details["object_scores"][n.obstacle])
+                      for n in nodes}
+        widths = {id(n): space.gaps[row.index - 1][n.gap - 1].width for n in nodes if n.kind == "gap"}
+        row_nodes = (_row_candidates(nodes, by_element, widths, config, "gap", config.max_gaps_per_row)
+                     + _row_candidates(nodes, by_element, widths, config, "object", config.max_objects_per_row))
+        candidates.append(row_nodes)
+
+    # 3. Segments between consecutive rows, classified; paths along accepted segments.
+    segment_scores = []
+    for r in range(len(candidates) - 1):
+        X = segment_feature_matrix(space, candidates[r], candidates[r + 1], mode=config.mode)
+        segment_scores.append(models.segment.decision_function(X).reshape(len(candidates[r]), len(candidates[r + 1])))
+    paths = _enumerate_paths(candidates, segment_scores, config.max_paths) if candidates else [_Path((), 0.0)]
+
+    # 4. Keypoints per path; moved obstacles' directions by Cd (batched per row).
+    for path in paths:
+        path.keypoints.append(PlanKeypoint("start", (float(start[0]), float(start[1]))))
+    for r in range(len(candidates)):
+        queries = [(p, p.nodes[r]) for p in paths if p.nodes[r].kind == "object"]
+        if queries:
+            X = np.array([direction_features(space, n.obstacle, hand=p.keypoints[-1].position, mode=config.mode)
+                          for p, n in queries])
+            labels = models.direction.predict(X)
+        for path in paths:
+            node = path.nodes[r]
+            if node.kind == "gap":
+                path.keypoints.append(PlanKeypoint("gap", node.center, node.row, node.element))
+        for (path, node), label in zip(queries, labels if queries else []):
+            direction = DIRECTIONS[int(label)]
+            release = relocated(space.rects[node.obstacle], direction, space.alpha).center
+            path.keypoints += [PlanKeypoint("move", node.center, node.row, node.obstacle, direction),
+                               PlanKeypoint("release", release, node.row, node.obstacle, direction)]
+    for path in paths:
+        path.keypoints.append(PlanKeypoint("target", (float(target[0]), float(target[1])), None, scene.target.name))
+
+    # 5. Arm configurations by Ra, step by step across all paths, and the arm's expected collision.
+    for path in paths:
+        path.arms.append(q0)
+    longest = max(len(p.keypoints) for p in paths)
+    for k in range(1, longest):
+        active = [p for p in paths if len(p.keypoints) > k]
+        X = []
+        for p in active:
+            step = np.subtract(p.keypoints[k].position, p.keypoints[k - 1].position)
+            X.append(arm_features(p.arms[-1], step / arm_total, direction_of(*step, faithful=faithful)))
+        predicted = models.arm.predict(np.array(X))
+        for p, q in zip(active, predicted):
+            p.arms.append(np.clip(q, 0.0, np.pi))
+    names = space.obstacle_names
+    walls = [space.walls[w] for w in ("back", "left", "right")]
+    occluders = rect_array([space.rects[n] for n in names] + ([_misread_wall(w) for w in walls] if faithful else walls))
+    before, after, masks, owner = [], [], [], []
+    for index, path in enumerate(paths):
+        gone: set[str] = set()
+        hands = np.array([k.position for k in path.keypoints])
+        joints = arm_joints(hands, np.array(path.arms), upper, fore)
+        for k in range(1, len(path.keypoints)):
+            for keypoint in (path.keypoints[k - 1], path.keypoints[k]):
+                if keypoint.action == "move":
+                    gone.add(keypoint.element)
+            before.append(joints[k - 1])
+            after.append(joints[k])
+            masks.append([n not in gone for n in names] + [True] * len(walls))
+            owner.append(index)
+    if len(paths) > 1 or not faithful:
+        costs = sweep_collision(np.array(before), np.array(after), occluders, np.array(masks, dtype=bool),
+                                band=config.arm_band, faithful=faithful)
+        for index, cost in zip(owner, costs):
+            paths[index].cost += float(cost)
+
+    # 6. The path with the least expected collision (ties: the first).
+    best = min(range(len(paths)), key=lambda i: paths[i].cost)
+    chosen = paths[best]
+    keypoints = tuple(
+        PlanKeypoint(k.action, (float(k.position[0]), float(k.position[1])), k.row, k.element, k.direction,
+                     (float(q[0]), float(q[1])))
+        for k, q in zip(chosen.keypoints, chosen.arms)
+    )
+    alternatives = tuple(sorted((PlanCandidate(tuple(p.keypoints), p.cost) for i, p in enumerate(paths) if i != best),
+                                key=lambda c: c.expected_collision))
+    details["candidates"] = {str(r + 1): [n.element for n in c] for r, c in enumerate(candidates)}
+    return HighLevelPlan(scene.name, keypoints, chosen.cost, alternatives, time.perf_counter() - started, None, details)

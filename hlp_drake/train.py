@@ -1,0 +1,51 @@
+"""``python -m hlp_drake.train``: fit the five decision learners on the VR demonstrations and save them.
+
+    python -m hlp_drake.train [--dataset PATH] [--mode fixed|faithful] [--subjects sub_01 ...] --out DIR
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Sequence
+
+from hlp_drake.cli import run_cli
+from hlp_drake.dataset.dataset import Dataset
+from hlp_drake.errors import HlpError
+from hlp_drake.features import training_data
+from hlp_drake.learners import PRESETS, DecisionModels
+from hlp_drake.segmentation import DEFAULT_MODE, MODES, demonstration_records, segment_dataset
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m hlp_drake.train", description=__doc__.split("\n")[0])
+    parser.add_argument("--dataset", help="the archive or the unpacked dataset/ folder (default: $HLP_DATASET)")
+    parser.add_argument("--mode", choices=MODES, default=DEFAULT_MODE)
+    parser.add_argument("--preset", choices=sorted(PRESETS), default="paper")
+    parser.add_argument("--subjects", nargs="+", help="train on these subjects only (default: all)")
+    parser.add_argument("--out", required=True, help="directory for models.json and models.npz")
+    parser.add_argument("--progress", action="store_true")
+    args = parser.parse_args(argv)
+    dataset = Dataset(args.dataset)
+    if args.subjects:
+        unknown = sorted(set(args.subjects) - set(dataset.subjects))
+        if unknown:
+            raise HlpError(f"unknown subjects: {', '.join(unknown)}")
+    started = time.perf_counter()
+    records = demonstration_records(dataset, args.subjects)
+    result = segment_dataset(dataset, mode=args.mode, records=records, progress=args.progress)
+    data = training_data(result.demonstrations, mode=args.mode)
+    segmented = time.perf_counter()
+    models = DecisionModels(PRESETS[args.preset]).fit(data)
+    models.save(args.out)
+    print(f"segmented {len(result.demonstrations)} demonstrations of {len(models.subjects)} subjects "
+          f"({args.mode} mode) in {segmented - started:.1f} s; fitted {args.preset} models in "
+          f"{time.perf_counter() - segmented:.1f} s")
+    print(f"rows: gap {len(data.gap)}, object {len(data.object)}, segment {len(data.segment)}, "
+          f"direction {len(data.direction)}, arm {len(data.arm)}")
+    print(f"wrote {args.out}/models.json and models.npz")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(run_cli(main))

@@ -21,7 +21,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m hlp_drake.train", description=__doc__.split("\n")[0])
     parser.add_argument("--dataset", help="the archive or the unpacked dataset/ folder (default: $HLP_DATASET)")
     parser.add_argument("--mode", choices=MODES, default=DEFAULT_MODE)
-    parser.add_argument("--preset", choices=sorted(PRESETS), default="paper")
+    parser.add_argument("--preset", choices=sorted(PRESETS), default="strong",
+                        help="strong (default, the bundled models) or paper (reference section 5)")
     parser.add_argument("--subjects", nargs="+", help="train on these subjects only (default: all)")
     parser.add_argument("--out", required=True, help="directory for models.json and models.npz")
     parser.add_argument("--progress", action="store_true")

@@ -88,8 +88,10 @@ def test_left_handers_are_mirrored_in_fixed_mode(fixed, faithful):
 
 def test_faithful_training_sets_have_the_reference_sizes(faithful):
     data = training_data(faithful.demonstrations, mode="faithful")
-    assert data.gap.X.shape == (6256, 5) and data.gap.y.sum() == 1029
-    assert data.object.X.shape == (9030, 7) and data.object.y.sum() == 2475
+    gap, obj = data.gap.original_rows(), data.object.original_rows()
+    assert gap.X.shape == (6256, 5) and gap.y.sum() == 1029
+    assert obj.X.shape == (9030, 7) and obj.y.sum() == 2475
+    assert len(data.gap) == 8 * 1752 and len(data.object) == 6 * 1752  # every trial, for other presets
     assert data.direction.X.shape == (2475, 10)
     assert data.segment.X.shape == (85848, 4) and data.segment.y.sum() == 1752
     assert data.arm.X.shape == (7731, 5) and data.arm.y.shape == (7731, 2)

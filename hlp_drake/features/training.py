@@ -25,14 +25,22 @@ class LabelledSet:
     y: np.ndarray
     subjects: np.ndarray
     keys: np.ndarray
+    original: np.ndarray  # bool per row: part of the original's training set (see ``training_data``)
 
     def __len__(self) -> int:
         return len(self.y)
 
+    def rows(self, mask: np.ndarray) -> LabelledSet:
+        return LabelledSet(self.columns, self.X[mask], self.y[mask], self.subjects[mask], self.keys[mask],
+                           self.original[mask])
+
     def subset(self, subjects: Iterable[str]) -> LabelledSet:
         """The rows of the given subjects."""
-        mask = np.isin(self.subjects, list(subjects))
-        return LabelledSet(self.columns, self.X[mask], self.y[mask], self.subjects[mask], self.keys[mask])
+        return self.rows(np.isin(self.subjects, list(subjects)))
+
+    def original_rows(self) -> LabelledSet:
+        """Only the rows the original code trained on."""
+        return self.rows(self.original)
 
 
 @dataclass
@@ -57,13 +65,14 @@ class _Builder:
     """Accumulates the rows of one labelled set."""
 
     def __init__(self, columns: tuple[str, ...]) -> None:
-        self.columns, self.X, self.y, self.keys = columns, [], [], []
+        self.columns, self.X, self.y, self.keys, self.original = columns, [], [], [], []
 
-    def add(self, key: str, X: np.ndarray, y: np.ndarray) -> None:
+    def add(self, key: str, X: np.ndarray, y: np.ndarray, original: bool = True) -> None:
         X = np.atleast_2d(X)
         self.X.append(X)
         self.y.append(np.asarray(y, dtype=float).reshape(len(X), -1))
         self.keys += [key] * len(X)
+        self.original += [original] * len(X)
 
     def build(self) -> LabelledSet:
         width = len(self.columns)
@@ -72,7 +81,7 @@ class _Builder:
         y = y[:, 0] if y.shape[1] == 1 else y
         keys = np.array(self.keys, dtype=object)
         subjects = np.array([k.split("/")[0] for k in self.keys], dtype=object)
-        return LabelledSet(self.columns, X, y, subjects, keys)
+        return LabelledSet(self.columns, X, y, subjects, keys, np.array(self.original, dtype=bool))
 
 
 def _chosen(node: Node, decision) -> bool:
@@ -103,12 +112,33 @@ def _segment_labels(space: TaskSpace, demo: Demonstration, row: int, near: list[
     return labels
 
 
+def gap_labels(demo: Demonstration, space: TaskSpace, *, faithful: bool) -> list[float]:
+    """Per gap (rows in order, left to right): 1 for the gap the hand went through, 0 elsewhere and
+    in rows where an obstacle was moved. Faithful: the raw passage flags of gap rows."""
+    labels: list[float] = []
+    for decision, row_flags, gaps in zip(demo.decisions, demo.gap_flags, space.gaps):
+        if decision.decision == OBJECT:
+            labels += [0.0] * len(gaps)
+        elif faithful:
+            labels += [float(f) for f in row_flags]
+        else:
+            labels += [float(g.index == decision.gap) for g in gaps]
+    return labels
+
+
+def object_labels(demo: Demonstration, space: TaskSpace) -> list[float]:
+    """Per obstacle (scene order): 1 for each row's moved obstacle."""
+    moved = {d.obstacle for d in demo.decisions if d.decision == OBJECT}
+    return [float(n in moved) for n in space.obstacle_names]
+
+
 def training_data(demonstrations: Iterable[Demonstration], *, mode: Mode | None = None) -> TrainingData:
     """Build the five training sets from demonstrations segmented in ``mode``.
 
-    - gap: every gap of a trial that used at least one gap (label: the gap passed; 0 in rows where
-      an obstacle was moved);
-    - object: every obstacle of a trial that moved at least one (label: the row's moved obstacle);
+    - gap: every gap of every trial (label: the gap passed; 0 in rows where an obstacle was
+      moved); the original uses only trials that used at least one gap (``original`` rows);
+    - object: every obstacle of every trial (label: the row's moved obstacle); the original uses
+      only trials that moved at least one obstacle (``original`` rows);
     - direction: one row per moved obstacle (label: direction class index);
     - segment: every (node of row r, node of row r+1) pair (label: the pair the hand used);
     - arm: consecutive keypoints (label: the next keypoint's (q1, q2)).
@@ -123,19 +153,8 @@ def training_data(demonstrations: Iterable[Demonstration], *, mode: Mode | None 
         faithful = is_faithful(mode)
         space = TaskSpace(demo.scene)
         flags = demo.flags
-        if not all(flags):
-            labels = []
-            for decision, row_flags, gaps in zip(demo.decisions, demo.gap_flags, space.gaps):
-                if decision.decision == OBJECT:
-                    labels += [0.0] * len(gaps)
-                elif faithful:
-                    labels += [float(f) for f in row_flags]
-                else:
-                    labels += [float(g.index == decision.gap) for g in gaps]
-            gap.add(demo.key, gap_features(space), labels)
-        if any(flags):
-            moved = {d.obstacle for d in demo.decisions if d.decision == OBJECT}
-            obj.add(demo.key, object_features(space), [float(n in moved) for n in space.obstacle_names])
+        gap.add(demo.key, gap_features(space), gap_labels(demo, space, faithful=faithful), not all(flags))
+        obj.add(demo.key, object_features(space), object_labels(demo, space), any(flags))
         for k, keypoint in enumerate(demo.keypoints):
             if keypoint.kind != "approach":
                 continue

@@ -8,6 +8,8 @@ from sklearn.gaussian_process import GaussianProcessRegressor
 from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from hlp_drake.learners.inputs import prediction_input
+
 from hlp_drake.learners.encoding import expand_directions
 
 CATEGORICAL = (4,)  # direction class index in Xa
@@ -59,8 +61,7 @@ class ArmRegressor(RegressorMixin, BaseEstimator):
 
     def predict(self, X: np.ndarray) -> np.ndarray:
         """(n, outputs) predicted angles."""
-        check_is_fitted(self)
-        X = validate_data(self, X, reset=False)
+        X = prediction_input(self, X)
         Z = (expand_directions(X, CATEGORICAL) - self.mean_) / self.scale_
         sq = (Z**2).sum(1)[:, None] + (self.train_**2).sum(1)[None, :] - 2.0 * Z @ self.train_.T
         sq = np.clip(sq, 0.0, None)

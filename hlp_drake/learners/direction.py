@@ -7,6 +7,8 @@ from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.svm import SVC
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from hlp_drake.learners.inputs import prediction_input
+
 from hlp_drake.learners.balance import oversample
 from hlp_drake.learners.encoding import expand_directions
 
@@ -40,8 +42,7 @@ class DirectionClassifier(ClassifierMixin, BaseEstimator):
 
     def votes(self, X: np.ndarray) -> np.ndarray:
         """(n, classes) one-vs-one votes."""
-        check_is_fitted(self)
-        X = validate_data(self, X, reset=False)
+        X = prediction_input(self, X)
         scores = expand_directions(X, CATEGORICAL) @ self.coef_.T + self.intercept_
         votes = np.zeros((len(X), len(self.classes_)))
         for k, (i, j) in enumerate(self._pairs()):

@@ -7,6 +7,8 @@ from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.svm import SVC
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from hlp_drake.learners.inputs import prediction_input
+
 from hlp_drake.learners.balance import oversample
 
 
@@ -19,6 +21,7 @@ class RbfSvmClassifier(ClassifierMixin, BaseEstimator):
         max_per_class: rows per class after balancing at most (large classes are subsampled
             first); None balances to the largest class as the original. An RBF SVM's fit grows
             quadratically with the rows, so the segment classifier uses a cap.
+        balance: oversample the minority class (the original); False fits the natural mix.
         random_state: seed of the oversampling.
 
     The fitted model keeps only plain arrays (scaler, support vectors, dual coefficients), so
@@ -26,10 +29,11 @@ class RbfSvmClassifier(ClassifierMixin, BaseEstimator):
     """
 
     def __init__(self, C: float = 1.0, kernel_scale: float = 0.25, max_per_class: int | None = None,
-                 random_state: int = 0) -> None:
+                 balance: bool = True, random_state: int = 0) -> None:
         self.C = C
         self.kernel_scale = kernel_scale
         self.max_per_class = max_per_class
+        self.balance = balance
         self.random_state = random_state
 
     def fit(self, X: np.ndarray, y: np.ndarray) -> RbfSvmClassifier:
@@ -38,7 +42,7 @@ class RbfSvmClassifier(ClassifierMixin, BaseEstimator):
         if len(self.classes_) != 2:
             raise ValueError(f"RbfSvmClassifier needs two classes, got {len(self.classes_)}")
         rng = np.random.default_rng(self.random_state)
-        Xb, yb = oversample(X, y, rng, self.max_per_class)
+        Xb, yb = oversample(X, y, rng, self.max_per_class) if self.balance else (X, y)
         self.mean_ = Xb.mean(axis=0)
         self.scale_ = np.where(Xb.std(axis=0) > 0, Xb.std(axis=0), 1.0)
         self.gamma_ = 1.0 / self.kernel_scale**2
@@ -51,8 +55,7 @@ class RbfSvmClassifier(ClassifierMixin, BaseEstimator):
 
     def decision_function(self, X: np.ndarray) -> np.ndarray:
         """Signed distance-like score; > 0 means the positive class (``classes_[1]``)."""
-        check_is_fitted(self)
-        X = validate_data(self, X, reset=False)
+        X = prediction_input(self, X)
         Z = (X - self.mean_) / self.scale_
         sq = (Z**2).sum(1)[:, None] + (self.support_vectors_**2).sum(1)[None, :] - 2.0 * Z @ self.support_vectors_.T
         return np.exp(-self.gamma_ * np.clip(sq, 0.0, None)) @ self.dual_coef_ + self.intercept_

@@ -21,6 +21,9 @@ class PlannerConfig:
         min_gap_width: gaps narrower than this are never candidates (m; 0 keeps all, as the
             original).
         arm_band: half-width of the band swept by an arm link, m.
+        classify_per_row: per row, only the gaps and obstacles laterally nearest the start-target
+            line (this many of each) are classified, so the work per row is bounded however
+            crowded the row is (a VR row has 4 gaps and 3 obstacles: all are classified).
     """
 
     mode: Mode = "fixed"
@@ -29,3 +32,4 @@ class PlannerConfig:
     max_paths: int = 24
     min_gap_width: float = 0.0
     arm_band: float = 0.025
+    classify_per_row: int = 6

@@ -51,11 +51,16 @@ def _row_candidates(nodes: list[Node], scores: dict[str, float], widths: dict[in
 
 
 def _enumerate_paths(candidates: list[list[Node]], segment_scores: list[np.ndarray], max_paths: int) -> list[_Path]:
-    """Node sequences (one per row) along accepted row-to-row segments, best summed score first."""
+    """Node sequences (one per row) along accepted row-to-row segments, best summed score first.
+
+    A pair is accepted when Cc scores it positive. As in the original, when no pair between two
+    rows is accepted the two best pairs are; and a node with no accepted way on continues along
+    its best-scoring segment, so there is always a path.
+    """
     accepted = []
     for scores in segment_scores:
         ok = scores > 0
-        if not ok.any():  # the original accepts the two best pairs when none is accepted
+        if not ok.any():
             best = np.argsort(-scores, axis=None)[:2]
             ok = np.zeros_like(ok)
             ok.flat[best] = True
@@ -65,11 +70,29 @@ def _enumerate_paths(candidates: list[list[Node]], segment_scores: list[np.ndarr
         extended = []
         for path in paths:
             i = candidates[r].index(path.nodes[-1])
-            for j in np.flatnonzero(ok[i]):
+            following = np.flatnonzero(ok[i]) if ok[i].any() else [int(np.argmax(segment_scores[r][i]))]
+            for j in following:
                 extended.append(_Path(path.nodes + (candidates[r + 1][j],), path.score + float(segment_scores[r][i, j])))
         extended.sort(key=lambda p: -p.score)
         paths = extended[:max_paths]
     return paths
+
+
+def _nearest_per_row(space: TaskSpace, items: list[tuple[int, tuple[float, float]]], start: np.ndarray,
+                     target: np.ndarray, limit: int) -> np.ndarray:
+    """Indices of ``items`` (row, centre) kept: per row the ``limit`` laterally nearest the line
+    from the start to the target (measured at the item's depth)."""
+    keep = []
+    for row in space.rows:
+        index = [i for i, (r, _) in enumerate(items) if r == row.index]
+        if len(index) > limit:
+            def offset(i: int) -> float:
+                x, y = items[i][1]
+                t = (x - start[0]) / (target[0] - start[0]) if target[0] != start[0] else 0.0
+                return abs(y - (start[1] + t * (target[1] - start[1])))
+            index = sorted(sorted(index, key=offset)[:limit])
+        keep += index
+    return np.array(sorted(keep), dtype=int)
 
 
 def _no_plan(scene: Scene, reason: str, started: float) -> HighLevelPlan:
@@ -107,21 +130,32 @@ def plan(scene: Scene, models: DecisionModels, config: PlannerConfig | None = No
     start = np.asarray(scene.start, float)
     target = np.asarray(space.target.center, float)
 
-    # 1. Classify every gap and obstacle once.
+    # 1. Classify the gaps and obstacles once (per row the ones nearest the start-target line).
     gaps = [g for row in space.gaps for g in row]
-    gap_scores = models.gap.decision_function(gap_features(space)) if gaps else np.zeros(0)
-    object_scores = models.object.decision_function(object_features(space)) if space.obstacle_names else np.zeros(0)
+    names = space.obstacle_names
+    gap_pick = _nearest_per_row(space, [(g.row, g.center) for g in gaps], start, target, config.classify_per_row)
+    row_of = {n: row.index for row in space.rows for n in row.members}
+    object_pick = _nearest_per_row(space, [(row_of[n], space.rects[n].center) for n in names], start, target,
+                                   config.classify_per_row)
+    gap_scores = np.full(len(gaps), -np.inf)
+    object_scores = np.full(len(names), -np.inf)
+    if len(gap_pick):
+        gap_scores[gap_pick] = models.gap.decision_function(gap_features(space)[gap_pick])
+    if len(object_pick):
+        object_scores[object_pick] = models.object.decision_function(object_features(space)[object_pick])
     details = {
-        "gap_scores": {f"{g.row}:{g.index}": float(s) for g, s in zip(gaps, gap_scores)},
-        "object_scores": dict(zip(space.obstacle_names, map(float, object_scores))),
+        "gap_scores": {f"{g.row}:{g.index}": float(s) for g, s in zip(gaps, gap_scores) if np.isfinite(s)},
+        "object_scores": {n: float(s) for n, s in zip(names, object_scores) if np.isfinite(s)},
     }
 
     # 2. Candidates per row.
     candidates: list[list[Node]] = []
+    scores = {f"{g.row}:{g.index}": s for g, s in zip(gaps, gap_scores)}
+    obstacle_scores = dict(zip(names, object_scores))
     for row in space.rows:
-        nodes = space.nodes(row.index)
-        scores = {f"{g.row}:{g.index}": s for g, s in zip(gaps, gap_scores)}
-        by_element = {n.element: (scores[f"{row.index}:{n.gap}"] if n.kind == "gap" else details["object_scores"][n.obstacle])
+        nodes = [n for n in space.nodes(row.index)
+                 if np.isfinite(scores[f"{row.index}:{n.gap}"] if n.kind == "gap" else obstacle_scores[n.obstacle])]
+        by_element = {n.element: (scores[f"{row.index}:{n.gap}"] if n.kind == "gap" else obstacle_scores[n.obstacle])
                       for n in nodes}
         widths = {id(n): space.gaps[row.index - 1][n.gap - 1].width for n in nodes if n.kind == "gap"}
         row_nodes = (_row_candidates(nodes, by_element, widths, config, "gap", config.max_gaps_per_row)
@@ -169,7 +203,6 @@ def plan(scene: Scene, models: DecisionModels, config: PlannerConfig | None = No
         predicted = models.arm.predict(np.array(X))
         for p, q in zip(active, predicted):
             p.arms.append(np.clip(q, 0.0, np.pi))
-    names = space.obstacle_names
     walls = [space.walls[w] for w in ("back", "left", "right")]
     occluders = rect_array([space.rects[n] for n in names] + ([_misread_wall(w) for w in walls] if faithful else walls))
     before, after, masks, owner = [], [], [], []

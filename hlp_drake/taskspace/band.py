@@ -11,8 +11,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-import shapely
-from shapely.geometry import Polygon, box
+from shapely.geometry import Polygon
 
 from hlp_drake.taskspace.rect import Rect
 

@@ -1,0 +1,76 @@
+"""Planning time of the human-like planner with the bundled models, and per-scene feature time.
+
+    python benchmarks/planning_time.py [--dataset PATH] [--scenes 50] [--json OUT]
+
+Scenes: the VR scenes of 5 held-out subjects (the ~450 test scenes of one 19/5 split) and seeded
+Generalization II scenes with 6, 12, 25 and 50 objects (sizes the generator cannot place are
+reported as such). Prints the median and 95th percentile per group.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import time
+import timeit
+from pathlib import Path
+
+import numpy as np
+
+from hlp_drake.dataset import Dataset
+from hlp_drake.errors import HlpError
+from hlp_drake.evaluation import subject_splits
+from hlp_drake.features import gap_features, object_features, segment_feature_matrix
+from hlp_drake.learners.bundled import default_models
+from hlp_drake.planner import plan
+from hlp_drake.scene.generators import generate_scene
+from hlp_drake.segmentation import demonstration_records
+from hlp_drake.taskspace import TaskSpace
+
+DEFAULT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "hlp-vr-dataset.tar.xz"
+
+
+def times(scenes, models) -> dict[str, float]:
+    for scene in scenes[:3]:
+        plan(scene, models)  # warm up
+    t = np.array([plan(scene, models).planning_time_s for scene in scenes])
+    return {"scenes": len(scenes), "median_ms": float(np.median(t) * 1e3), "p95_ms": float(np.percentile(t, 95) * 1e3)}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--dataset", default=str(DEFAULT))
+    parser.add_argument("--scenes", type=int, default=50, help="generated scenes per object count")
+    parser.add_argument("--json")
+    args = parser.parse_args()
+    models = default_models()
+    report: dict = {"machine": f"{platform.processor() or platform.machine()}, {platform.python_version()}"}
+    dataset = Dataset(args.dataset, progress=False)
+    _, test = subject_splits(dataset.subjects, n_train=19, splits=1, seed=0)[0]
+    vr = [dataset.scene(r.key) for r in demonstration_records(dataset, test)]
+    report["vr_test_scenes"] = times(vr, models)
+    space = TaskSpace(vr[0])
+    feature_time = timeit.timeit(lambda: (gap_features(TaskSpace(vr[0])), object_features(TaskSpace(vr[0]))), number=300)
+    segment_time = timeit.timeit(lambda: segment_feature_matrix(space, space.nodes(1), space.nodes(2), mode="fixed"),
+                                 number=300)
+    report["features_per_scene_ms"] = {"task_space_gap_object": feature_time / 300 * 1e3,
+                                       "segment_grid_7x7": segment_time / 300 * 1e3}
+    for objects in (6, 12, 25, 50):
+        try:
+            scenes = [generate_scene("gen2", seed, objects) for seed in range(args.scenes)]
+        except HlpError as error:
+            report[f"gen2_{objects}"] = {"error": str(error)}
+            continue
+        report[f"gen2_{objects}"] = times(scenes, models) | {
+            "rows_mean": float(np.mean([len(TaskSpace(s).rows) for s in scenes]))}
+    for name, value in report.items():
+        print(f"{name}: {value}")
+    if args.json:
+        Path(args.json).write_text(json.dumps(report, indent=2) + "\n")
+
+
+if __name__ == "__main__":
+    started = time.perf_counter()
+    main()
+    print(f"({time.perf_counter() - started:.0f} s)")

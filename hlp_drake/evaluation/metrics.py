@@ -1,0 +1,82 @@
+"""Per-trial similarity of a plan to the person's decisions (reference section 7, the paper's Table I)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from hlp_drake.features.training import gap_labels, object_labels
+from hlp_drake.planner.plan import HighLevelPlan
+from hlp_drake.segmentation.demonstration import GAP, OBJECT, Demonstration
+from hlp_drake.taskspace import TaskSpace
+
+
+@dataclass(frozen=True)
+class RowOutcome:
+    row: int
+    human_decision: str
+    human_element: str
+    hlp_decision: str
+    hlp_element: str
+    decision_ok: bool  # I(D)
+    element_ok: bool  # I(E) as the released code: raw classifier labels of the row match the person's
+    element_plan_ok: bool  # the plan used the person's element
+
+
+@dataclass(frozen=True)
+class TrialOutcome:
+    key: str
+    rows: tuple[RowOutcome, ...]
+    gap_correct: int
+    gap_total: int
+    object_correct: int
+    object_total: int
+    planning_time_s: float
+
+    @property
+    def shlp(self) -> float:
+        """0.25 * sum over rows of I(D) * (I(D) + I(E)) for two rows; scaled by rows otherwise."""
+        scores = [int(r.decision_ok) * (int(r.decision_ok) + int(r.element_ok)) for r in self.rows]
+        return float(np.sum(scores)) / (2.0 * len(self.rows)) if self.rows else 0.0
+
+
+def planned_rows(plan: HighLevelPlan) -> dict[int, tuple[str, str]]:
+    """Per row: ("gap", index) or ("object", name) of the plan."""
+    rows: dict[int, tuple[str, str]] = {}
+    for k in plan.keypoints:
+        if k.row is not None and k.row not in rows and k.action in ("gap", "move"):
+            rows[k.row] = (GAP if k.action == "gap" else OBJECT, str(k.element))
+    return rows
+
+
+def score_trial(demo: Demonstration, plan: HighLevelPlan, *, faithful: bool) -> TrialOutcome:
+    """Compare ``plan`` (made for ``demo.scene``) with what the person did."""
+    space = TaskSpace(demo.scene)
+    gap_truth = np.array(gap_labels(demo, space, faithful=faithful)) > 0
+    object_truth = np.array(object_labels(demo, space)) > 0
+    gaps = [g for row in space.gaps for g in row]
+    gap_raw = np.array([plan.details.get("gap_scores", {}).get(f"{g.row}:{g.index}", -1.0) > 0 for g in gaps])
+    object_raw = np.array([plan.details.get("object_scores", {}).get(n, -1.0) > 0 for n in space.obstacle_names])
+    planned = planned_rows(plan)
+    rows = []
+    for decision in demo.decisions:
+        hlp_decision, hlp_element = planned.get(decision.row, ("none", ""))
+        if hlp_decision == GAP:
+            mask = np.array([g.row == decision.row for g in gaps])
+            element_ok = bool(np.array_equal(gap_raw[mask], gap_truth[mask]))
+        elif hlp_decision == OBJECT:
+            members = set(space.rows[decision.row - 1].members)
+            mask = np.array([n in members for n in space.obstacle_names])
+            element_ok = bool(np.array_equal(object_raw[mask], object_truth[mask]))
+        else:
+            element_ok = False
+        decision_ok = hlp_decision == decision.decision
+        rows.append(RowOutcome(decision.row, decision.decision, decision.element, hlp_decision, hlp_element,
+                               decision_ok, element_ok, decision_ok and hlp_element == decision.element))
+    return TrialOutcome(
+        demo.key, tuple(rows),
+        int((gap_raw == gap_truth).sum()), len(gaps),
+        int((object_raw == object_truth).sum()), len(object_truth),
+        plan.planning_time_s,
+    )

@@ -1,0 +1,81 @@
+"""The learners as scikit-learn estimators, and the safe model files."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from sklearn.base import clone
+
+from hlp_drake.errors import ModelError
+from hlp_drake.learners import ArmRegressor, DecisionModels, DirectionClassifier, RbfSvmClassifier
+from hlp_drake.learners.bundled import BUNDLED_DIRECTORY, default_models
+
+
+def _blobs(n: int = 300, seed: int = 0):
+    rng = np.random.default_rng(seed)
+    X = np.vstack([rng.normal(0.0, 0.3, (n, 3)), rng.normal(1.0, 0.3, (n // 5, 3))])
+    y = np.r_[np.zeros(n), np.ones(n // 5)]
+    return X, y
+
+
+def test_rbf_svm_learns_separable_classes_and_follows_the_estimator_api():
+    X, y = _blobs()
+    model = RbfSvmClassifier(kernel_scale=1.0)
+    assert model.fit(X, y) is model
+    assert (model.predict(X) == y).mean() > 0.95
+    assert clone(model).get_params() == model.get_params()
+    with pytest.raises(ValueError, match="two classes"):
+        RbfSvmClassifier().fit(X, np.zeros(len(X)))
+    with pytest.raises(ValueError, match="NaN"):
+        model.decision_function(np.full((1, 3), np.nan))
+
+
+def test_svm_decision_function_matches_scikit_learn():
+    from sklearn.svm import SVC
+
+    X, y = _blobs()
+    model = RbfSvmClassifier(kernel_scale=0.5, balance=False).fit(X, y)
+    reference = SVC(C=1.0, gamma=4.0).fit((X - model.mean_) / model.scale_, y)
+    assert model.decision_function(X) == pytest.approx(reference.decision_function((X - model.mean_) / model.scale_))
+
+
+def test_direction_classifier_and_arm_regressor_learn():
+    rng = np.random.default_rng(1)
+    free = rng.uniform(0, 1, (400, 8))
+    label = np.argmax(free, axis=1)  # move towards the freest block
+    X = np.column_stack([free, rng.integers(0, 8, 400), rng.integers(0, 8, 400)])
+    assert (DirectionClassifier().fit(X, label).predict(X) == label).mean() > 0.8
+    Xa = np.column_stack([rng.uniform(1, 2, (300, 2)), rng.normal(0, 0.3, (300, 2)), rng.integers(0, 8, 300)])
+    ya = Xa[:, :2] + 0.5 * Xa[:, 2:4]
+    arm = ArmRegressor(max_samples=200).fit(Xa, ya)
+    assert np.sqrt(((arm.predict(Xa) - ya) ** 2).mean()) < 0.05
+
+
+def test_bundled_models_load_and_round_trip(tmp_path):
+    models = default_models()
+    assert models.mode == "fixed" and len(models.subjects) == 24
+    saved = models.save(tmp_path / "copy")
+    again = DecisionModels.load(saved)
+    X = np.random.default_rng(0).uniform(0, 1, (5, 5))
+    assert again.gap.decision_function(X) == pytest.approx(models.gap.decision_function(X))
+
+
+def test_tampered_or_foreign_model_files_are_refused(tmp_path):
+    directory = default_models().save(tmp_path / "m")
+    npz = directory / "models.npz"
+    data = bytearray(npz.read_bytes())
+    data[100] ^= 0xFF
+    npz.write_bytes(bytes(data))
+    with pytest.raises(ModelError, match="checksum mismatch"):
+        DecisionModels.load(directory)
+    (directory / "models.json").write_text("{not json")
+    with pytest.raises(ModelError, match="not a model description"):
+        DecisionModels.load(directory)
+    (directory / "models.json").write_text(json.dumps({"format": "pickle"}))
+    with pytest.raises(ModelError, match="not an hlp_drake model file"):
+        DecisionModels.load(directory)
+    with pytest.raises(ModelError, match="model file not found"):
+        DecisionModels.load(tmp_path / "nowhere")
+    assert (BUNDLED_DIRECTORY / "models.json").is_file()

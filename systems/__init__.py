@@ -1,5 +1,7 @@
 """Drake blocks of hlp_drake (imported as ``hlp_drake.systems``) and the model package they load."""
 
+from hlp_drake.systems.hlp_planner_system import HlpPlannerSystem
+from hlp_drake.systems.keypoint_ik import Keyframes, KeypointIk
 from hlp_drake.systems.model_package import MODELS_PACKAGE, configure_parser, models_directory
 from hlp_drake.systems.robot import (
     ACTUATED_JOINTS,
@@ -13,8 +15,46 @@ from hlp_drake.systems.robot import (
     robot_joint_limits,
     set_robot_positions,
 )
+from hlp_drake.systems.scene_models import (
+    SceneModels,
+    add_scene,
+    fallen_objects,
+    object_planar_poses,
+    scene_from_plant,
+    set_object_poses,
+)
+from hlp_drake.systems.world import (
+    DESIRED_STATE_PORT,
+    PlanningModel,
+    add_position_trajectory,
+    desired_state_from_robot_state,
+    make_world_diagram,
+    robot_base_pose,
+    start_configuration,
+    world_plant,
+)
+from hlp_drake.systems.world_config import WorldConfig, load_world_config
 
 __all__ = [
+    "DESIRED_STATE_PORT",
+    "HlpPlannerSystem",
+    "Keyframes",
+    "KeypointIk",
+    "PlanningModel",
+    "SceneModels",
+    "WorldConfig",
+    "add_position_trajectory",
+    "add_scene",
+    "desired_state_from_robot_state",
+    "fallen_objects",
+    "load_world_config",
+    "make_world_diagram",
+    "object_planar_poses",
+    "robot_base_pose",
+    "scene_from_plant",
+    "set_object_poses",
+    "start_configuration",
+    "world_plant",
     "ACTUATED_JOINTS",
     "ARM_JOINTS",
     "BASE_JOINTS",

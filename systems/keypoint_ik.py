@@ -1,0 +1,393 @@
+"""``KeypointIk``: a high-level plan's keypoints -> robot keyframes (IK) -> a joint-space trajectory.
+
+Input port:
+    ``plan`` (abstract, ``HighLevelPlan``): the plan for the scene the system was built for.
+
+Output ports (both computed only when ``plan`` changes; cached otherwise):
+    ``keyframes`` (abstract, ``Keyframes``): per keypoint the robot's 11 positions, a success flag and
+        a message naming the keypoint when its IK failed.
+    ``trajectory`` (abstract, ``PiecewisePolynomial``): a first-order hold of the robot's 11 positions
+        from the start configuration through the successful keyframes (straight lines in joint space),
+        timed by ``WorldConfig.motion``.
+
+The positions are in the robot model instance's order (``world.robot_position_names()``: base x, y,
+yaw, the six UR5 joints, left finger, right (mimic) finger), the same in the world diagram's plant,
+so ``world.add_position_trajectory`` can play the trajectory.
+
+Each keypoint's IK (SNOPT) runs on a planning model built once here: the robot, the table and the
+scene's objects welded at their scene poses, with one private context. Constraints:
+
+* the tcp at the keypoint's (x, y) and ``config.ik.height`` above the table top (within
+  ``ik.position_tolerance``);
+* the approach axis (tcp +z) within ``ik.approach_tolerance`` of world +x and the finger axis (tcp
+  +y) within ``ik.roll_tolerance`` of horizontal: the horizontal grasp of the start configuration;
+* joint limits, the gripper kept open, the base within its workspace (its front at most
+  ``ik.base_under_table`` past the table's front edge, its centre within the table's width plus
+  ``ik.base_lateral_margin``);
+* at least ``ik.table_clearance`` between the robot and the table top and between the robot's own
+  links. Robot-object pairs are filtered out in the private context: pushing objects is allowed.
+
+The cost keeps each keyframe near the previous one. A keypoint is solved from up to ``ik.attempts``
+seeds (the previous keyframe; it with the base moved along with the tcp; the start posture moved
+to the keypoint) and checked by forward kinematics; a keypoint that fails is reported in
+``Keyframes`` and skipped by the trajectory (the next keypoint is seeded from the last success).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.geometry import CollisionFilterDeclaration, GeometrySet
+from pydrake.multibody.inverse_kinematics import InverseKinematics
+from pydrake.solvers import Solve
+from pydrake.systems.framework import LeafSystem
+from pydrake.trajectories import PiecewisePolynomial
+
+from hlp_drake.planner.plan import HighLevelPlan, PlanKeypoint
+from hlp_drake.scene.model import Scene
+from hlp_drake.systems.robot import (
+    ARM_JOINTS,
+    BASE_FOOTPRINT,
+    BASE_JOINTS,
+    GRIPPER_JOINTS,
+    GRIPPER_MIMIC_JOINTS,
+    TCP_FRAME,
+)
+from hlp_drake.systems.world import (
+    PlanningModel,
+    ik_solver_options,
+    robot_position_names,
+    start_configuration,
+    tcp_keypoint_height,
+)
+from hlp_drake.systems.world_config import WorldConfig
+
+START_MATCH_TOLERANCE = 1e-3
+"""A "start" keypoint this close (m) to ``scene.start`` uses the start configuration without IK."""
+POSTURE_WEIGHT = 0.05
+"""Weight of the pull of the arm's joints towards their start posture, against 1 for the step."""
+FK_CHECK_FACTOR = 2.0
+"""A solution whose tcp is farther than this times ``ik.position_tolerance`` from its target fails."""
+
+
+@dataclass(frozen=True)
+class Keyframes:
+    """The IK result of a plan.
+
+    Attributes:
+        keypoints: the plan's keypoints.
+        positions: (n, 11) robot positions per keypoint (for a failed keypoint: the solver's last
+            iterate, not to be executed).
+        success: per keypoint, whether its IK succeeded.
+        messages: per keypoint, "" on success, else why it failed (naming the keypoint).
+        tcp_positions: (n, 3) tcp positions of ``positions`` (forward kinematics).
+        start: the robot's 11 start positions.
+        problems: plan-level problems (no plan, wrong scene); empty normally.
+        solve_time_s: wall-clock time of all the solves.
+    """
+
+    keypoints: tuple[PlanKeypoint, ...]
+    positions: np.ndarray
+    success: tuple[bool, ...]
+    messages: tuple[str, ...]
+    tcp_positions: np.ndarray
+    start: np.ndarray
+    problems: tuple[str, ...] = ()
+    solve_time_s: float = 0.0
+    details: dict = field(default_factory=dict, compare=False)
+
+    @property
+    def ok(self) -> bool:
+        """True when there are keyframes, all succeeded, and the plan had no problem."""
+        return not self.problems and len(self.success) > 0 and all(self.success)
+
+    @property
+    def failures(self) -> list[str]:
+        """Every problem and failure message."""
+        return [*self.problems, *(m for m, ok in zip(self.messages, self.success) if not ok)]
+
+    @classmethod
+    def empty(cls, start: np.ndarray, problem: str | None = None) -> Keyframes:
+        n = len(start)
+        return cls(
+            keypoints=(),
+            positions=np.zeros((0, n)),
+            success=(),
+            messages=(),
+            tcp_positions=np.zeros((0, 3)),
+            start=np.array(start, dtype=float),
+            problems=() if problem is None else (problem,),
+        )
+
+
+def _describe(index: int, keypoint: PlanKeypoint) -> str:
+    element = f" {keypoint.element}" if keypoint.element else ""
+    x, y = keypoint.position
+    return f"keypoint {index} ({keypoint.action}{element}) at ({x:.3f}, {y:.3f})"
+
+
+class KeypointIk(LeafSystem):
+    """Solves IK for a plan's keypoints on ``scene`` and times a joint trajectory through them.
+
+    See the module's docstring for the ports and the constraints.
+
+    Args:
+        scene: the scene the plans are for (table and obstacles of the planning model, start).
+        config: IK and motion settings (``WorldConfig()`` by default).
+
+    Attributes:
+        num_solves: how many times the keyframes were computed (for checking the cache).
+    """
+
+    def __init__(self, scene: Scene, config: WorldConfig | None = None) -> None:
+        super().__init__()
+        self._scene = scene
+        self._config = WorldConfig() if config is None else config
+        self._model = PlanningModel(scene, self._config)
+        plant, robot = self._model.plant, self._model.robot
+        self._plant = plant
+        self._robot = robot
+        self._tcp = plant.GetFrameByName(TCP_FRAME, robot)
+        if plant.num_positions() != plant.num_positions(robot):
+            raise RuntimeError("the planning model must have no positions besides the robot's")
+        # Robot-object contact is allowed (objects may be pushed): hide those pairs from the IK's
+        # distance constraint in this private context only; the model keeps them for other queries.
+        scene_graph_context = self._model.scene_graph.GetMyMutableContextFromRoot(self._model.context)
+        # The robot's own links are left out too: the distance constraint is robot-vs-table only.
+        robot_geometries = GeometrySet(self._model.robot_geometries())
+        self._model.scene_graph.collision_filter_manager(scene_graph_context).Apply(
+            CollisionFilterDeclaration()
+            .ExcludeBetween(robot_geometries, GeometrySet(self._model.object_geometries()))
+            .ExcludeWithin(robot_geometries)
+        )
+        self._start = start_configuration(scene, plant, robot, config=self._config)
+        self._names = robot_position_names()
+        self._index = {name: plant.GetJointByName(name, robot).position_start() for name in self._names}
+        if list(self._index.values()) != list(range(len(self._names))):
+            raise RuntimeError(f"unexpected position order of the robot: {self._index}")
+        self._velocity_limits = np.array(
+            [plant.GetJointByName(name, robot).velocity_upper_limits()[0] for name in self._names]
+        )
+        self._lower = plant.GetPositionLowerLimits().copy()
+        self._upper = plant.GetPositionUpperLimits().copy()
+        ik = self._config.ik
+        table = scene.table
+        self._upper[self._index[BASE_JOINTS[0]]] = ik.base_under_table - BASE_FOOTPRINT[0] / 2.0
+        y_limit = table.width / 2.0 + ik.base_lateral_margin
+        self._lower[self._index[BASE_JOINTS[1]]] = -y_limit
+        self._upper[self._index[BASE_JOINTS[1]]] = y_limit
+        yaw = self._index[BASE_JOINTS[2]]
+        self._lower[yaw], self._upper[yaw] = -ik.base_max_yaw, ik.base_max_yaw
+        for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS:  # keep the gripper as at the start (open)
+            self._lower[self._index[name]] = self._upper[self._index[name]] = self._start[self._index[name]]
+        self._height = tcp_keypoint_height(scene, self._config)
+        self._options = ik_solver_options(ik.max_iterations)
+        self.num_solves = 0
+
+        empty_plan = HighLevelPlan(scene=scene.name, keypoints=(), reason="no plan given")
+        self._plan_port = self.DeclareAbstractInputPort(
+            name="plan", model_value=AbstractValue.Make(empty_plan)
+        )
+        plan_ticket = {self.input_port_ticket(self._plan_port.get_index())}
+        self._keyframes_port = self.DeclareAbstractOutputPort(
+            name="keyframes",
+            alloc=lambda: AbstractValue.Make(Keyframes.empty(self._start)),
+            calc=self._calc_keyframes,
+            prerequisites_of_calc=plan_ticket,
+        )
+        self._trajectory_port = self.DeclareAbstractOutputPort(
+            name="trajectory",
+            alloc=lambda: AbstractValue.Make(PiecewisePolynomial()),
+            calc=self._calc_trajectory,
+            prerequisites_of_calc=plan_ticket,
+        )
+
+    # --- Accessors ------------------------------------------------------------------------------
+
+    @property
+    def scene(self) -> Scene:
+        return self._scene
+
+    @property
+    def planning_model(self) -> PlanningModel:
+        return self._model
+
+    @property
+    def start(self) -> np.ndarray:
+        """The robot's 11 start positions."""
+        return self._start.copy()
+
+    def get_plan_input_port(self):
+        return self._plan_port
+
+    def get_keyframes_output_port(self):
+        return self._keyframes_port
+
+    def get_trajectory_output_port(self):
+        return self._trajectory_port
+
+    def tcp_position(self, q: np.ndarray) -> np.ndarray:
+        """World position of the tcp at robot positions ``q`` (uses the private context)."""
+        self._plant.SetPositions(self._model.plant_context, self._robot, q)
+        return self._tcp.CalcPoseInWorld(self._model.plant_context).translation().copy()
+
+    # --- Keyframes ------------------------------------------------------------------------------
+
+    def _calc_keyframes(self, context, output) -> None:
+        if not self._plan_port.HasValue(context):
+            output.set_value(Keyframes.empty(self._start, "no plan: the plan input port is not connected"))
+            return
+        output.set_value(self.solve(self._plan_port.Eval(context)))
+
+    def solve(self, plan: HighLevelPlan) -> Keyframes:
+        """The keyframes of ``plan``: what the ``keyframes`` port outputs (uncached when called directly)."""
+        self.num_solves += 1
+        if plan.scene and self._scene.name and plan.scene != self._scene.name:
+            return Keyframes.empty(
+                self._start, f"the plan is for scene {plan.scene!r}, this KeypointIk for {self._scene.name!r}"
+            )
+        if not plan.ok:
+            return Keyframes.empty(self._start, f"no plan: {plan.reason or 'fewer than two keypoints'}")
+        started = time.perf_counter()
+        positions, success, messages = [], [], []
+        previous = self._start
+        for index, keypoint in enumerate(plan.keypoints):
+            q, message = self._solve_keypoint(index, keypoint, previous)
+            positions.append(q)
+            success.append(message == "")
+            messages.append(message)
+            if message == "":
+                previous = q
+        positions = np.array(positions)
+        return Keyframes(
+            keypoints=tuple(plan.keypoints),
+            positions=positions,
+            success=tuple(success),
+            messages=tuple(messages),
+            tcp_positions=np.array([self.tcp_position(q) for q in positions]),
+            start=self._start.copy(),
+            solve_time_s=time.perf_counter() - started,
+        )
+
+    def _target(self, keypoint: PlanKeypoint) -> np.ndarray:
+        return np.array([keypoint.position[0], keypoint.position[1], self._height], dtype=float)
+
+    def _shifted(self, reference: np.ndarray, target: np.ndarray) -> np.ndarray:
+        """``reference`` with the base moved by the tcp's offset to ``target`` (clipped to the bounds)."""
+        shifted = reference.copy()
+        shift = target - self.tcp_position(reference)
+        shifted[self._index[BASE_JOINTS[0]]] += shift[0]
+        shifted[self._index[BASE_JOINTS[1]]] += shift[1]
+        return np.clip(shifted, self._lower, self._upper)
+
+    def _program(self, target: np.ndarray, previous: np.ndarray, *, clearance: bool) -> tuple:
+        """The IK program of one keypoint: (program, decision variables)."""
+        ik_config = self._config.ik
+        tolerance = ik_config.position_tolerance
+        world = self._plant.world_frame()
+        ik = InverseKinematics(self._plant, self._model.plant_context, with_joint_limits=False)
+        q = ik.q()
+        prog = ik.get_mutable_prog()
+        prog.AddBoundingBoxConstraint(self._lower, self._upper, q)
+        ik.AddPositionConstraint(self._tcp, np.zeros(3), world, target - tolerance, target + tolerance)
+        ik.AddAngleBetweenVectorsConstraint(
+            world, [1.0, 0.0, 0.0], self._tcp, [0.0, 0.0, 1.0], 0.0, ik_config.approach_tolerance
+        )
+        ik.AddAngleBetweenVectorsConstraint(
+            world,
+            [0.0, 0.0, 1.0],
+            self._tcp,
+            [0.0, 1.0, 0.0],
+            math.pi / 2 - ik_config.roll_tolerance,
+            math.pi / 2 + ik_config.roll_tolerance,
+        )
+        if clearance:
+            ik.AddMinimumDistanceLowerBoundConstraint(
+                ik_config.table_clearance, ik_config.table_clearance + 0.05
+            )
+        prog.AddQuadraticErrorCost(np.eye(len(previous)), previous, q)
+        # A weak pull towards the start posture of the arm keeps it from folding up over many keypoints.
+        arm = [self._index[name] for name in ARM_JOINTS]
+        prog.AddQuadraticErrorCost(POSTURE_WEIGHT * np.eye(len(arm)), self._start[arm], q[arm])
+        return prog, q
+
+    def _solve_keypoint(
+        self, index: int, keypoint: PlanKeypoint, previous: np.ndarray
+    ) -> tuple[np.ndarray, str]:
+        """(positions, "") on success, else (the best iterate, the failure message).
+
+        Seeds, in order, up to ``ik.attempts``: the previous keyframe; the solution of the same
+        program without the clearance constraint (from the previous keyframe); the previous
+        keyframe with the base moved along with the tcp; the start posture moved likewise.
+        """
+        target = self._target(keypoint)
+        start_distance = np.hypot(*np.subtract(keypoint.position, self._scene.start))
+        if keypoint.action == "start" and start_distance <= START_MATCH_TOLERANCE:
+            return self._start.copy(), ""
+        tolerance = self._config.ik.position_tolerance
+        prog, q = self._program(target, previous, clearance=True)
+        best, reasons = previous.copy(), []
+
+        def seeds():
+            yield previous.copy()
+            loose, loose_q = self._program(target, previous, clearance=False)
+            result = Solve(loose, previous, self._options)
+            if result.is_success():
+                yield result.GetSolution(loose_q)
+            yield self._shifted(previous, target)
+            yield self._shifted(self._start, target)
+
+        attempts = 0
+        for seed in seeds():
+            if attempts == self._config.ik.attempts:
+                break
+            attempts += 1
+            result = Solve(prog, seed, self._options)
+            solution = result.GetSolution(q)
+            if not result.is_success():
+                best = solution
+                reasons.append(str(result.get_solution_result()).split(".")[-1])
+                continue
+            error = np.linalg.norm(self.tcp_position(solution) - target)
+            if error > FK_CHECK_FACTOR * tolerance * math.sqrt(3):
+                best = solution
+                reasons.append(f"tcp {error * 1000:.1f} mm off")
+                continue
+            return solution, ""
+        return best, (
+            f"{_describe(index, keypoint)}: IK failed after {attempts} attempt(s) "
+            f"(SNOPT: {', '.join(reasons)}); "
+            f"the tcp target {np.round(target, 3).tolist()} may be out of reach"
+        )
+
+    # --- Trajectory -----------------------------------------------------------------------------
+
+    def _calc_trajectory(self, context, output) -> None:
+        keyframes: Keyframes = self._keyframes_port.Eval(context)
+        output.set_value(self.trajectory(keyframes))
+
+    def trajectory(self, keyframes: Keyframes) -> PiecewisePolynomial:
+        """The first-order hold from the start through ``keyframes``' successful keyframes."""
+        motion = self._config.motion
+        knots = [self._start]
+        for q, ok in zip(keyframes.positions, keyframes.success):
+            if ok and np.max(np.abs(q - knots[-1])) > 1e-9:
+                knots.append(q)
+        if len(knots) == 1:
+            knots.append(self._start)  # hold the start
+        times = [0.0]
+        tcp = [self.tcp_position(q) for q in knots]
+        for i in range(1, len(knots)):
+            joint_time = np.max(
+                np.abs(knots[i] - knots[i - 1]) / (motion.joint_speed_fraction * self._velocity_limits)
+            )
+            tcp_time = np.linalg.norm(tcp[i] - tcp[i - 1]) / motion.tcp_speed
+            times.append(times[-1] + max(motion.min_segment_duration, float(joint_time), float(tcp_time)))
+        return PiecewisePolynomial.FirstOrderHold(times, np.column_stack(knots))
+
+
+__all__ = ["Keyframes", "KeypointIk"]

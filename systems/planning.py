@@ -1,0 +1,99 @@
+"""The planning diagram: a planner block (HLP or the straight-line baseline) feeding KeypointIk."""
+
+from __future__ import annotations
+
+from pydrake.common.value import AbstractValue
+from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
+
+from hlp_drake.learners.models import DecisionModels
+from hlp_drake.planner import HighLevelPlan, PlanKeypoint
+from hlp_drake.planner.transfer import robot_plan
+from hlp_drake.scene.generators import generate_scene
+from hlp_drake.scene.model import Scene
+from hlp_drake.systems.hlp_planner_system import HlpPlannerSystem
+from hlp_drake.systems.keypoint_ik import KeypointIk
+from hlp_drake.systems.world_config import WorldConfig
+
+PLANNERS = ("hlp", "sto")
+
+
+def straight_line_plan(scene: Scene) -> HighLevelPlan:
+    """The baseline's initial plan: from the start straight to the target."""
+    return HighLevelPlan(scene.name, (
+        PlanKeypoint("start", (float(scene.start[0]), float(scene.start[1]))),
+        PlanKeypoint("target", (float(scene.target.x), float(scene.target.y)), None, scene.target.name),
+    ))
+
+
+class StraightLinePlanSystem(LeafSystem):
+    """The straight-line baseline's planner block: same ports as ``HlpPlannerSystem``.
+
+    Input port ``scene`` (abstract Scene); output port ``plan`` (abstract HighLevelPlan).
+    """
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._scene_port = self.DeclareAbstractInputPort(name="scene", model_value=AbstractValue.Make(generate_scene("vr", 0)))
+        self._plan_port = self.DeclareAbstractOutputPort(
+            name="plan", alloc=lambda: AbstractValue.Make(HighLevelPlan("", ())),
+            calc=lambda context, output: output.set_value(straight_line_plan(self._scene_port.Eval(context))),
+            prerequisites_of_calc={self.all_input_ports_ticket()})
+
+    def get_scene_input_port(self):
+        return self._scene_port
+
+    def get_plan_output_port(self):
+        return self._plan_port
+
+
+class RobotPlanTransfer(LeafSystem):
+    """Turns a human-like plan into the pushing robot's waypoints (``hlp_drake.planner.transfer``).
+
+    Input port ``plan`` and output port ``robot_plan`` (both abstract HighLevelPlan).
+    """
+
+    def __init__(self, scene: Scene) -> None:
+        super().__init__()
+        self._scene = scene
+        self._plan_port = self.DeclareAbstractInputPort(name="plan", model_value=AbstractValue.Make(HighLevelPlan("", ())))
+        self._out_port = self.DeclareAbstractOutputPort(
+            name="robot_plan", alloc=lambda: AbstractValue.Make(HighLevelPlan("", ())),
+            calc=lambda context, output: output.set_value(robot_plan(self._plan_port.Eval(context), self._scene)),
+            prerequisites_of_calc={self.all_input_ports_ticket()})
+
+    def get_plan_input_port(self):
+        return self._plan_port
+
+    def get_robot_plan_output_port(self):
+        return self._out_port
+
+
+def make_planning_diagram(scene: Scene, *, planner: str = "hlp", models: DecisionModels | None = None,
+                          config: WorldConfig | None = None) -> Diagram:
+    """``scene`` input -> planner block -> push transfer -> KeypointIk.
+
+    Outputs ``plan`` (the planner's), ``robot_plan`` (its pushing-robot waypoints), ``keyframes``
+    and ``trajectory``.
+
+    Args:
+        planner: "hlp" (the human-like planner) or "sto" (the straight line of the baseline); the
+            only difference is the planner block.
+    """
+    if planner not in PLANNERS:
+        raise ValueError(f"unknown planner {planner!r}; choose one of {', '.join(PLANNERS)}")
+    builder = DiagramBuilder()
+    block = HlpPlannerSystem(models=models) if planner == "hlp" else StraightLinePlanSystem()
+    block.set_name(f"{planner}_planner")
+    builder.AddSystem(block)
+    transfer = builder.AddNamedSystem("robot_plan_transfer", RobotPlanTransfer(scene))
+    ik = builder.AddNamedSystem("keypoint_ik", KeypointIk(scene, config))
+    builder.Connect(block.get_plan_output_port(), transfer.get_plan_input_port())
+    builder.Connect(transfer.get_robot_plan_output_port(), ik.get_plan_input_port())
+    builder.ExportInput(block.get_scene_input_port(), "scene")
+    builder.ExportOutput(block.get_plan_output_port(), "plan")
+    builder.ExportOutput(transfer.get_robot_plan_output_port(), "robot_plan")
+    builder.ExportOutput(ik.get_keyframes_output_port(), "keyframes")
+    builder.ExportOutput(ik.get_trajectory_output_port(), "trajectory")
+    diagram = builder.Build()
+    diagram.set_name(f"{planner}_planning")
+    return diagram

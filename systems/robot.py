@@ -12,10 +12,10 @@ SAP (the default approximation ``kLagged``, or ``kSap`` or ``kSimilar``). A cont
 (``time_step=0``) loads the model for kinematics (IK, collision queries) but cannot be simulated.
 
 Frames (link names): ``base_link`` (on the floor below the middle of the base's footprint, x
-forward), ``ur5_base_link`` (the arm mount on the deck), ``ur5_base`` (the UR5's DH base frame,
-the mount turned by pi about z), ``ur5_flange`` (the DH tool flange, ROS's ``tool0``),
-``gripper_base_link`` (the same pose as the flange) and ``tcp`` (between the fingertip pads, +z
-along the approach direction, +y along the left finger's opening direction).
+forward; it carries the riser), ``ur5_base_link`` (the arm mount on top of the riser),
+``ur5_base`` (the UR5's DH base frame, the mount turned by pi about z), ``ur5_flange`` (the DH tool
+flange, ROS's ``tool0``), ``gripper_base_link`` (the same pose as the flange) and ``tcp`` (between
+the fingertip pads, +z along the approach direction, +y along the left finger's opening direction).
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ from pydrake.multibody.plant import DiscreteContactSolver, MultibodyPlant
 from pydrake.multibody.tree import Joint, ModelInstanceIndex
 from pydrake.systems.framework import Context
 
-from hlp_drake.systems.model_package import MODELS_PACKAGE, configure_parser
+from hlp_drake.systems.model_package import MODELS_PACKAGE, configure_parser, new_parser
 
 ROBOT_URL = f"package://{MODELS_PACKAGE}/robot/mobile_ur5.urdf"
 ROBOT_MODEL_NAME = "mobile_ur5"
@@ -58,16 +58,25 @@ TCP_FRAME = "tcp"
 BASE_FOOTPRINT = (0.96, 0.79)
 """Length (x) and width (y) of the base, m; its top deck is ``DECK_HEIGHT`` above the floor."""
 DECK_HEIGHT = 0.30
-ARM_MOUNT = (0.35, 0.0, 0.30)
-"""Position of the UR5's mount (``ur5_base_link``) in ``base_link``, m."""
+MOUNT_HEIGHT = 0.80
+"""Height of the arm's mount above the floor, m: the top of the riser, a round column (part of
+``base_link``, radius ``RISER_RADIUS``) standing on the deck. At about table-top height it lets the
+arm stretch out flat over a 0.70-0.80 m table: the tcp, horizontal at 0.06 m above the top, reaches
+about 0.96 m past the table's front edge (0.85 m and 0.73 m from a 0.60 m mount)."""
+RISER_RADIUS = 0.075
+ARM_MOUNT = (0.39, 0.0, MOUNT_HEIGHT)
+"""Position of the UR5's mount (``ur5_base_link``) in ``base_link``, m: on the riser, 0.09 m behind
+the base's front (the riser's front 0.015 m behind it)."""
 TCP_OFFSET = 0.14
 """Distance of ``tcp`` from the flange along the approach axis, m."""
 GRIPPER_OPEN = 0.0425
 GRIPPER_CLOSED = 0.0
 
-HOME_ARM_POSITIONS: tuple[float, ...] = (-0.4039, -1.6142, 0.8160, 0.7982, 1.1669, -math.pi / 2)
-"""Ready pose of the arm, elbow up: the tcp about 1.0 m above the floor and 0.85 m in front of the
-base's centre (on its centre line), pointing forward (+x) with the fingers opening sideways (y)."""
+HOME_ARM_POSITIONS: tuple[float, ...] = (-0.2257, -0.9273, 1.9016, -0.9743, 1.3451, -math.pi / 2)
+"""Ready pose of the arm, elbow up: the tcp 0.81 m above the floor (0.06 m above a 0.75 m table top)
+and 1.10 m in front of the base's centre (on its centre line, 0.71 m ahead of the mount), pointing
+forward (+x) with the fingers opening sideways (y): the start posture for the default
+``WorldConfig().ik.start_reach``."""
 
 
 class JointLimits(NamedTuple):
@@ -103,7 +112,7 @@ def add_robot(
     if plant.HasModelInstanceNamed(name):
         raise ValueError(f"the plant already has a model instance named {name!r}")
     if parser is None:
-        parser = Parser(plant)
+        parser = new_parser(plant)
     elif parser.plant() is not plant:
         raise ValueError("parser belongs to a different plant")
     configure_parser(parser)

@@ -131,8 +131,8 @@ class IkConfig:
         table_clearance: smallest distance between the robot and the table top (and between the
             robot's own links), m. Contact with objects is allowed (they may be pushed).
         base_under_table: how far the base's front may go under the table top past its front edge, m
-            (the table has no legs, and the deck is lower than the table top; the arm's shoulder, about
-            0.13 m behind the base's front, must stay in front of the table).
+            (the table has no legs and the deck is lower than the table top, but the riser under the
+            arm, 0.015 m behind the base's front and as high as the table, must stay in front of it).
         base_lateral_margin: the base's centre stays within the table's width plus this on each side, m.
         base_max_yaw: largest turn of the base away from facing +x, rad.
         start_reach: horizontal distance from the base's centre to the tcp at the start, m.
@@ -146,10 +146,10 @@ class IkConfig:
     approach_tolerance: float = 0.35
     roll_tolerance: float = 0.05
     table_clearance: float = 0.01
-    base_under_table: float = 0.10
+    base_under_table: float = 0.0
     base_lateral_margin: float = 0.50
     base_max_yaw: float = math.pi / 2
-    start_reach: float = 0.80
+    start_reach: float = 1.10
     start_base_clearance: float = 0.05
     max_iterations: int = 500
     attempts: int = 4

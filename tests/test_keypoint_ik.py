@@ -10,9 +10,9 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from hlp_drake.planner.plan import HighLevelPlan, PlanKeypoint
 from hlp_drake.scene.generators import generate_scene
-from hlp_drake.scene.model import Scene
+from hlp_drake.scene.model import Scene, SceneObject, Table
 from hlp_drake.systems.keypoint_ik import Keyframes, KeypointIk
-from hlp_drake.systems.robot import TCP_FRAME
+from hlp_drake.systems.robot import BASE_FOOTPRINT, TCP_FRAME
 from hlp_drake.systems.world import make_world_diagram, start_configuration, world_plant
 from hlp_drake.systems.world_config import WorldConfig
 from hlp_drake.taskspace import TaskSpace
@@ -169,12 +169,54 @@ def test_no_plan_and_wrong_scene_are_problems_not_successes(system, scene):
     assert not system.GetOutputPort("keyframes").Eval(default_context).ok
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=AssertionError,
-    reason="robot reach: the UR5 mount (ARM_MOUNT z = 0.30 m) is ~0.4 m below these table tops, so the "
-    "tcp reaches only ~0.5-0.55 m past the front edge; gen1 targets stand 0.64-0.86 m deep",
-)
 def test_start_gap_target_plan_on_gen1_succeeds(system, scene):
     keyframes, _ = evaluate(system, through_gaps(scene, to_target=True))
     assert keyframes.ok, keyframes.failures
+    height = scene.table.height + CONFIG.ik.height
+    np.testing.assert_allclose(keyframes.tcp_positions[-1], [*scene.target.position, height], atol=0.005)
+
+
+def assert_reaches(keyframes: Keyframes, plan: HighLevelPlan, height: float) -> None:
+    assert keyframes.ok, keyframes.failures
+    for tcp, keypoint in zip(keyframes.tcp_positions, plan.keypoints):
+        np.testing.assert_allclose(tcp, [*keypoint.position, height], atol=0.005)
+
+
+@pytest.mark.parametrize(
+    "kind, seed", [("gen1", 0), ("gen1", 1), ("gen1", 2), ("gen1", 3), ("gen1", 4), ("vr", 0)]
+)
+def test_ik_reaches_the_target_of_generated_and_vr_scenes(kind, seed):
+    """The target keypoint (0.53-0.86 m deep on 0.70-0.80 m tables) is reached straight from the start
+    and through the rows' gaps."""
+    scene = generate_scene(kind, seed)
+    system = KeypointIk(scene, CONFIG)
+    target = PlanKeypoint("target", scene.target.position, element=scene.target.name)
+    direct = HighLevelPlan(scene=scene.name, keypoints=(PlanKeypoint("start", scene.start), target))
+    height = scene.table.height + CONFIG.ik.height
+    for plan in (direct, through_gaps(scene, to_target=True)):
+        assert_reaches(system.solve(plan), plan, height)
+
+
+@pytest.mark.parametrize("height", [0.70, 0.80])
+def test_tcp_reaches_0_95_m_past_the_front_edge_and_the_edge_itself(height):
+    """The riser puts the arm's mount at about table height: the horizontal gripper reaches 0.95 m deep
+    into a 0.70 m and a 0.80 m high table, and comes back to its front edge."""
+    scene = Scene(
+        table=Table(length=1.05, width=1.0, height=height),
+        start=(0.1, 0.0),
+        target=SceneObject("target", "cylinder", 0.95, 0.0, (0.05, 0.05, 0.1)),
+        name=f"reach-{height}",
+    )
+    system = KeypointIk(scene, CONFIG)
+    plan = HighLevelPlan(
+        scene=scene.name,
+        keypoints=(
+            PlanKeypoint("start", scene.start),
+            PlanKeypoint("target", scene.target.position, element="target"),
+            PlanKeypoint("gap", (0.0, 0.0), element="edge"),
+        ),
+    )
+    keyframes = system.solve(plan)
+    assert_reaches(keyframes, plan, height + CONFIG.ik.height)
+    # The base stays outside the table's footprint.
+    assert np.all(keyframes.positions[:, 0] + BASE_FOOTPRINT[0] / 2.0 <= CONFIG.ik.base_under_table + 1e-6)

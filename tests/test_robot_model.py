@@ -31,11 +31,14 @@ from hlp_drake.systems.robot import (
     BASE_BODY,
     BASE_FOOTPRINT,
     BASE_JOINTS,
+    DECK_HEIGHT,
     FLANGE_FRAME,
     GRIPPER_JOINTS,
     GRIPPER_MIMIC_JOINTS,
     GRIPPER_OPEN,
     HOME_ARM_POSITIONS,
+    MOUNT_HEIGHT,
+    RISER_RADIUS,
     ROBOT_MODEL_NAME,
     TCP_FRAME,
     TCP_OFFSET,
@@ -202,7 +205,8 @@ def test_arm_mounted_at_the_front_facing_forward(robot: Robot):
     X_base_mount = plant.CalcRelativeTransform(context, base, mount)
     np.testing.assert_allclose(X_base_mount.translation(), ARM_MOUNT)
     assert X_base_mount.rotation().IsExactlyIdentity()
-    assert 0.0 < BASE_FOOTPRINT[0] / 2 - ARM_MOUNT[0] < 0.2  # near the front edge, on the deck
+    assert 0.0 < BASE_FOOTPRINT[0] / 2 - ARM_MOUNT[0] < 0.2  # near the front edge, on the riser
+    assert ARM_MOUNT[2] == MOUNT_HEIGHT
     # The UR5's DH base is the mount turned by pi; at zero angles the arm stretches along +x.
     X_mount_dh = plant.CalcRelativeTransform(
         context, mount, plant.GetFrameByName(ARM_BASE_FRAME, robot.instance)
@@ -210,6 +214,32 @@ def test_arm_mounted_at_the_front_facing_forward(robot: Robot):
     assert X_mount_dh.IsNearlyEqualTo(RigidTransform(RotationMatrix.MakeZRotation(math.pi), [0, 0, 0]), 1e-12)
     p_flange = plant.CalcRelativeTransform(context, mount, plant.GetFrameByName(FLANGE_FRAME, robot.instance))
     assert p_flange.translation()[0] == pytest.approx(0.425 + 0.39225)
+
+
+def test_riser_lifts_the_mount_to_about_table_height(robot: Robot):
+    """A round column on the deck, part of the base body, up to the mount: 0.7-0.8 m tables' height."""
+    plant, inspector = robot.plant, robot.scene_graph.model_inspector()
+    assert 0.7 <= MOUNT_HEIGHT <= 0.85
+    body = plant.GetBodyByName(BASE_BODY, robot.instance)
+    columns = []
+    for role in (Role.kProximity, Role.kIllustration):
+        for geometry in inspector.GetGeometries(plant.GetBodyFrameIdOrThrow(body.index()), role):
+            shape = inspector.GetShape(geometry)
+            if isinstance(shape, Cylinder) and shape.length() > 0.3:
+                columns.append((role, shape, inspector.GetPoseInFrame(geometry)))
+    assert {role for role, _, _ in columns} == {Role.kProximity, Role.kIllustration}
+    for _, shape, X_base_column in columns:
+        p = X_base_column.translation()
+        assert X_base_column.rotation().IsNearlyIdentity(1e-12)  # upright
+        np.testing.assert_allclose(p[:2], ARM_MOUNT[:2], atol=1e-12)  # right under the mount
+        assert p[2] - shape.length() / 2 == pytest.approx(DECK_HEIGHT)  # stands on the deck
+        assert p[2] + shape.length() / 2 == pytest.approx(MOUNT_HEIGHT)  # carries the arm's base
+        assert shape.radius() == pytest.approx(RISER_RADIUS)
+        front = ARM_MOUNT[0] + shape.radius()
+        assert 0.0 < BASE_FOOTPRINT[0] / 2 - front < 0.03  # nearly flush with the base's front
+    # The riser's mass raises the base's centre of mass and moves it forward.
+    com = body.default_com()
+    assert 0.0 < com[0] < ARM_MOUNT[0] and com[1] == pytest.approx(0.0) and 0.17 < com[2] < MOUNT_HEIGHT
 
 
 def test_planar_base_joints_move_the_base(robot: Robot):
@@ -229,7 +259,8 @@ def test_home_pose_is_in_front_above_the_table_pointing_forward(robot: Robot):
     set_robot_positions(plant, context, robot.instance)
     X_world_tcp = plant.GetFrameByName(TCP_FRAME, robot.instance).CalcPoseInWorld(context)
     x, y, z = X_world_tcp.translation()
-    assert x > BASE_FOOTPRINT[0] / 2 + 0.2 and abs(y) < 1e-3 and 0.9 < z < 1.1
+    assert x > BASE_FOOTPRINT[0] / 2 + 0.2 and abs(y) < 1e-3 and 0.75 < z < 0.9  # at table height
+    assert x - ARM_MOUNT[0] > 0.5  # well in front of the arm's base, the arm half stretched out
     np.testing.assert_allclose(X_world_tcp.rotation().matrix()[:, 2], [1.0, 0.0, 0.0], atol=1e-3)  # approach
     np.testing.assert_allclose(
         abs(X_world_tcp.rotation().matrix()[1, 1]), 1.0, atol=1e-3
@@ -341,7 +372,8 @@ def test_masses_and_inertias(robot: Robot):
     assert arm_mass == pytest.approx(sum(UR5_MASSES), abs=1e-9)
     for link, mass in zip(UR5_LINKS, UR5_MASSES):
         assert plant.GetBodyByName(link, robot.instance).default_mass() == pytest.approx(mass)
-    assert plant.GetBodyByName(BASE_BODY, robot.instance).default_mass() == pytest.approx(135.0)
+    base_mass = plant.GetBodyByName(BASE_BODY, robot.instance).default_mass()
+    assert base_mass == pytest.approx(135.0 + 15.0)  # the base and its riser
     gripper = sum(
         plant.GetBodyByName(link, robot.instance).default_mass()
         for link in ("gripper_base_link", "left_finger_link", "right_finger_link")

@@ -13,7 +13,15 @@ the footprint):
 * Base: a Ridgeback-sized body (0.96 x 0.79 m, top deck at 0.30 m, 135 kg) driven by three joints
   from the world: prismatic ``base_x_joint``, prismatic ``base_y_joint``, revolute
   ``base_yaw_joint``, through two nearly massless links.
-* Arm: a UR5 on the deck near the front edge, at zero joint angles stretched out along +x. The
+* Riser: a round column (0.15 m across, 15 kg) on the deck, part of ``base_link``, lifting the arm's
+  mount to 0.80 m, 0.09 m behind the base's front (the column's front 0.015 m behind it). The
+  height is measured, not guessed: with the tcp held horizontal along +x at 0.06 m above a table
+  top (the keypoint IK's grasp, 0.01 m clearance to the table), the tcp reaches past the table's
+  front edge 0.85 m (0.70 m table) and 0.73 m (0.80 m table) from a 0.60 m mount, whose shoulder
+  then sits below the table top and has to lift the arm over the edge, but 0.96 m for both from
+  0.80 m: with the shoulder about level with the wrist the arm stretches out flat over the table,
+  and only the column (and the UR5's base on it) must stay in front of the table's edge.
+* Arm: a UR5 on the riser near the base's front, at zero joint angles stretched out along +x. The
   links follow UR's own layout (shoulder, elbow and wrist offsets), which reproduces the official DH
   kinematics exactly: link ``ur5_base`` is the DH base frame (the arm mount turned by pi about z)
   and link ``ur5_flange`` is the DH tool flange frame. Masses are the official ones, centres of mass
@@ -59,16 +67,21 @@ SHOULDER_OFFSET = 0.13585  # lateral offsets of UR's layout; they add up to d4:
 ELBOW_OFFSET = -0.1197  # 0.13585 - 0.1197 + 0.093 = 0.10915
 WRIST_1_OFFSET = 0.093
 
-ARM_MOUNT_XYZ = (0.35, 0.0, 0.30)  # arm base on the deck, 0.13 m behind the front edge
 BIG_EFFORT, SMALL_EFFORT = 150.0, 28.0
 
 # --- Base (Clearpath Ridgeback sized) ----------------------------------------------------------
 BASE_LENGTH, BASE_WIDTH, DECK_HEIGHT = 0.96, 0.79, 0.30
-BASE_MASS = 135.0
+BASE_MASS = 135.0  # the base without the riser
 BASE_TRAVEL = 10.0  # +- m along world x and y
 BASE_SPEED, BASE_YAW_RATE = 1.0, 2.0
 BASE_FORCE, BASE_TORQUE = 1000.0, 400.0
 WHEEL_RADIUS, WHEEL_WIDTH = 0.0762, 0.06
+
+# --- Riser: a column on the deck lifting the arm's mount to about table height -------------------
+MOUNT_HEIGHT = 0.80  # top of the riser = the arm's mount, m above the floor (see the docstring)
+RISER_RADIUS = 0.075  # a round column under the mount, as wide as the UR5's base
+RISER_MASS = 15.0  # a steel tube (150 mm, 8 mm wall) with its flanges
+ARM_MOUNT_XYZ = (0.39, 0.0, MOUNT_HEIGHT)  # arm base on the riser, 0.09 m behind the base's front
 
 # --- Gripper (Robotiq 2F-85 sized) --------------------------------------------------------------
 GRIPPER_MASS, FINGER_MASS = 0.85, 0.04
@@ -182,6 +195,23 @@ def box_inertia(mass: float, size: Vec) -> Vec:
     return (mass * (y * y + z * z) / 12.0, mass * (x * x + z * z) / 12.0, mass * (x * x + y * y) / 12.0)
 
 
+def combined_inertia(parts: list[tuple[float, Vec, Vec]]) -> tuple[float, Vec, tuple[float, ...]]:
+    """Mass, centre of mass and (ixx, iyy, izz, ixy, ixz, iyz) about it (URDF signs: ixy = -sum m x y)
+    of rigid parts (mass, centre of mass, principal (ixx, iyy, izz) about it, axes along the link's)."""
+    mass = sum(m for m, _, _ in parts)
+    com = tuple(sum(m * c[i] for m, c, _ in parts) / mass for i in range(3))
+    ixx = iyy = izz = ixy = ixz = iyz = 0.0
+    for m, c, (jxx, jyy, jzz) in parts:
+        dx, dy, dz = _sub(c, com)
+        ixx += jxx + m * (dy * dy + dz * dz)
+        iyy += jyy + m * (dx * dx + dz * dz)
+        izz += jzz + m * (dx * dx + dy * dy)
+        ixy -= m * dx * dy
+        ixz -= m * dx * dz
+        iyz -= m * dy * dz
+    return mass, com, (ixx, iyy, izz, ixy, ixz, iyz)
+
+
 # --- URDF text -----------------------------------------------------------------------------------
 def num(x: float) -> str:
     text = f"{x:.12g}"
@@ -243,11 +273,12 @@ def cyl_span(axis: str, lo: float, hi: float, radius: float, at: Vec = (0.0, 0.0
 class Link:
     def __init__(self, name: str, comment: str = "") -> None:
         self.name, self.comment = name, comment
-        self.inertial: tuple[float, Vec, Vec] | None = None
+        self.inertial: tuple[float, Vec, tuple[float, ...]] | None = None
         self.visuals: list[tuple[Shape, str]] = []
         self.collisions: list[Shape] = []
 
-    def mass(self, mass: float, com: Vec, inertia: Vec) -> Link:
+    def mass(self, mass: float, com: Vec, inertia: tuple[float, ...]) -> Link:
+        """``inertia`` about ``com``: (ixx, iyy, izz) or (ixx, iyy, izz, ixy, ixz, iyz)."""
         self.inertial = (mass, com, inertia)
         return self
 
@@ -261,14 +292,15 @@ class Link:
         lines = [f"  <!-- {self.comment} -->"] if self.comment else []
         lines.append(f'  <link name="{self.name}">')
         if self.inertial is not None:
-            mass, com, (ixx, iyy, izz) = self.inertial
+            mass, com, inertia = self.inertial
+            ixx, iyy, izz, ixy, ixz, iyz = (*inertia, 0.0, 0.0, 0.0)[:6]
             lines += [
                 "    <inertial>",
                 f'      <origin xyz="{nums(com)}" rpy="0 0 0"/>',
                 f'      <mass value="{num(mass)}"/>',
                 (
-                    f'      <inertia ixx="{num(ixx)}" ixy="0" ixz="0" iyy="{num(iyy)}" iyz="0"'
-                    f' izz="{num(izz)}"/>'
+                    f'      <inertia ixx="{num(ixx)}" ixy="{num(ixy)}" ixz="{num(ixz)}" iyy="{num(iyy)}"'
+                    f' iyz="{num(iyz)}" izz="{num(izz)}"/>'
                 ),
                 "    </inertial>",
             ]
@@ -351,8 +383,19 @@ def base_links() -> list[Link]:
     y_link = Link("base_y_link").mass(0.01, (0, 0, 0), tiny)
     base = Link("base_link", "omnidirectional base, origin on the floor below the middle of the footprint")
     body_h = DECK_HEIGHT - 0.03
+    riser_h = MOUNT_HEIGHT - DECK_HEIGHT
+    riser_centre = (ARM_MOUNT_XYZ[0], ARM_MOUNT_XYZ[1], DECK_HEIGHT + riser_h / 2.0)
     base.mass(
-        BASE_MASS, (0.0, 0.0, 0.03 + body_h / 2.0), box_inertia(BASE_MASS, (BASE_LENGTH, BASE_WIDTH, body_h))
+        *combined_inertia(
+            [
+                (
+                    BASE_MASS,
+                    (0.0, 0.0, 0.03 + body_h / 2.0),
+                    box_inertia(BASE_MASS, (BASE_LENGTH, BASE_WIDTH, body_h)),
+                ),
+                (RISER_MASS, riser_centre, cylinder_inertia(RISER_MASS, RISER_RADIUS, riser_h, "z")),
+            ]
+        )
     )
     half_l, half_w = BASE_LENGTH / 2.0, BASE_WIDTH / 2.0
     base.add(box((0, 0, 0.19), (BASE_LENGTH, BASE_WIDTH, 0.18)), "base_dark", collide=False)
@@ -385,7 +428,15 @@ def base_links() -> list[Link]:
                 "base_yellow",
                 collide=False,
             )
-    base.add(box((ARM_MOUNT_XYZ[0], 0, DECK_HEIGHT - 0.001), (0.20, 0.20, 0.002)), "ur_dark", collide=False)
+    # The riser: a column on the deck under the arm's mount, with a foot and a top plate (visual).
+    base.add(cyl("z", riser_centre, RISER_RADIUS, riser_h), "base_dark")
+    mount_xy = (ARM_MOUNT_XYZ[0], ARM_MOUNT_XYZ[1])
+    base.add(  # foot flange on the deck, inside the base's outline
+        box((*mount_xy, DECK_HEIGHT + 0.006), (0.15, 0.22, 0.012)), "ur_dark", collide=False
+    )
+    ring = RISER_RADIUS + 0.002
+    base.add(cyl("z", (*mount_xy, MOUNT_HEIGHT - 0.006), ring, 0.012), "ur_dark", collide=False)  # top flange
+    base.add(cyl("z", (*mount_xy, MOUNT_HEIGHT - 0.08), ring, 0.03), "base_yellow", collide=False)  # stripe
     return [x_link, y_link, base]
 
 
@@ -396,7 +447,9 @@ def arm_links() -> list[Link]:
     upper, fore = -UR5_DH[1][1], -UR5_DH[2][1]
     r_big, r_mid, r_small = 0.06, 0.05, 0.045
 
-    base = Link("ur5_base_link", "UR5: arm mount on the deck, x forward; the arm stretches along +x at q = 0")
+    base = Link(
+        "ur5_base_link", "UR5: arm mount on the riser, x forward; the arm stretches along +x at q = 0"
+    )
     base.mass(UR5_MASSES[0], (0, 0, 0.019), cylinder_inertia(UR5_MASSES[0], 0.075, 0.038, "z"))
     base.add(cyl_span("z", 0.0, 0.038, 0.075), "ur_grey")
     base.add(cyl_span("z", 0.038, 0.044, 0.062), "ur_dark", collide=False)

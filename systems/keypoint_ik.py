@@ -348,7 +348,10 @@ class KeypointIk(LeafSystem):
             attempts += 1
             result = Solve(prog, seed, self._options)
             solution = result.GetSolution(q)
-            if not result.is_success():
+            # SNOPT often stops at its iteration limit on a point that meets every constraint:
+            # accept such an iterate when the constraints check out (the FK check follows).
+            feasible = result.is_success() or prog.CheckSatisfied(prog.GetAllConstraints(), solution, 1e-6)
+            if not feasible:
                 best = solution
                 reasons.append(str(result.get_solution_result()).split(".")[-1])
                 continue

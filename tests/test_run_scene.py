@@ -79,3 +79,12 @@ def test_run_scene_bad_scene_file_is_one_line(tmp_path):
     overlapping.write_text(yaml.safe_dump(data))
     result = run_module("hlp_drake.run_scene", "--scene", str(overlapping), "--json", str(out))
     assert result.returncode == 2 and "overlap" in result.stderr and not out.exists()
+
+
+def test_run_scene_without_arguments_runs_the_bundled_default(tmp_path):
+    out = tmp_path / "default.json"
+    result = run_module("hlp_drake.run_scene", "--json", str(out), cwd=tmp_path)
+    assert result.returncode == 0, result.stdout + result.stderr
+    report = json.loads(out.read_text())
+    assert report["success"] and report["scene"].startswith("default") and report["objects_dropped"] == []
+    assert any(k["action"] == "move" for k in report["plan"]["keypoints"])

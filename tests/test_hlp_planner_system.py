@@ -37,3 +37,22 @@ def test_unconnected_input_is_a_clear_error():
     system = HlpPlannerSystem()
     with pytest.raises(RuntimeError, match="connect or fix its 'scene'"):
         system.get_plan_output_port().Eval(system.CreateDefaultContext())
+
+
+def test_plans_from_the_plants_body_poses_in_a_diagram():
+    from pydrake.systems.framework import DiagramBuilder
+
+    from hlp_drake.systems.world import make_world_diagram, world_plant
+
+    scene = generate_scene("gen1", 3)
+    builder = DiagramBuilder()
+    world = builder.AddSystem(make_world_diagram(scene))
+    plant, _ = world_plant(world)
+    planner = builder.AddSystem(HlpPlannerSystem(plant=plant, template=scene))
+    builder.Connect(world.GetOutputPort("body_poses"), planner.get_body_poses_input_port())
+    builder.ExportOutput(planner.get_plan_output_port(), "plan")
+    diagram = builder.Build()
+    context = diagram.CreateDefaultContext()
+    seen = diagram.GetOutputPort("plan").Eval(context)
+    # The objects rest where the scene puts them, so the plan equals the plan of the scene itself.
+    assert seen.ok and seen.to_dict()["keypoints"] == plan(scene, default_models()).to_dict()["keypoints"]

@@ -2,9 +2,10 @@
 
     python benchmarks/planning_time.py [--dataset PATH] [--scenes 50] [--json OUT]
 
-Scenes: the VR scenes of 5 held-out subjects (the ~450 test scenes of one 19/5 split) and seeded
+Scenes: the VR scenes of 5 held-out subjects (the ~450 test scenes of one 19/5 split), seeded
 Generalization II scenes with 6, 12, 25 and 50 objects (sizes the generator cannot place are
-reported as such). Prints the median and 95th percentile per group.
+reported as such; their row count grows too), and two-row scenes with 6, 12, 25 and 50 boxes (the
+object count alone). Prints the median and 95th percentile per group.
 """
 
 from __future__ import annotations
@@ -25,10 +26,27 @@ from hlp_drake.features import gap_features, object_features, segment_feature_ma
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.planner import plan
 from hlp_drake.scene.generators import generate_scene
+from hlp_drake.scene.model import Scene, SceneObject, Table
 from hlp_drake.segmentation import demonstration_records
 from hlp_drake.taskspace import TaskSpace
 
 DEFAULT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "hlp-vr-dataset.tar.xz"
+
+
+def two_row_scene(objects: int, seed: int) -> Scene:
+    """``objects`` boxes in two rows on a table wide enough for them (isolates the object count
+    from the row count, which random layouts also grow)."""
+    rng = np.random.default_rng(seed)
+    per_row = [objects // 2, objects - objects // 2]
+    width = max(1.0, 0.12 * max(per_row) + 0.2)
+    obstacles = []
+    for row, (count, x) in enumerate(zip(per_row, (0.35, 0.6)), start=1):
+        slots = np.linspace(-width / 2 + 0.08, width / 2 - 0.08, count)
+        for i, y in enumerate(slots):
+            obstacles.append(SceneObject(f"r{row}_{i}", "box", x, float(y + rng.uniform(-0.01, 0.01)),
+                                         (0.05, float(rng.uniform(0.05, 0.08)), 0.12)))
+    return Scene(Table(1.0, width, 0.75), (0.1, 0.0), SceneObject("Target", "cylinder", 0.85, 0.0, (0.06, 0.06, 0.12)),
+                 tuple(obstacles), name=f"two-row-{objects}-{seed}")
 
 
 def times(scenes, models) -> dict[str, float]:
@@ -64,6 +82,8 @@ def main() -> None:
             continue
         report[f"gen2_{objects}"] = times(scenes, models) | {
             "rows_mean": float(np.mean([len(TaskSpace(s).rows) for s in scenes]))}
+    for objects in (6, 12, 25, 50):
+        report[f"two_rows_{objects}"] = times([two_row_scene(objects, seed) for seed in range(args.scenes)], models)
     for name, value in report.items():
         print(f"{name}: {value}")
     if args.json:

@@ -46,24 +46,27 @@ def sweep_collision(before: np.ndarray, after: np.ndarray, occluders: np.ndarray
     if n == 0 or len(occluders) == 0:
         return np.zeros(n)
     counted = np.maximum(mask.sum(axis=1), 1)
+    if not faithful:
+        # Two triangles per link sweep, all links and motions clipped in one batch.
+        inflated = _inflate(occluders, band)
+        areas = (inflated[:, 2] - inflated[:, 0]) * (inflated[:, 3] - inflated[:, 1])
+        a0, b0, a1, b1 = before[:, :3], before[:, 1:], after[:, :3], after[:, 1:]  # (n, 3, 2) per link
+        first = np.stack([a0, b0, b1, b1], axis=2)
+        second = np.stack([a0, b1, a1, a1], axis=2)
+        triangles = np.concatenate([first, second], axis=1).reshape(-1, 4, 2)  # (n * 6, 4, 2)
+        cover = convex_rect_overlap(triangles, inflated).reshape(n, 2, 3, -1).sum(axis=1) / areas
+        cover = np.minimum(cover, 1.0)  # (n, 3 links, m)
+        return (np.where(mask[:, None, :], cover, 0.0).sum(axis=2) / counted[:, None]).sum(axis=1)
     total = np.zeros(n)
     for link in range(3):
         a0, b0, a1, b1 = before[:, link], before[:, link + 1], after[:, link], after[:, link + 1]
-        if faithful:
-            da, db = a1 - a0, b1 - b0
-            phi = np.minimum(paper_angle(da), paper_angle(db))
-            offsets = np.column_stack([np.sin(phi), -np.cos(phi)])  # the original's (cos, sin) in its frame
-            reach = np.maximum(np.linalg.norm(da, axis=1), np.linalg.norm(db, axis=1))
-            cover = np.stack([
-                band_coverage_sampled(a0[i], b0[i], offsets[i], band, band + reach[i], occluders)[0]
-                for i in range(n)
-            ])
-        else:
-            inflated = _inflate(occluders, band)
-            areas = (inflated[:, 2] - inflated[:, 0]) * (inflated[:, 3] - inflated[:, 1])
-            first = np.stack([a0, b0, b1, b1], axis=1)
-            second = np.stack([a0, b1, a1, a1], axis=1)
-            cover = (convex_rect_overlap(first, inflated) + convex_rect_overlap(second, inflated)) / areas
-            cover = np.minimum(cover, 1.0)
+        da, db = a1 - a0, b1 - b0
+        phi = np.minimum(paper_angle(da), paper_angle(db))
+        offsets = np.column_stack([np.sin(phi), -np.cos(phi)])  # the original's (cos, sin) in its frame
+        reach = np.maximum(np.linalg.norm(da, axis=1), np.linalg.norm(db, axis=1))
+        cover = np.stack([
+            band_coverage_sampled(a0[i], b0[i], offsets[i], band, band + reach[i], occluders)[0]
+            for i in range(n)
+        ])
         total += np.where(mask, cover, 0.0).sum(axis=1) / counted
     return total

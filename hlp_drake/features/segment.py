@@ -20,6 +20,17 @@ def _misread_wall(wall: Rect) -> Rect:
     return Rect(wall.x_min - hd, wall.y_max - hw, wall.x_min + hd, wall.y_max + hw)
 
 
+PATH_WALLS = ("back", "left", "right")  # the front wall is not an occluder of hand or arm paths
+
+
+def path_occluders(space: TaskSpace, *, faithful: bool) -> np.ndarray:
+    """(n_obstacles + 3, 4): every obstacle (scene order), then the back, left and right walls
+    (misplaced as the original does, bug B3, in faithful mode)."""
+    walls = [space.walls[w] for w in PATH_WALLS]
+    walls = [_misread_wall(w) for w in walls] if faithful else walls
+    return rect_array([space.rects[n] for n in space.obstacle_names] + walls)
+
+
 def segment_feature_matrix(space: TaskSpace, near: list[Node], far: list[Node], *, mode: Mode,
                            training: bool = False) -> np.ndarray:
     """Xc of every pair (a in ``near``, b in ``far``), a-major: (len(near) * len(far), 4).
@@ -43,8 +54,7 @@ def segment_feature_matrix(space: TaskSpace, near: list[Node], far: list[Node], 
     span = np.abs(d[:, 1]) / norm
     slope = -d[:, 1] / d[:, 0] - (-(target[1] - start[1])) / (target[0] - start[0])
     names = space.obstacle_names
-    walls = [space.walls[w] for w in ("back", "left", "right")]
-    rects = rect_array([space.rects[n] for n in names] + ([_misread_wall(w) for w in walls] if faithful else walls))
+    rects = path_occluders(space, faithful=faithful)
     half = HAND_WIDTH / 2.0
     if faithful:
         theta = paper_angle(d)

@@ -23,10 +23,9 @@ from hlp_drake.planner.relocation import relocated
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.validation import scene_problems
 from hlp_drake.segmentation.modes import is_faithful
-from hlp_drake.taskspace import DIRECTIONS, Node, TaskSpace, direction_of, rect_array
-from hlp_drake.features.segment import _misread_wall
-
-VR_DIAGONAL = 0.95268  # the table the models were trained on; arm lengths scale with the table
+from hlp_drake.taskspace import DIRECTIONS, Node, TaskSpace, direction_of
+from hlp_drake.features.segment import PATH_WALLS, path_occluders
+from hlp_drake.scene.generators import VR_TABLE
 
 
 @dataclass
@@ -34,20 +33,19 @@ class _Path:
     nodes: tuple[Node, ...]
     score: float
     keypoints: list[PlanKeypoint] = field(default_factory=list)
-    removed: list[set[str]] = field(default_factory=list)  # per segment: obstacles gone by then
     arms: list[np.ndarray] = field(default_factory=list)
     cost: float = 0.0
 
 
-def _row_candidates(nodes: list[Node], scores: dict[str, float], widths: dict[int, float], config: PlannerConfig,
-                    kind: str, cap: int) -> list[Node]:
-    """Accepted candidates of one kind (score > 0, best ``cap``), else the single best one."""
-    pool = [n for n in nodes if n.kind == kind and (kind == "object" or widths[id(n)] >= config.min_gap_width)]
-    if not pool:
-        return []
-    ranked = sorted(pool, key=lambda n: -scores[n.element])
-    accepted = [n for n in ranked if scores[n.element] > 0][:cap] or ranked[:1]
-    return [n for n in pool if n in accepted]  # keep the row's order (left to right / scene order)
+def _row_candidates(nodes: list[Node], score: dict[Node, float], kind: str, cap: int, min_width: float,
+                    space: TaskSpace) -> list[Node]:
+    """Accepted candidates of one kind (score > 0, best ``cap``), else the single best one; in the
+    row's order (gaps left to right, obstacles in scene order)."""
+    pool = [n for n in nodes if n.kind == kind
+            and (kind == "object" or space.gaps[n.row - 1][n.gap - 1].width >= min_width)]
+    ranked = sorted(pool, key=lambda n: -score[n])
+    accepted = [n for n in ranked if score[n] > 0][:cap] or ranked[:1]
+    return [n for n in pool if n in accepted]
 
 
 def _enumerate_paths(candidates: list[list[Node]], segment_scores: list[np.ndarray], max_paths: int) -> list[_Path]:
@@ -123,7 +121,7 @@ def plan(scene: Scene, models: DecisionModels, config: PlannerConfig | None = No
         return _no_plan(scene, "invalid scene: " + "; ".join(problems), started)
     faithful = is_faithful(config.mode)
     space = TaskSpace(scene)
-    scale = table_diagonal(scene.table) / VR_DIAGONAL
+    scale = table_diagonal(scene.table) / table_diagonal(VR_TABLE)  # arm lengths scale with the table
     upper, fore = link_lengths if link_lengths is not None else tuple(np.asarray(models.link_lengths_) * scale)
     arm_total = upper + fore
     q0 = np.asarray(start_arm if start_arm is not None else models.start_arm_, float)
@@ -148,19 +146,17 @@ def plan(scene: Scene, models: DecisionModels, config: PlannerConfig | None = No
         "object_scores": {n: float(s) for n, s in zip(names, object_scores) if np.isfinite(s)},
     }
 
-    # 2. Candidates per row.
+    # 2. Candidates per row (only classified gaps and obstacles).
+    gap_score = {(g.row, g.index): s for g, s in zip(gaps, gap_scores)}
+    object_score = dict(zip(names, object_scores))
     candidates: list[list[Node]] = []
-    scores = {f"{g.row}:{g.index}": s for g, s in zip(gaps, gap_scores)}
-    obstacle_scores = dict(zip(names, object_scores))
     for row in space.rows:
-        nodes = [n for n in space.nodes(row.index)
-                 if np.isfinite(scores[f"{row.index}:{n.gap}"] if n.kind == "gap" else obstacle_scores[n.obstacle])]
-        by_element = {n.element: (scores[f"{row.index}:{n.gap}"] if n.kind == "gap" else obstacle_scores[n.obstacle])
-                      for n in nodes}
-        widths = {id(n): space.gaps[row.index - 1][n.gap - 1].width for n in nodes if n.kind == "gap"}
-        row_nodes = (_row_candidates(nodes, by_element, widths, config, "gap", config.max_gaps_per_row)
-                     + _row_candidates(nodes, by_element, widths, config, "object", config.max_objects_per_row))
-        candidates.append(row_nodes)
+        score = {n: gap_score[(n.row, n.gap)] if n.kind == "gap" else object_score[n.obstacle]
+                 for n in space.nodes(row.index)}
+        nodes = [n for n, s in score.items() if np.isfinite(s)]
+        candidates.append(
+            _row_candidates(nodes, score, "gap", config.max_gaps_per_row, config.min_gap_width, space)
+            + _row_candidates(nodes, score, "object", config.max_objects_per_row, config.min_gap_width, space))
 
     # 3. Segments between consecutive rows, classified; paths along accepted segments.
     segment_scores = []
@@ -203,8 +199,7 @@ def plan(scene: Scene, models: DecisionModels, config: PlannerConfig | None = No
         predicted = models.arm.predict(np.array(X))
         for p, q in zip(active, predicted):
             p.arms.append(np.clip(q, 0.0, np.pi))
-    walls = [space.walls[w] for w in ("back", "left", "right")]
-    occluders = rect_array([space.rects[n] for n in names] + ([_misread_wall(w) for w in walls] if faithful else walls))
+    occluders = path_occluders(space, faithful=faithful)
     before, after, masks, owner = [], [], [], []
     for index, path in enumerate(paths):
         gone: set[str] = set()
@@ -216,7 +211,7 @@ def plan(scene: Scene, models: DecisionModels, config: PlannerConfig | None = No
                     gone.add(keypoint.element)
             before.append(joints[k - 1])
             after.append(joints[k])
-            masks.append([n not in gone for n in names] + [True] * len(walls))
+            masks.append([n not in gone for n in names] + [True] * len(PATH_WALLS))
             owner.append(index)
     if len(paths) > 1 or not faithful:
         costs = sweep_collision(np.array(before), np.array(after), occluders, np.array(masks, dtype=bool),

@@ -11,7 +11,6 @@ from hlp_drake.segmentation.arm import LinkLengths
 from hlp_drake.segmentation.modes import Mode
 
 GAP, OBJECT = "gap", "object"
-KEYPOINT_KINDS = ("start", "gap", "approach", "release", "target")
 
 
 @dataclass(frozen=True)

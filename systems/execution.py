@@ -46,6 +46,8 @@ class ExecutionResult:
     objects_dropped: list[str] = field(default_factory=list)
     target_distance: float | None = None
     simulated_s: float = 0.0
+    iterations: int = 0
+    rollouts: int = 0
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -54,9 +56,7 @@ class ExecutionResult:
             "ik": {"ok": self.keyframes.ok, "failures": self.keyframes.failures},
             "robot_actuated_dofs": 10, "timings": self.timings, "objects_moved": self.objects_moved,
             "objects_dropped": self.objects_dropped, "target_distance": self.target_distance,
-            "simulated_s": self.simulated_s,
-            # The stochastic trajectory optimiser is not part of this pipeline yet: no rollouts.
-            "iterations": 0, "rollouts": 0,
+            "simulated_s": self.simulated_s, "iterations": self.iterations, "rollouts": self.rollouts,
         }
 
 

@@ -27,6 +27,7 @@ from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 from pydrake.multibody.plant import MultibodyPlantConfig
 
 from hlp_drake.errors import HlpError
+from hlp_drake.systems.sto_config import GraspConfig, StoConfig, sto_config_problems
 
 SAP_APPROXIMATIONS = ("sap", "lagged", "similar")
 """Discrete contact approximations solved by SAP (TAMSI, "tamsi", cannot simulate the mimic finger)."""
@@ -180,6 +181,8 @@ class WorldConfig:
         control: robot PD gains.
         ik: keypoint inverse kinematics.
         motion: trajectory timing.
+        sto: the stochastic trajectory optimiser.
+        grasp: the grasp and lift after the reach.
         meshcat: whether a caller (e.g. a command-line tool) should visualise in MeshCat; see
             ``hlp_drake.systems.world.start_meshcat``.
     """
@@ -190,6 +193,8 @@ class WorldConfig:
     control: ControlConfig = field(default_factory=ControlConfig)
     ik: IkConfig = field(default_factory=IkConfig)
     motion: MotionConfig = field(default_factory=MotionConfig)
+    sto: StoConfig = field(default_factory=StoConfig)
+    grasp: GraspConfig = field(default_factory=GraspConfig)
     meshcat: bool = False
 
 
@@ -253,6 +258,7 @@ def config_problems(config: WorldConfig) -> list[str]:
     positive("motion.tcp_speed", config.motion.tcp_speed)
     positive("motion.joint_speed_fraction", config.motion.joint_speed_fraction)
     positive("motion.min_segment_duration", config.motion.min_segment_duration)
+    problems.extend(sto_config_problems(config.sto, config.grasp))
     return problems
 
 

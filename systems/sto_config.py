@@ -1,0 +1,146 @@
+"""``StoConfig``: every setting of the stochastic trajectory optimiser (part of ``WorldConfig``).
+
+In a world YAML file it sits under ``sto:``::
+
+    sto:
+      samples: 8
+      update: mppi
+      noise: {vx: 0.04, vy: 0.04, yaw_rate: 0.02}
+      cost: {goal_weight: 2000.0}
+"""
+
+# No "from __future__ import annotations": yaml_load_typed reads the field types at run time.
+import math
+from dataclasses import dataclass, field
+
+UPDATES = ("greedy", "mppi")
+
+
+@dataclass
+class BaseNoise:
+    """Standard deviations of the Gaussian noise added to the base's planar velocity per control step.
+
+    The STO family perturbs the planar (x, y, yaw) velocity of the holonomic base; the arm keeps the
+    joint motion of the sequence being improved, so the whole gripper shifts in the table plane.
+    """
+
+    vx: float = 0.04  # m/s
+    vy: float = 0.04  # m/s
+    yaw_rate: float = 0.02  # rad/s
+
+
+@dataclass
+class StoCost:
+    """Weights of the rollout cost (charged from the states at the ends of the control steps).
+
+    Attributes:
+        pregrasp_margin: the target is inside the gripper's pre-grasp region when the tcp is within
+            its radius plus this (horizontally) and within this of the keypoint height, m.
+        goal_weight: final cost per metre of tcp-to-pre-grasp-region distance outside the region.
+        off_table: per object off the table (centre outside the top or below it), at every step.
+        table_contact: per control step in which the robot touches the table (its edge or top).
+        force_limit, force_weight: per newton of a contact force on an object above the limit.
+        disturbance_weight: final, per square metre of the obstacles' summed squared displacement.
+        target_disturbance_weight: final, per square metre of the target's squared displacement.
+        near_obstacle: final, when the tcp ends within ``near_distance`` of an obstacle's centre
+            line plus its half-size (the fingers would close on it).
+        effort_weight: per (rad/s)^2 or (m/s)^2, times seconds, of the commanded joint velocities.
+    """
+
+    pregrasp_margin: float = 0.03
+    goal_weight: float = 2000.0
+    off_table: float = 300.0
+    table_contact: float = 300.0
+    force_limit: float = 60.0
+    force_weight: float = 50.0
+    disturbance_weight: float = 100.0
+    target_disturbance_weight: float = 1000.0
+    near_obstacle: float = 500.0
+    near_distance: float = 0.01
+    effort_weight: float = 0.05
+
+
+@dataclass
+class StoConfig:
+    """The stochastic trajectory optimiser (``hlp_drake.systems.sto``).
+
+    Attributes:
+        samples: noisy rollouts per iteration (K).
+        max_iterations: iteration budget (an iteration = K rollouts + an update).
+        time_budget_s: wall-clock budget of one optimisation; no iteration starts that is expected
+            to end past it.
+        step_duration: duration of one control step, s (the sequence's knots are this far apart).
+        noise: base-velocity noise per step.
+        update: "greedy" (keep the best noisy rollout) or "mppi" (cost-weighted mean of the noise).
+        mppi_temperature: h in w_k = exp(-h (c_k - c_min) / (c_max - c_min)).
+        workers: rollout processes (1: roll out in this process).
+        seed: seed of the noise.
+        rollout_time_step: plant time step of the rollouts, s (coarser than the execution's; the
+            executed result is checked on the full model).
+        settle_s: simulated time after the last control step before the final state is read, s.
+        max_object_speed: an object faster than this (m/s) means the simulation blew up.
+        max_sink: an object more than this below the table top while over it means it tunnelled, m.
+        cost: the cost weights.
+    """
+
+    samples: int = 8
+    max_iterations: int = 20
+    time_budget_s: float = 120.0
+    step_duration: float = 0.5
+    noise: BaseNoise = field(default_factory=BaseNoise)
+    update: str = "greedy"
+    mppi_temperature: float = 10.0
+    workers: int = 2
+    seed: int = 0
+    rollout_time_step: float = 0.005
+    settle_s: float = 0.5
+    max_object_speed: float = 5.0
+    max_sink: float = 0.03
+    cost: StoCost = field(default_factory=StoCost)
+
+
+@dataclass
+class GraspConfig:
+    """The grasp after a successful reach: close the fingers, then lift the tcp straight up.
+
+    Attributes:
+        close_s: time to close the fingers, s.
+        lift_height: how far the tcp rises, m.
+        lift_s: time of the lift, s.
+        hold_s: time held at the top before the check, s.
+        held_height: the grasp held when the target rose at least this far, m.
+    """
+
+    close_s: float = 1.0
+    lift_height: float = 0.10
+    lift_s: float = 1.5
+    hold_s: float = 0.5
+    held_height: float = 0.05
+
+
+def sto_config_problems(sto: StoConfig, grasp: GraspConfig) -> list[str]:
+    """The reasons ``sto`` or ``grasp`` cannot be used (empty when they are fine)."""
+    problems: list[str] = []
+
+    def positive(where: str, value: float, *, zero_ok: bool = False) -> None:
+        if not math.isfinite(value) or value < 0 or (value == 0 and not zero_ok):
+            problems.append(f"{where} must be {'>= 0' if zero_ok else '> 0'}, got {value}")
+
+    for name in ("samples", "max_iterations", "workers"):
+        if int(getattr(sto, name)) < 1:
+            problems.append(f"sto.{name} must be >= 1, got {getattr(sto, name)}")
+    for name in ("time_budget_s", "step_duration", "mppi_temperature", "rollout_time_step",
+                 "max_object_speed", "max_sink"):
+        positive(f"sto.{name}", getattr(sto, name))
+    positive("sto.settle_s", sto.settle_s, zero_ok=True)
+    for name in ("vx", "vy", "yaw_rate"):
+        positive(f"sto.noise.{name}", getattr(sto.noise, name), zero_ok=True)
+    if sto.update not in UPDATES:
+        problems.append(f"sto.update must be one of {', '.join(UPDATES)}, got {sto.update!r}")
+    for name in StoCost.__dataclass_fields__:
+        positive(f"sto.cost.{name}", getattr(sto.cost, name), zero_ok=True)
+    for name in ("close_s", "lift_s", "held_height"):
+        positive(f"grasp.{name}", getattr(grasp, name))
+    for name in ("lift_height", "hold_s"):
+        positive(f"grasp.{name}", getattr(grasp, name), zero_ok=True)
+    return problems

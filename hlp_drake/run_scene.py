@@ -16,6 +16,7 @@ from pathlib import Path
 
 from hlp_drake.atomic import write_text_atomic
 from hlp_drake.cli import run_cli
+from hlp_drake.errors import HlpError
 from hlp_drake.scene.generators import KINDS, generate_scene
 from hlp_drake.scene.io import load_scene
 from hlp_drake.scene.validation import validate_scene
@@ -29,13 +30,17 @@ def summary(result) -> str:
         k.action + (f" {k.element}" if k.action in ("gap", "move") else "") + (f" {k.direction}" if k.action == "move" else "")
         for k in plan.keypoints) or "(none)"
     t = result.timings
+    optimiser = (f"optimise {t['optimise_s']:.1f} s ({result.iterations} iterations, {result.rollouts} rollouts)"
+                 if result.rollouts else "not optimised")
+    grasp = {None: "not attempted", True: "held", False: "did not hold"}[result.grasp_held]
     lines = [
         f"scene {result.scene.name}: {len(result.scene.obstacles)} obstacles, planner {result.planner}",
         f"plan: {steps}",
-        f"timings: plan {t['plan_s']:.3f} s, IK {t['ik_s']:.2f} s, execute {t['execute_s']:.1f} s "
+        f"timings: plan {t['plan_s']:.3f} s, IK {t['ik_s']:.2f} s, {optimiser}, execute {t['execute_s']:.1f} s "
         f"({result.simulated_s:.1f} s simulated), total {t['total_s']:.1f} s",
         f"objects moved: {', '.join(result.objects_moved) or 'none'}; dropped: {', '.join(result.objects_dropped) or 'none'}",
         "success" if result.success else f"failure: {result.failure_reason}",
+        f"grasp: {grasp}",
     ]
     return "\n".join(lines)
 
@@ -48,7 +53,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0, help="seed of the generated scene (default 0)")
     parser.add_argument("--objects", type=int, help="number of obstacles (gen2 / unstructured)")
     parser.add_argument("--planner", choices=("hlp", "sto"), default="hlp",
-                        help="hlp: human-like plan; sto: the baseline's straight line")
+                        help="initialise the trajectory optimiser with the human-like plan (hlp) or with "
+                             "the baseline's straight line (sto)")
+    parser.add_argument("--workers", type=int, help="rollout processes of the optimiser (default: the config's sto.workers)")
     parser.add_argument("--config", help="world configuration YAML (WorldConfig)")
     parser.add_argument("--meshcat", action="store_true", help="show the run live in MeshCat (prints the URL)")
     parser.add_argument("--html", help="write a self-contained MeshCat recording of the run")
@@ -64,6 +71,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     from hlp_drake.systems.world_config import WorldConfig, load_world_config
 
     config = load_world_config(args.config) if args.config else WorldConfig()
+    if args.workers is not None:
+        if args.workers < 1:
+            raise HlpError(f"--workers must be >= 1, got {args.workers}")
+        config.sto.workers = args.workers
     meshcat = None
     if args.meshcat or args.html:
         from pydrake.geometry import Meshcat, MeshcatParams

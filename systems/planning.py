@@ -12,6 +12,8 @@ from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.hlp_planner_system import HlpPlannerSystem
 from hlp_drake.systems.keypoint_ik import KeypointIk
+from hlp_drake.systems.rollout_pool import RolloutPool
+from hlp_drake.systems.sto import StochasticTrajectoryOptimiser
 from hlp_drake.systems.world_config import WorldConfig
 
 PLANNERS = ("hlp", "sto")
@@ -69,15 +71,17 @@ class RobotPlanTransfer(LeafSystem):
 
 
 def make_planning_diagram(scene: Scene, *, planner: str = "hlp", models: DecisionModels | None = None,
-                          config: WorldConfig | None = None) -> Diagram:
-    """``scene`` input -> planner block -> push transfer -> KeypointIk.
+                          config: WorldConfig | None = None, pool: RolloutPool | None = None) -> Diagram:
+    """``scene`` input -> planner block -> push transfer -> KeypointIk -> StochasticTrajectoryOptimiser.
 
-    Outputs ``plan`` (the planner's), ``robot_plan`` (its pushing-robot waypoints), ``keyframes``
-    and ``trajectory``.
+    Outputs ``plan`` (the planner's), ``robot_plan`` (its pushing-robot waypoints), ``keyframes``,
+    ``trajectory`` (the initial joint trajectory through the keyframes), ``optimised_trajectory``
+    and ``optimisation`` (the optimiser's ``StoResult``). Evaluating the last two runs the optimiser.
 
     Args:
         planner: "hlp" (the human-like planner) or "sto" (the straight line of the baseline); the
-            only difference is the planner block.
+            only difference is the planner block: the optimiser and its settings are the same.
+        pool: the optimiser's rollout workers (an in-process pool by default).
     """
     if planner not in PLANNERS:
         raise ValueError(f"unknown planner {planner!r}; choose one of {', '.join(PLANNERS)}")
@@ -88,12 +92,16 @@ def make_planning_diagram(scene: Scene, *, planner: str = "hlp", models: Decisio
     transfer = builder.AddNamedSystem("robot_plan_transfer", RobotPlanTransfer(scene))
     ik = builder.AddNamedSystem("keypoint_ik", KeypointIk(scene, config))
     builder.Connect(block.get_plan_output_port(), transfer.get_plan_input_port())
+    optimiser = builder.AddNamedSystem("optimiser", StochasticTrajectoryOptimiser(scene, config, pool=pool))
     builder.Connect(transfer.get_robot_plan_output_port(), ik.get_plan_input_port())
+    builder.Connect(ik.get_trajectory_output_port(), optimiser.get_initial_trajectory_input_port())
     builder.ExportInput(block.get_scene_input_port(), "scene")
     builder.ExportOutput(block.get_plan_output_port(), "plan")
     builder.ExportOutput(transfer.get_robot_plan_output_port(), "robot_plan")
     builder.ExportOutput(ik.get_keyframes_output_port(), "keyframes")
     builder.ExportOutput(ik.get_trajectory_output_port(), "trajectory")
+    builder.ExportOutput(optimiser.get_trajectory_output_port(), "optimised_trajectory")
+    builder.ExportOutput(optimiser.get_result_output_port(), "optimisation")
     diagram = builder.Build()
     diagram.set_name(f"{planner}_planning")
     return diagram

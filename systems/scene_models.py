@@ -218,19 +218,25 @@ def object_planar_poses(
     return result
 
 
+def off_table_mask(positions: np.ndarray, table) -> np.ndarray:
+    """Per object centre in ``positions`` (m, 3): whether it is off the table (below the top or
+    outside its footprint)."""
+    positions = np.asarray(positions, dtype=float).reshape(-1, 3)
+    x_min, y_min, x_max, y_max = table.bounds
+    x, y, z = positions.T
+    inside = (x >= x_min) & (x <= x_max) & (y >= y_min) & (y <= y_max)
+    return ~(inside & (z >= table.height))
+
+
 def fallen_objects(plant: MultibodyPlant, context: Context, scene: Scene) -> list[str]:
     """Names of the objects that are no longer on the table.
 
     An object has fallen when its centre is below the table top or outside the table's footprint.
     """
-    table = scene.table
-    x_min, y_min, x_max, y_max = table.bounds
-    fallen = []
-    for name, X in object_poses(plant, context, [obj.name for obj in scene.objects]).items():
-        x, y, z = X.translation()
-        if z < table.height or not (x_min <= x <= x_max and y_min <= y <= y_max):
-            fallen.append(name)
-    return fallen
+    names = [obj.name for obj in scene.objects]
+    poses = object_poses(plant, context, names)
+    mask = off_table_mask(np.array([poses[name].translation() for name in names]), scene.table)
+    return [name for name, off in zip(names, mask) if off]
 
 
 def tilted_objects(
@@ -266,6 +272,7 @@ __all__ = [
     "object_planar_poses",
     "object_pose",
     "object_poses",
+    "off_table_mask",
     "scene_from_plant",
     "set_object_poses",
     "tilted_objects",

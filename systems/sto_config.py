@@ -27,6 +27,9 @@ class BaseNoise:
     vx: float = 0.04  # m/s
     vy: float = 0.04  # m/s
     yaw_rate: float = 0.02  # rad/s
+    end_fraction: float = 0.25
+    """Share of the noise's accumulated drift kept at the end of the sequence: the rest is taken out
+    evenly over the steps, so a detour returns towards the end point the sequence aims at."""
 
 
 @dataclass
@@ -78,8 +81,10 @@ class StoConfig:
         rollout_time_step: plant time step of the rollouts, s (coarser than the execution's; the
             executed result is checked on the full model).
         settle_s: simulated time after the last control step before the final state is read, s.
+        sample_period: how often a rollout's state is read for the cost, s.
         max_object_speed: an object faster than this (m/s) means the simulation blew up.
-        max_sink: an object more than this below the table top while over it means it tunnelled, m.
+        max_sink: an object's centre more than this below the table top while over it means it
+            tunnelled into the table, m.
         cost: the cost weights.
     """
 
@@ -94,6 +99,7 @@ class StoConfig:
     seed: int = 0
     rollout_time_step: float = 0.005
     settle_s: float = 0.5
+    sample_period: float = 0.1
     max_object_speed: float = 5.0
     max_sink: float = 0.03
     cost: StoCost = field(default_factory=StoCost)
@@ -130,11 +136,13 @@ def sto_config_problems(sto: StoConfig, grasp: GraspConfig) -> list[str]:
         if int(getattr(sto, name)) < 1:
             problems.append(f"sto.{name} must be >= 1, got {getattr(sto, name)}")
     for name in ("time_budget_s", "step_duration", "mppi_temperature", "rollout_time_step",
-                 "max_object_speed", "max_sink"):
+                 "sample_period", "max_object_speed", "max_sink"):
         positive(f"sto.{name}", getattr(sto, name))
     positive("sto.settle_s", sto.settle_s, zero_ok=True)
     for name in ("vx", "vy", "yaw_rate"):
         positive(f"sto.noise.{name}", getattr(sto.noise, name), zero_ok=True)
+    if not 0.0 <= sto.noise.end_fraction <= 1.0:
+        problems.append(f"sto.noise.end_fraction must be in [0, 1], got {sto.noise.end_fraction}")
     if sto.update not in UPDATES:
         problems.append(f"sto.update must be one of {', '.join(UPDATES)}, got {sto.update!r}")
     for name in StoCost.__dataclass_fields__:

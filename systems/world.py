@@ -116,7 +116,8 @@ def tcp_keypoint_height(scene: Scene, config: WorldConfig) -> float:
 
 
 @functools.lru_cache(maxsize=1)
-def _kinematic_robot() -> tuple[MultibodyPlant, ModelInstanceIndex]:
+def kinematic_robot() -> tuple[MultibodyPlant, ModelInstanceIndex]:
+    """A robot-only continuous plant for kinematics (built once, shared; do not modify it)."""
     plant = MultibodyPlant(time_step=0.0)
     instance = add_robot(plant)
     plant.Finalize()
@@ -182,7 +183,7 @@ def start_configuration(
 @functools.lru_cache(maxsize=64)
 def _start_arm(base_offset_x: float, tcp_z: float, max_iterations: int) -> tuple[float, ...] | None:
     """Arm angles putting the tcp ``-base_offset_x`` ahead of the base at height ``tcp_z`` (cached)."""
-    plant, instance = _kinematic_robot()
+    plant, instance = kinematic_robot()
     context = plant.CreateDefaultContext()
     ik = InverseKinematics(plant, context, with_joint_limits=True)
     q = ik.q()

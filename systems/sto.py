@@ -1,0 +1,208 @@
+"""The physics-based stochastic trajectory optimiser (STO) and its Drake block.
+
+``optimise(scene, initial, config, pool=...)`` improves a ``ControlSequence`` as the STO family does
+(the project's notes, section A): every iteration rolls out ``samples`` noisy copies of the current
+sequence in the contact simulation (``RolloutWorld``), the noise being Gaussian per-step velocities
+of the holonomic base; the update keeps the cheapest copy ("greedy") or the cost-weighted mean of
+the noise, w_k = exp(-h (c_k - c_min) / (c_max - c_min)) ("mppi", rolled out once more); a candidate
+replaces the current sequence only if its cost is lower (monotone acceptance). It stops at the first
+successful rollout (target in the pre-grasp region, nothing fell), at ``max_iterations``, or when
+the next iteration would end past ``time_budget_s``.
+
+``StochasticTrajectoryOptimiser`` wraps it as a LeafSystem: input ``initial_trajectory`` (abstract
+PiecewisePolynomial of the robot's 11 positions, e.g. ``KeypointIk``'s ``trajectory``), outputs
+``trajectory`` (the optimised one) and ``result`` (``StoResult``), computed once per input value.
+The HLP-initialised and the straight-line-initialised runs use this same block and configuration;
+only the initial trajectory differs.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.systems.framework import LeafSystem
+from pydrake.trajectories import PiecewisePolynomial
+
+from hlp_drake.scene.model import Scene
+from hlp_drake.systems.control_sequence import ControlSequence
+from hlp_drake.systems.rollout import RolloutOutcome
+from hlp_drake.systems.rollout_pool import RolloutPool
+from hlp_drake.systems.sto_config import BaseNoise, StoConfig
+from hlp_drake.systems.world_config import WorldConfig
+
+
+@dataclass
+class StoResult:
+    """The outcome of one optimisation.
+
+    Attributes:
+        sequence: the best sequence found (the initial one if nothing was better).
+        outcome: its rollout.
+        success: whether its rollout passed the success test.
+        failure_reason: why not (None on success), one line.
+        iterations: iterations run (0: the initial sequence already succeeded, or none was run).
+        rollouts: rollouts simulated, the initial one included.
+        optimise_s: wall-clock time of the optimisation, s.
+        costs: the current cost after the initial rollout and after every iteration.
+        initial_cost: the initial sequence's cost.
+    """
+
+    sequence: ControlSequence
+    outcome: RolloutOutcome | None
+    success: bool
+    failure_reason: str | None
+    iterations: int = 0
+    rollouts: int = 0
+    optimise_s: float = 0.0
+    costs: list[float] = field(default_factory=list)
+    initial_cost: float | None = None
+
+    def to_dict(self) -> dict:
+        return {
+            "success": self.success, "failure_reason": self.failure_reason, "iterations": self.iterations,
+            "rollouts": self.rollouts, "optimise_s": self.optimise_s, "initial_cost": self.initial_cost,
+            "final_cost": self.outcome.cost if self.outcome is not None else None,
+            "cost_terms": dict(self.outcome.terms) if self.outcome is not None else {},
+            "costs": list(self.costs),
+        }
+
+
+def sample_base_noise(rng: np.random.Generator, sequence: ControlSequence, noise: BaseNoise,
+                      samples: int) -> np.ndarray:
+    """(samples, n, 3) Gaussian base velocities (vx, vy, yaw rate) per step of ``sequence``.
+
+    All but ``noise.end_fraction`` of each sample's accumulated drift is taken out evenly over the
+    duration, so a noisy copy detours and comes back towards the sequence's end point.
+    """
+    sigma = np.array([noise.vx, noise.vy, noise.yaw_rate])
+    velocity = rng.normal(size=(samples, sequence.num_steps, 3)) * sigma
+    drift = np.einsum("knj,n->kj", velocity, sequence.steps)  # (samples, 3) displacement at the end
+    return velocity - (1.0 - noise.end_fraction) * drift[:, None, :] / sequence.duration
+
+
+def mppi_weights(costs: np.ndarray, temperature: float) -> np.ndarray:
+    """Normalised weights exp(-h (c - c_min) / (c_max - c_min)) of the rollouts' costs."""
+    costs = np.asarray(costs, dtype=float)
+    spread = float(np.max(costs) - np.min(costs))
+    if not np.isfinite(spread) or spread <= 0:
+        return np.full(len(costs), 1.0 / len(costs))
+    weights = np.exp(-temperature * (costs - np.min(costs)) / spread)
+    return weights / np.sum(weights)
+
+
+def optimise(scene: Scene, initial: ControlSequence, config: WorldConfig | None = None, *,
+             pool: RolloutPool | None = None, progress=None) -> StoResult:
+    """Improve ``initial`` on ``scene`` (see the module's docstring); never raises for a bad scene.
+
+    Args:
+        pool: the rollout workers; a temporary in-process pool by default.
+        progress: optional callable ``progress(iteration, cost)`` called after every iteration.
+    """
+    config = WorldConfig() if config is None else config
+    sto: StoConfig = config.sto
+    own_pool = pool is None
+    pool = RolloutPool(1) if own_pool else pool
+    started = time.perf_counter()
+    try:
+        collisions = pool.world(scene, config).start_collisions
+        if collisions:
+            return StoResult(initial, None, False, f"the robot starts in collision with {', '.join(collisions)}",
+                             optimise_s=time.perf_counter() - started)
+        rng = np.random.default_rng(sto.seed)
+        best = initial
+        (outcome,) = pool.rollouts(scene, config, [best])
+        result = StoResult(best, outcome, outcome.success, outcome.failure_reason, rollouts=1,
+                           costs=[outcome.cost], initial_cost=outcome.cost)
+        last_iteration_s = 0.0
+        while not result.success and result.iterations < sto.max_iterations:
+            elapsed = time.perf_counter() - started
+            if elapsed + last_iteration_s > sto.time_budget_s:
+                result.failure_reason = f"{outcome.failure_reason} (time budget of {sto.time_budget_s:g} s spent)"
+                break
+            iteration_started = time.perf_counter()
+            noise = sample_base_noise(rng, best, sto.noise, sto.samples)
+            candidates = [best.with_base_velocity(v) for v in noise]
+            outcomes = pool.rollouts(scene, config, candidates)
+            result.rollouts += len(candidates)
+            if sto.update == "mppi":
+                weights = mppi_weights(np.array([o.cost for o in outcomes]), sto.mppi_temperature)
+                mean = best.with_base_velocity(np.einsum("k,knj->nj", weights, noise))
+                candidates.append(mean)
+                outcomes.extend(pool.rollouts(scene, config, [mean]))
+                result.rollouts += 1
+            i = int(np.argmin([o.cost for o in outcomes]))
+            if outcomes[i].cost < outcome.cost:  # monotone acceptance
+                best, outcome = candidates[i], outcomes[i]
+            result.iterations += 1
+            result.sequence, result.outcome = best, outcome
+            result.success, result.failure_reason = outcome.success, outcome.failure_reason
+            result.costs.append(outcome.cost)
+            last_iteration_s = time.perf_counter() - iteration_started
+            if progress is not None:
+                progress(result.iterations, outcome.cost)
+        if not result.success and result.iterations >= sto.max_iterations and result.failure_reason:
+            result.failure_reason = f"{result.failure_reason} (after {result.iterations} iterations)"
+        result.optimise_s = time.perf_counter() - started
+        return result
+    finally:
+        if own_pool:
+            pool.close()
+
+
+class StochasticTrajectoryOptimiser(LeafSystem):
+    """The STO as a Drake block (see the module's docstring for the ports).
+
+    Args:
+        scene: the scene the trajectories are for.
+        config: the world and ``config.sto`` settings (``WorldConfig()`` by default).
+        pool: rollout workers to use (an in-process one, made on first use, by default).
+
+    Attributes:
+        num_optimisations: how many times the optimisation ran (for checking the cache).
+    """
+
+    def __init__(self, scene: Scene, config: WorldConfig | None = None, *, pool: RolloutPool | None = None) -> None:
+        super().__init__()
+        self._scene = scene
+        self._config = WorldConfig() if config is None else config
+        self._pool = pool
+        self.num_optimisations = 0
+        self._input = self.DeclareAbstractInputPort(
+            name="initial_trajectory", model_value=AbstractValue.Make(PiecewisePolynomial()))
+        ticket = {self.input_port_ticket(self._input.get_index())}
+        self._result = self.DeclareAbstractOutputPort(
+            name="result", alloc=lambda: AbstractValue.Make(_EMPTY_RESULT), calc=self._calc_result,
+            prerequisites_of_calc=ticket)
+        self._trajectory = self.DeclareAbstractOutputPort(
+            name="trajectory", alloc=lambda: AbstractValue.Make(PiecewisePolynomial()),
+            calc=lambda context, output: output.set_value(self._result.Eval(context).sequence.to_trajectory()),
+            prerequisites_of_calc=ticket)
+
+    def get_initial_trajectory_input_port(self):
+        return self._input
+
+    def get_trajectory_output_port(self):
+        return self._trajectory
+
+    def get_result_output_port(self):
+        return self._result
+
+    def _calc_result(self, context, output) -> None:
+        trajectory = self._input.Eval(context)
+        if trajectory.get_number_of_segments() == 0:
+            output.set_value(StoResult(_EMPTY_RESULT.sequence, None, False, "no initial trajectory"))
+            return
+        if self._pool is None:
+            self._pool = RolloutPool(1)
+        self.num_optimisations += 1
+        initial = ControlSequence.from_trajectory(trajectory, self._config.sto.step_duration)
+        output.set_value(optimise(self._scene, initial, self._config, pool=self._pool))
+
+
+_EMPTY_RESULT = StoResult(ControlSequence(np.array([0.0, 1.0]), np.zeros((2, 11))), None, False,
+                          "not optimised")
+
+__all__ = ["StoResult", "StochasticTrajectoryOptimiser", "mppi_weights", "optimise", "sample_base_noise"]

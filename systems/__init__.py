@@ -1,5 +1,6 @@
 """Drake blocks of hlp_drake (imported as ``hlp_drake.systems``) and the model package they load."""
 
+from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.hlp_planner_system import HlpPlannerSystem
 from hlp_drake.systems.keypoint_ik import Keyframes, KeypointIk
 from hlp_drake.systems.model_package import MODELS_PACKAGE, configure_parser, models_directory
@@ -23,6 +24,10 @@ from hlp_drake.systems.scene_models import (
     scene_from_plant,
     set_object_poses,
 )
+from hlp_drake.systems.rollout import RolloutOutcome, RolloutWorld
+from hlp_drake.systems.rollout_pool import RolloutPool
+from hlp_drake.systems.sto import StochasticTrajectoryOptimiser, StoResult, optimise
+from hlp_drake.systems.sto_config import GraspConfig, StoConfig
 from hlp_drake.systems.world import (
     DESIRED_STATE_PORT,
     PlanningModel,
@@ -36,6 +41,15 @@ from hlp_drake.systems.world import (
 from hlp_drake.systems.world_config import WorldConfig, load_world_config
 
 __all__ = [
+    "ControlSequence",
+    "GraspConfig",
+    "RolloutOutcome",
+    "RolloutPool",
+    "RolloutWorld",
+    "StoConfig",
+    "StoResult",
+    "StochasticTrajectoryOptimiser",
+    "optimise",
     "DESIRED_STATE_PORT",
     "HlpPlannerSystem",
     "Keyframes",

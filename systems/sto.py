@@ -191,7 +191,7 @@ class StochasticTrajectoryOptimiser(LeafSystem):
         return self._result
 
     def _calc_result(self, context, output) -> None:
-        trajectory = self._input.Eval(context)
+        trajectory = self._input.Eval(context) if self._input.HasValue(context) else PiecewisePolynomial()
         if trajectory.get_number_of_segments() == 0:
             output.set_value(StoResult(_EMPTY_RESULT.sequence, None, False, "no initial trajectory"))
             return

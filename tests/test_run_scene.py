@@ -49,7 +49,7 @@ def test_planning_diagram_swaps_the_planner_block():
 
 def test_run_scene_end_to_end_json(tmp_path):
     out = tmp_path / "run.json"
-    result = run_module("hlp_drake.run_scene", "--kind", "vr", "--seed", "1", "--json", str(out))
+    result = run_module("hlp_drake.run_scene", "--kind", "vr", "--seed", "1", "--workers", "1", "--json", str(out))
     assert result.returncode in (0, 1), result.stderr
     report = json.loads(out.read_text())
     assert report["planner"] == "hlp" and report["robot_actuated_dofs"] == 10
@@ -88,3 +88,15 @@ def test_run_scene_without_arguments_runs_the_bundled_default(tmp_path):
     report = json.loads(out.read_text())
     assert report["success"] and report["scene"].startswith("default") and report["objects_dropped"] == []
     assert any(k["action"] == "move" for k in report["plan"]["keypoints"])
+    # The optimiser ran (on 2 worker processes by default) and the grasp was tried and held.
+    assert report["rollouts"] >= 1 and report["iterations"] >= 0 and report["timings"]["optimise_s"] > 0
+    assert report["optimisation"]["success"] and report["optimisation"]["final_cost"] <= report["optimisation"]["initial_cost"]
+    assert report["grasp_held"] is True
+    assert "rollouts" in result.stdout and "grasp: held" in result.stdout
+
+
+def test_run_scene_rejects_a_bad_worker_count(tmp_path):
+    out = tmp_path / "run.json"
+    result = run_module("hlp_drake.run_scene", "--workers", "0", "--json", str(out))
+    assert result.returncode == 2 and result.stderr.strip() == "error: --workers must be >= 1, got 0"
+    assert not out.exists()

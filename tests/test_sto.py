@@ -1,0 +1,238 @@
+"""The stochastic trajectory optimiser: control sequences, rollout cost, the optimiser, its block."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from pydrake.trajectories import PiecewisePolynomial
+
+from hlp_drake.scene.io import load_scene
+from hlp_drake.scene.model import SceneObject
+from hlp_drake.systems.control_sequence import ControlSequence
+from hlp_drake.systems.planning import make_planning_diagram
+from hlp_drake.systems.rollout import BLOWN_UP_COST, RolloutSamples, RolloutWorld, rollout_cost
+from hlp_drake.systems.rollout_pool import RolloutPool
+from hlp_drake.systems.sto import StochasticTrajectoryOptimiser, mppi_weights, optimise, sample_base_noise
+from hlp_drake.systems.world import tcp_keypoint_height
+from hlp_drake.systems.world_config import WorldConfig
+from hlp_drake.run_scene import DEFAULT_SCENE
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return load_scene(DEFAULT_SCENE)
+
+
+@pytest.fixture(scope="module")
+def trajectories(scene):
+    """The initial (IK) trajectories of both planners on the default scene."""
+    result = {}
+    for planner in ("hlp", "sto"):
+        diagram = make_planning_diagram(scene, planner=planner)
+        context = diagram.CreateDefaultContext()
+        diagram.GetInputPort("scene").FixValue(context, scene)
+        result[planner] = diagram.GetOutputPort("trajectory").Eval(context)
+    return result
+
+
+@pytest.fixture(scope="module")
+def world(scene):
+    return RolloutWorld(scene, WorldConfig())
+
+
+def short(sequence: ControlSequence, horizon: float) -> ControlSequence:
+    """The first ``horizon`` seconds of ``sequence``, in 4 steps."""
+    trajectory = sequence.to_trajectory()
+    times = np.linspace(0.0, horizon, 5)
+    return ControlSequence(times, np.column_stack([trajectory.value(t) for t in times]).T)
+
+
+# --- Control sequences -----------------------------------------------------------------------------
+
+
+def test_sequence_keeps_every_keyframe_and_bounds_the_step(trajectories):
+    trajectory = trajectories["hlp"]
+    sequence = ControlSequence.from_trajectory(trajectory, 0.5)
+    assert sequence.times[0] == 0.0 and np.all(sequence.steps <= 0.5 + 1e-9)
+    assert sequence.duration == pytest.approx(trajectory.end_time() - trajectory.start_time())
+    for t in trajectory.get_segment_times():  # the keyframes are knots, not cut corners
+        i = int(np.argmin(np.abs(sequence.times - t)))
+        assert sequence.times[i] == pytest.approx(t)
+        np.testing.assert_allclose(sequence.knots[i], trajectory.value(t).ravel(), atol=1e-12)
+    replay = sequence.to_trajectory()
+    for t in np.linspace(0, sequence.duration, 37):
+        np.testing.assert_allclose(replay.value(t), trajectory.value(t), atol=1e-9)
+
+
+def test_base_velocity_is_integrated_and_the_start_stays():
+    sequence = ControlSequence(np.array([0.0, 0.5, 1.5]), np.zeros((3, 11)))
+    velocity = np.array([[0.2, -0.1, 0.05], [0.1, 0.0, 0.0]])
+    moved = sequence.with_base_velocity(velocity)
+    np.testing.assert_allclose(moved.knots[0], 0.0)
+    np.testing.assert_allclose(moved.knots[1, :3], [0.1, -0.05, 0.025])
+    np.testing.assert_allclose(moved.knots[2, :3], [0.2, -0.05, 0.025])
+    np.testing.assert_allclose(moved.knots[:, 3:], 0.0)  # the arm and fingers keep their motion
+    assert moved.effort() == pytest.approx(0.5 * (0.2**2 + 0.1**2 + 0.05**2) + 1.0 * 0.1**2)
+    with pytest.raises(ValueError, match="base velocities"):
+        sequence.with_base_velocity(np.zeros((3, 3)))
+    with pytest.raises(ValueError, match="increase"):
+        ControlSequence(np.array([0.0, 0.0]), np.zeros((2, 11)))
+    with pytest.raises(ValueError, match="finite"):
+        ControlSequence(np.array([0.0, 1.0]), np.full((2, 11), np.nan))
+
+
+def test_noise_is_seeded_and_keeps_only_part_of_its_drift():
+    config = WorldConfig().sto
+    sequence = ControlSequence(np.linspace(0.0, 4.0, 9), np.zeros((9, 11)))
+    a = sample_base_noise(np.random.default_rng(3), sequence, config.noise, 6)
+    b = sample_base_noise(np.random.default_rng(3), sequence, config.noise, 6)
+    np.testing.assert_array_equal(a, b)
+    raw = np.random.default_rng(3).normal(size=(6, 8, 3)) * [config.noise.vx, config.noise.vy, config.noise.yaw_rate]
+    end = np.einsum("knj,n->kj", a, sequence.steps)
+    np.testing.assert_allclose(end, config.noise.end_fraction * np.einsum("knj,n->kj", raw, sequence.steps))
+
+
+def test_mppi_weights_favour_the_cheapest_rollout():
+    weights = mppi_weights(np.array([10.0, 20.0, 110.0]), 10.0)
+    assert weights.sum() == pytest.approx(1.0)
+    assert weights[0] > weights[1] > weights[2]
+    assert weights[2] / weights[0] == pytest.approx(np.exp(-10.0))
+    np.testing.assert_allclose(mppi_weights(np.array([5.0, 5.0]), 10.0), [0.5, 0.5])
+
+
+# --- Cost ------------------------------------------------------------------------------------------
+
+
+def synthetic_samples(scene, *, tcp_end, moved=None, force=0.0, blew_up=None):
+    positions = np.array([[o.x, o.y, scene.table.height + o.size[2] / 2] for o in scene.objects])
+    end = positions.copy()
+    if moved is not None:
+        end[moved[0]] += moved[1]
+    height = tcp_keypoint_height(scene, WorldConfig())
+    return RolloutSamples(np.array([0.0, 0.5]), np.stack([positions, end]),
+                          np.array([[0.0, 0.0, height], [*tcp_end, height]]), np.array([0.0, force]),
+                          np.array([False, False]), blew_up)
+
+
+def test_cost_rewards_reaching_and_charges_falls_forces_and_blow_ups(scene):
+    config = WorldConfig()
+    height = tcp_keypoint_height(scene, config)
+    kwargs = dict(tcp_height=height, effort=0.0, step_duration=0.5)
+    target = (scene.target.x, scene.target.y)
+    reached = rollout_cost(synthetic_samples(scene, tcp_end=target), scene, config.sto, **kwargs)
+    assert reached.success and reached.failure_reason is None and reached.cost < 1.0
+    short_of = rollout_cost(synthetic_samples(scene, tcp_end=(target[0] - 0.2, target[1])), scene, config.sto, **kwargs)
+    assert not short_of.success and "pre-grasp" in short_of.failure_reason
+    assert short_of.terms["goal"] == pytest.approx(config.sto.cost.goal_weight * 0.2)
+    fell = rollout_cost(synthetic_samples(scene, tcp_end=target, moved=(1, [0.0, 5.0, -1.0])), scene, config.sto, **kwargs)
+    assert not fell.success and scene.obstacles[0].name in fell.failure_reason
+    assert fell.terms["off_table"] > 0 and fell.terms["disturbance"] > 0
+    pushed = rollout_cost(synthetic_samples(scene, tcp_end=target, force=100.0), scene, config.sto, **kwargs)
+    assert pushed.terms["force"] == pytest.approx(config.sto.cost.force_weight * 40.0)
+    broken = rollout_cost(synthetic_samples(scene, tcp_end=target, blew_up="x sank"), scene, config.sto, **kwargs)
+    assert broken.cost == BLOWN_UP_COST and not broken.success and "blew up" in broken.failure_reason
+
+
+# --- Rollouts --------------------------------------------------------------------------------------
+
+
+def test_rollouts_are_repeatable_and_the_hlp_initialisation_reaches_the_default_target(world, trajectories):
+    sequence = ControlSequence.from_trajectory(trajectories["hlp"], 0.5)
+    first, second = world.rollout(sequence), world.rollout(sequence)
+    assert first.success, first.failure_reason
+    assert first.cost == second.cost and first.terms == second.terms  # contexts are reset, not rebuilt
+    assert first.simulated_s == pytest.approx(sequence.duration + world.config.sto.settle_s)
+
+
+def test_holding_still_fails_with_the_goal_cost(world, scene):
+    start = world.start_positions
+    outcome = world.rollout(ControlSequence(np.array([0.0, 1.0]), np.vstack([start, start])))
+    assert not outcome.success and "pre-grasp" in outcome.failure_reason
+    assert outcome.terms["goal"] > 100 * outcome.terms["effort"] and outcome.fallen == ()
+
+
+def test_impossible_object_speed_counts_as_a_blow_up(scene, trajectories):
+    config = WorldConfig()
+    config.sto.max_object_speed = 1e-4  # any push now exceeds it
+    outcome = RolloutWorld(scene, config).rollout(ControlSequence.from_trajectory(trajectories["sto"], 0.5))
+    assert not outcome.success and outcome.cost == BLOWN_UP_COST and "over the table" in outcome.failure_reason
+
+
+def test_two_workers_give_the_same_outcomes_as_one(scene, trajectories, world):
+    base = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)
+    config = WorldConfig()
+    noise = sample_base_noise(np.random.default_rng(0), base, config.sto.noise, 3)
+    sequences = [base.with_base_velocity(v) for v in noise]
+    local = [world.rollout(s) for s in sequences]
+    with RolloutPool(2) as pool:
+        assert pool.startup_s > 0
+        remote = pool.rollouts(scene, config, sequences)
+    assert [o.cost for o in remote] == [o.cost for o in local]
+
+
+# --- The optimiser ---------------------------------------------------------------------------------
+
+
+def test_optimiser_is_seeded_monotone_and_stops_at_its_iteration_budget(scene, trajectories):
+    config = WorldConfig()
+    config.sto.max_iterations, config.sto.samples, config.sto.update = 2, 2, "mppi"
+    initial = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)  # too short to reach
+    with RolloutPool(1) as pool:
+        first = optimise(scene, initial, config, pool=pool)
+        second = optimise(scene, initial, config, pool=pool)
+    assert not first.success and "after 2 iterations" in first.failure_reason
+    assert first.iterations == 2 and first.rollouts == 1 + 2 * (2 + 1)  # mppi rolls its mean out too
+    assert all(b <= a for a, b in zip(first.costs, first.costs[1:]))
+    assert first.costs == second.costs
+    np.testing.assert_array_equal(first.sequence.knots, second.sequence.knots)
+
+
+def test_optimiser_respects_its_time_budget(scene, trajectories):
+    config = WorldConfig()
+    config.sto.time_budget_s = 1e-3
+    initial = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)
+    result = optimise(scene, initial, config)
+    assert not result.success and result.iterations == 0 and result.rollouts == 1
+    assert "time budget" in result.failure_reason
+
+
+def test_a_start_in_collision_fails_without_rollouts(scene, trajectories):
+    blocker = SceneObject(name="Blocker", shape="box", x=float(scene.start[0]) + 0.03, y=float(scene.start[1]),
+                          size=(0.04, 0.16, 0.12))  # wider than the open fingers
+    blocked = dataclasses.replace(scene, obstacles=(*scene.obstacles, blocker))
+    initial = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)
+    config = WorldConfig()
+    config.sto.max_iterations = 1
+    result = optimise(blocked, initial, config)
+    assert not result.success and result.rollouts == 0
+    assert result.failure_reason == "the robot starts in collision with Blocker"
+
+
+def test_optimiser_block_ports_and_cache(scene, trajectories):
+    config = WorldConfig()
+    config.sto.max_iterations = 1
+    block = StochasticTrajectoryOptimiser(scene, config)
+    context = block.CreateDefaultContext()
+    empty = block.get_result_output_port().Eval(context)
+    assert not empty.success and empty.failure_reason == "no initial trajectory"
+    block.get_input_port(0).FixValue(context, trajectories["hlp"])
+    result = block.GetOutputPort("result").Eval(context)
+    trajectory = block.GetOutputPort("trajectory").Eval(context)
+    block.GetOutputPort("result").Eval(context)
+    assert block.num_optimisations == 1
+    assert result.success and result.iterations == 0  # the HLP initialisation already succeeds here
+    assert isinstance(trajectory, PiecewisePolynomial)
+    assert trajectory.end_time() == pytest.approx(trajectories["hlp"].end_time())
+
+
+def test_an_unreachable_target_fails_with_a_reason_and_no_rollouts(scene):
+    from hlp_drake.systems.execution import plan_and_execute
+
+    far = dataclasses.replace(scene.target, x=scene.table.length + 1.5)
+    config = WorldConfig()
+    config.sto.workers = 1
+    result = plan_and_execute(dataclasses.replace(scene, target=far), planner="sto", config=config)
+    assert not result.success and result.failure_reason.startswith("IK failed") and "Target" in result.failure_reason
+    assert result.rollouts == 0 and result.grasp_held is None

@@ -256,6 +256,9 @@ def _keep_clear(point: tuple[float, float], radius: float) -> Polygon:
 
 
 def _inset(rng: np.random.Generator, low: float, high: float, margin: float) -> float:
+    """Uniform in [low, high] kept ``margin`` from both ends, plus two rounding units: rounding the
+    position and the size to ``DECIMALS`` afterwards can then never push the object over an edge."""
+    margin += 2 * 10.0**-DECIMALS
     return float(rng.uniform(low + margin, high - margin))
 
 

@@ -1,0 +1,236 @@
+"""Run a whole experiment into a directory, resumably: jobs -> ``results.csv`` -> summary and plots.
+
+The directory holds ``config.json`` (what the rows depend on: kind, first seed, world config),
+``results.csv`` (rewritten atomically after every finished job), ``run.json`` (the run's settings,
+machine and software), ``summary.md``/``summary.json`` and ``success.png``/``times.png``.
+Scene i of a run has seed ``seed + i``. Rows already in ``results.csv`` are kept and not run again;
+a job interrupted mid-way is simply run again next time.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from contextlib import closing
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from tqdm import tqdm
+
+from hlp_drake.atomic import write_text_atomic
+from hlp_drake.errors import HlpError
+from hlp_drake.experiments.executors import EXECUTORS, check_executor, run_jobs
+from hlp_drake.experiments.metadata import git_commit, machine_info, software_versions, utc_now
+from hlp_drake.experiments.plots import write_plots
+from hlp_drake.experiments.results import ResultsFile, read_results, row_key
+from hlp_drake.experiments.runner import KINDS, Job, JobFunction, make_jobs, run_job
+from hlp_drake.experiments.summary import summarise, write_summary
+
+RESULTS, CONFIG, RUN = "results.csv", "config.json", "run.json"
+DERIVED = ("summary.md", "summary.json", "success.png", "times.png")
+IDENTITY_LABELS = {"kind": "kind", "seed": "seed", "world_config": "world config"}
+START_OVER = "use --fresh to start over or choose another --out"
+
+
+@dataclass(frozen=True)
+class ExperimentSettings:
+    """What to run and how.
+
+    Attributes:
+        kind: "gen1" (Table II) or "gen2" (Table III).
+        scenes: scenes per condition; scene i has seed ``seed + i``.
+        objects: gen2's object counts (one condition each); ignored by gen1.
+        workers: jobs at a time (None: one per core); with more than one, or on dask, every job's
+            optimiser rolls out in its own process (``sto.workers = 1``: no nested pools).
+        executor: "local" (this process, or a spawn process pool) or "dask".
+        scheduler: the dask scheduler's address (None: start a ``LocalCluster`` of ``workers``).
+        config_yaml: the world config as YAML text (None: ``WorldConfig()``'s defaults).
+        fresh: start over, discarding the directory's earlier results.
+    """
+
+    kind: str
+    scenes: int = 100
+    objects: tuple[int, ...] = (5, 7, 9)
+    seed: int = 0
+    workers: int | None = None
+    executor: str = "local"
+    scheduler: str | None = None
+    config_yaml: str | None = None
+    fresh: bool = False
+    progress: bool = True
+
+    @property
+    def worker_count(self) -> int:
+        return self.workers or os.cpu_count() or 1
+
+    @property
+    def parallel(self) -> bool:
+        """Whether jobs run in worker processes side by side (then without nested rollout pools)."""
+        return self.executor == "dask" or self.worker_count > 1
+
+    def problems(self) -> list[str]:
+        """The reasons these settings cannot run (empty when they can)."""
+        problems = []
+        if self.kind not in KINDS:
+            problems.append(f"unknown experiment {self.kind!r} (expected one of {', '.join(KINDS)})")
+        if self.scenes < 1:
+            problems.append(f"--scenes must be at least 1, got {self.scenes}")
+        if not self.objects or min(self.objects) < 1:
+            given = " ".join(map(str, self.objects)) or "none"
+            problems.append(f"--objects must be at least 1 each, got {given}")
+        if self.workers is not None and self.workers < 1:
+            problems.append(f"--workers must be at least 1, got {self.workers}")
+        if self.executor not in EXECUTORS:
+            problems.append(f"unknown executor {self.executor!r} (expected one of {', '.join(EXECUTORS)})")
+        if self.scheduler is not None and self.executor != "dask":
+            problems.append("--scheduler needs --executor dask")
+        return problems
+
+
+def world_config_yaml(text: str | None, *, single_process_rollouts: bool = False) -> str:
+    """``text`` (None: the defaults) validated and written out in full; optionally ``sto.workers = 1``."""
+    from hlp_drake.systems.world_config import dump_world_config, load_world_config
+
+    config = load_world_config(overrides=text)
+    if single_process_rollouts:
+        config.sto.workers = 1
+    return dump_world_config(config)
+
+
+def _check_directory(out: Path, identity: dict[str, Any], fresh: bool) -> None:
+    """Refuse a directory that is not one, or that holds another run's results (unless ``fresh``)."""
+    if out.exists() and not out.is_dir():
+        raise HlpError(f"--out {out} is not a directory")
+    if fresh:
+        return
+    config = out / CONFIG
+    if config.exists():
+        try:
+            earlier = json.loads(config.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            raise HlpError(f"{config} is unreadable; {START_OVER}") from None
+        if not isinstance(earlier, dict):
+            earlier = {}
+        differs = [label for key, label in IDENTITY_LABELS.items() if earlier.get(key) != identity[key]]
+        if differs:
+            raise HlpError(f"{out} holds a run with a different {', '.join(differs)} "
+                           f"({earlier.get('kind')} from seed {earlier.get('seed')}); "
+                           f"{START_OVER}")
+    elif (out / RESULTS).exists():
+        raise HlpError(f"{out / RESULTS} exists without {CONFIG}; {START_OVER}")
+
+
+def _earlier_runs(out: Path, fresh: bool) -> list[dict[str, Any]]:
+    """The records of the directory's earlier runs (from its ``run.json``), oldest first."""
+    if fresh:
+        return []
+    try:
+        previous = json.loads((out / RUN).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return []
+    if not isinstance(previous, dict):
+        return []
+    return [*previous.pop("earlier_runs", []), previous]
+
+
+def _measured_on(machine: dict[str, Any], settings: ExperimentSettings) -> str:
+    where = settings.scheduler and f"the dask cluster at {settings.scheduler}"
+    where = where or f"{machine['cpu_model'] or machine['machine']}, {machine['cpu_count']} cores"
+    jobs = settings.worker_count
+    at_once = f"{jobs} job{'s' if jobs > 1 else ''} at a time ({settings.executor} executor)"
+    shared = "; parallel jobs share the cores, so their times are pessimistic" if settings.parallel else ""
+    return f"{where}, {at_once}{shared}"
+
+
+def _run_record(settings: ExperimentSettings, command: str | None, config_yaml: str, jobs: list[Job],
+                pending: list[Job], earlier: list[dict[str, Any]]) -> dict[str, Any]:
+    return {
+        "command": command, "status": "running", "kind": settings.kind,
+        "seeds": {"first": settings.seed, "last": settings.seed + settings.scenes - 1,
+                  "scenes": settings.scenes},
+        "objects": sorted({job.objects for job in jobs}), "workers": settings.worker_count,
+        "executor": settings.executor, "scheduler": settings.scheduler,
+        "jobs": {"total": len(jobs), "kept": len(jobs) - len(pending), "to_run": len(pending)},
+        "machine": machine_info(), "software": software_versions(), "git_commit": git_commit(),
+        "world_config": config_yaml, "start_time": utc_now(), "end_time": None, "wall_s": None,
+        "earlier_runs": earlier,
+    }
+
+
+def _prepare(out: Path, identity: dict[str, Any], fresh: bool) -> None:
+    """Create the directory and record its identity; ``fresh`` removes the earlier run's outputs."""
+    out.mkdir(parents=True, exist_ok=True)
+    if fresh:
+        for name in (RESULTS, *DERIVED):
+            (out / name).unlink(missing_ok=True)
+    write_text_atomic(out / CONFIG, json.dumps(identity, indent=2) + "\n")
+
+
+def _run_pending(job: JobFunction, pending: list[Job], results: ResultsFile, settings: ExperimentSettings,
+                 total: int) -> None:
+    """Run ``pending`` on the settings' executor, saving each row as it finishes, with a progress bar."""
+    bar = tqdm(total=total, initial=total - len(pending), unit="job", dynamic_ncols=True,
+               desc=f"{settings.kind} ({settings.worker_count} at a time)", disable=not settings.progress)
+    finished = run_jobs(job, pending, executor=settings.executor, workers=settings.worker_count,
+                        scheduler=settings.scheduler)
+    with bar, closing(finished):
+        for done, row in finished:
+            if row_key(row) != done.key:
+                raise ValueError(f"the job for {done.key} returned the row of {row_key(row)}")
+            results.add(row)
+            bar.set_postfix_str(f"{done.scene} {done.planner}: {'success' if row['success'] else 'failure'}",
+                                refresh=False)
+            bar.update()
+
+
+def run_experiment(settings: ExperimentSettings, out: str | os.PathLike[str], *, job: JobFunction = run_job,
+                   command: str | None = None) -> dict[str, Any]:
+    """Run every job of ``settings`` not yet in ``out/results.csv``; write the summary and plots.
+
+    Every check (settings, world config, scene generation, the directory's earlier run) happens
+    before anything is written. ``job`` must be a picklable module-level function for the process
+    pool and dask executors.
+
+    Returns:
+        The summary (as written to ``summary.json``).
+
+    Raises:
+        HlpError: bad settings or directory (one line each); KeyboardInterrupt passes through, with
+            every finished row saved.
+    """
+    problems = settings.problems()
+    if problems:
+        raise HlpError(*problems)
+    check_executor(settings.executor, settings.scheduler)
+    out = Path(out)
+    config_yaml = world_config_yaml(settings.config_yaml)
+    jobs = make_jobs(settings.kind, range(settings.seed, settings.seed + settings.scenes), settings.objects,
+                     world_config_yaml(config_yaml, single_process_rollouts=settings.parallel))
+    identity = {"kind": settings.kind, "seed": settings.seed, "world_config": config_yaml}
+    _check_directory(out, identity, settings.fresh)
+    results = ResultsFile(out / RESULTS, [] if settings.fresh else read_results(out / RESULTS))
+    earlier = _earlier_runs(out, settings.fresh)
+
+    started = time.perf_counter()
+    _prepare(out, identity, settings.fresh)
+    results.save()
+    pending = [j for j in jobs if j.key not in results]
+    record = _run_record(settings, command, config_yaml, jobs, pending, earlier)
+    write_text_atomic(out / RUN, json.dumps(record, indent=2) + "\n")
+    try:
+        _run_pending(job, pending, results, settings, len(jobs))
+        record["status"] = "complete"
+    except BaseException as error:
+        interrupted = isinstance(error, KeyboardInterrupt)
+        record["status"] = "interrupted" if interrupted else f"failed: {type(error).__name__}"
+        raise
+    finally:
+        record.update(end_time=utc_now(), wall_s=round(time.perf_counter() - started, 3),
+                      jobs={**record["jobs"], "rows": len(results.rows)})
+        write_text_atomic(out / RUN, json.dumps(record, indent=2) + "\n")
+    summary = summarise(settings.kind, results.rows.values(), _measured_on(record["machine"], settings))
+    write_summary(out, summary)
+    write_plots(out, summary)
+    return summary

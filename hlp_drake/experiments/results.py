@@ -1,0 +1,137 @@
+"""``results.csv``: one row per (scene, planner), read back for resuming, rewritten atomically.
+
+Columns (in this order): the paper's ``scene, objects, planner, success, failure_reason, init_s,
+optimise_s, total_s, rollouts, objects_moved, objects_dropped``, then ``seed, iterations, execute_s``.
+Times are seconds; ``init_s`` = plan + IK, ``total_s`` = init + optimise (planning time: the simulated
+execution, ``execute_s``, is excluded); ``objects_moved`` and ``objects_dropped`` are counts.
+Booleans are ``true``/``false``; a missing failure reason is an empty field.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import os
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Any
+
+from hlp_drake.atomic import atomic_path
+from hlp_drake.errors import HlpError
+from hlp_drake.experiments.runner import Row
+
+COLUMNS = ("scene", "objects", "planner", "success", "failure_reason", "init_s", "optimise_s", "total_s",
+           "rollouts", "objects_moved", "objects_dropped", "seed", "iterations", "execute_s")
+INT_COLUMNS = frozenset({"objects", "rollouts", "objects_moved", "objects_dropped", "seed", "iterations"})
+FLOAT_COLUMNS = frozenset({"init_s", "optimise_s", "total_s", "execute_s"})
+BOOLEANS = {"true": True, "false": False}
+
+
+def row_key(row: Row) -> tuple[str, str]:
+    """A row's identity: (scene, planner)."""
+    return row["scene"], row["planner"]
+
+
+def sort_key(row: Row) -> tuple[int, int, str]:
+    """The file's order: object count, scene seed, planner."""
+    return row["objects"], row["seed"], row["planner"]
+
+
+def _format(column: str, value: Any) -> str:
+    if column == "success":
+        return "true" if value else "false"
+    if column in FLOAT_COLUMNS:
+        return f"{float(value):.6f}"
+    return "" if value is None else str(value)
+
+
+def _parse(column: str, text: str) -> Any:
+    if column == "success":
+        return BOOLEANS[text]  # KeyError: not a boolean
+    if column in INT_COLUMNS:
+        return int(text)
+    if column in FLOAT_COLUMNS:
+        return float(text)
+    if column == "failure_reason":
+        return text or None
+    return text
+
+
+def results_csv(rows: Iterable[Row]) -> str:
+    """``rows`` as CSV text with the header, sorted by ``sort_key``."""
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(COLUMNS)
+    for row in sorted(rows, key=sort_key):
+        writer.writerow([_format(column, row[column]) for column in COLUMNS])
+    return out.getvalue()
+
+
+def read_results(path: Path) -> list[Row]:
+    """The rows of ``path`` (none when it does not exist).
+
+    Raises:
+        HlpError: the file has other columns or a malformed row (one line, naming the file and line).
+    """
+    if not path.exists():
+        return []
+    with path.open(newline="", encoding="utf-8") as file:
+        reader = csv.reader(file)
+        header = tuple(next(reader, ()))
+        if header != COLUMNS:
+            raise HlpError(f"{path}: not an experiment results file (unexpected columns); "
+                           "use --fresh to start over")
+        rows = []
+        for record in reader:
+            try:
+                if len(record) != len(COLUMNS):
+                    raise ValueError(f"{len(record)} fields")
+                rows.append({column: _parse(column, text) for column, text in zip(COLUMNS, record)})
+            except (KeyError, ValueError) as error:
+                raise HlpError(f"{path}: line {reader.line_num}: malformed row ({error}); "
+                               "use --fresh to start over") from None
+    return rows
+
+
+def write_durable(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` atomically and durably: temp file beside it, fsync, ``os.replace``."""
+    with atomic_path(path) as tmp, tmp.open("w", encoding="utf-8", newline="") as file:
+        file.write(text)
+        file.flush()
+        os.fsync(file.fileno())
+    _fsync_directory(path.parent)
+
+
+def _fsync_directory(directory: Path) -> None:
+    """Make a rename in ``directory`` durable (where the platform allows opening a directory)."""
+    try:
+        fd = os.open(directory, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+class ResultsFile:
+    """The rows of ``results.csv`` by (scene, planner); every ``add`` rewrites the file atomically."""
+
+    def __init__(self, path: Path, rows: Iterable[Row] = ()) -> None:
+        self.path = path
+        self.rows: dict[tuple[str, str], Row] = {row_key(row): row for row in rows}
+
+    def __contains__(self, key: tuple[str, str]) -> bool:
+        return key in self.rows
+
+    def add(self, row: Row) -> None:
+        missing = [column for column in COLUMNS if column not in row]
+        if missing:
+            raise ValueError(f"a job returned a row without {', '.join(missing)}")
+        self.rows[row_key(row)] = {column: row[column] for column in COLUMNS}
+        self.save()
+
+    def save(self) -> None:
+        write_durable(self.path, results_csv(self.rows.values()))

@@ -1,0 +1,336 @@
+"""``python -m hlp_drake.experiments``: results.csv, resume after an interrupt, executors, summary, plots.
+
+All but one test run a cheap deterministic job (``cheap_job``: a pure function of its ``Job``) instead
+of the Drake planners; ``test_cli_end_to_end_with_the_real_planners`` runs the real ones on one scene.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import multiprocessing
+import os
+import random
+import signal
+import threading
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from conftest import run_module
+
+from hlp_drake.cli import run_cli
+from hlp_drake.errors import HlpError
+from hlp_drake.experiments import ExperimentSettings, Job, make_row, run_experiment
+from hlp_drake.experiments.cli import main
+from hlp_drake.experiments.results import COLUMNS, read_results, results_csv, write_durable
+from hlp_drake.experiments.summary import summarise
+
+REQUIRED_COLUMNS = ["scene", "objects", "planner", "success", "failure_reason", "init_s", "optimise_s",
+                    "total_s", "rollouts", "objects_moved", "objects_dropped"]
+OUTPUTS = ("results.csv", "config.json", "run.json", "summary.md", "summary.json", "success.png", "times.png")
+
+
+def cheap_job(job: Job) -> dict:
+    """A deterministic stand-in for plan_and_execute: outcome and times drawn from (scene, planner)."""
+    rng = random.Random(f"{job.scene}/{job.planner}")
+    scene = job.make_scene()
+    success = rng.random() < (0.9 if job.planner == "hlp" else 0.7)
+    return make_row(job, success=success, failure_reason=None if success else "the target is out of reach",
+                    plan_s=rng.uniform(0.01, 0.1), ik_s=rng.uniform(0.1, 0.5),
+                    optimise_s=rng.uniform(0.5, 2.0) * (1 if job.planner == "hlp" else 10),
+                    execute_s=rng.uniform(2, 4), rollouts=rng.randint(8, 80), iterations=rng.randint(1, 10),
+                    objects_moved=rng.randint(0, len(scene.obstacles)), objects_dropped=int(not success))
+
+
+class RecordingJob:
+    """``cheap_job`` that remembers which jobs it ran (in-process runs only: ``workers=1``)."""
+
+    def __init__(self) -> None:
+        self.ran: list[tuple[str, str]] = []
+
+    def __call__(self, job: Job) -> dict:
+        self.ran.append(job.key)
+        return cheap_job(job)
+
+
+class InterruptingJob(RecordingJob):
+    """Raises KeyboardInterrupt on its ``n``-th call, as Ctrl-C during that job would."""
+
+    def __init__(self, n: int) -> None:
+        super().__init__()
+        self.n = n
+
+    def __call__(self, job: Job) -> dict:
+        if len(self.ran) + 1 == self.n:
+            raise KeyboardInterrupt
+        return super().__call__(job)
+
+
+def interrupt_on_gen1_11_hlp(job: Job) -> dict:
+    """Picklable for the process pool: Ctrl-C during scene gen1-11's HLP job."""
+    if job.key == ("gen1-11", "hlp"):
+        raise KeyboardInterrupt
+    return cheap_job(job)
+
+
+def never_called(job: Job) -> dict:
+    raise AssertionError(f"{job.key} was run again")
+
+
+def settings(kind: str = "gen1", **changes) -> ExperimentSettings:
+    defaults = {"scenes": 3, "seed": 10, "workers": 1, "progress": False}
+    return ExperimentSettings(kind=kind, **{**defaults, **changes})
+
+
+def read_rows(path: Path) -> list[dict[str, str]]:
+    with path.open(newline="") as file:
+        return list(csv.DictReader(file))
+
+
+def assert_well_formed(path: Path) -> list[dict[str, str]]:
+    """The CSV has exactly the columns and every row has every field; no temp file beside it."""
+    with path.open(newline="") as file:
+        records = list(csv.reader(file))
+    assert tuple(records[0]) == COLUMNS
+    assert all(len(record) == len(COLUMNS) for record in records[1:])
+    assert not list(path.parent.glob(".*.tmp"))
+    return read_rows(path)
+
+
+def test_csv_has_the_columns_one_row_per_scene_and_planner_sorted(tmp_path):
+    summary = run_experiment(settings("gen2", scenes=2, objects=(4, 3)), tmp_path, job=cheap_job)
+    rows = assert_well_formed(tmp_path / "results.csv")
+    assert list(rows[0])[:len(REQUIRED_COLUMNS)] == REQUIRED_COLUMNS and list(rows[0])[-1] == "execute_s"
+    assert [(r["scene"], r["objects"], r["seed"], r["planner"]) for r in rows] == [
+        (f"gen2-{n}-{seed}", str(n), str(seed), planner)
+        for n in (3, 4) for seed in (10, 11) for planner in ("hlp", "sto")]
+    for row in rows:
+        assert row["success"] in ("true", "false")
+        assert (row["failure_reason"] == "") == (row["success"] == "true")
+        init, optimise = float(row["init_s"]), float(row["optimise_s"])
+        assert float(row["total_s"]) == pytest.approx(init + optimise, abs=2e-6)
+        assert int(row["objects_moved"]) <= int(row["objects"])
+    assert [c["objects"] for c in summary["conditions"]] == [3, 4]
+    assert all(name in {p.name for p in tmp_path.iterdir()} for name in OUTPUTS)
+
+
+def test_gen1_ignores_objects_and_reports_the_scene_count(tmp_path):
+    run_experiment(settings(objects=(3,)), tmp_path, job=cheap_job)
+    rows = read_rows(tmp_path / "results.csv")
+    assert {r["objects"] for r in rows} == {"6"}
+    assert [r["scene"] for r in rows[::2]] == ["gen1-10", "gen1-11", "gen1-12"]
+
+
+def test_interrupt_keeps_exactly_the_finished_rows_and_resume_runs_only_the_rest(tmp_path):
+    reference = tmp_path / "reference"
+    run_experiment(settings(), reference, job=cheap_job)
+    out = tmp_path / "run"
+    interrupting = InterruptingJob(5)
+    with pytest.raises(KeyboardInterrupt):
+        run_experiment(settings(), out, job=interrupting)
+    rows = assert_well_formed(out / "results.csv")
+    assert [(r["scene"], r["planner"]) for r in rows] == interrupting.ran and len(rows) == 4
+    run = json.loads((out / "run.json").read_text())
+    assert run["status"] == "interrupted" and run["jobs"]["rows"] == 4 and run["end_time"]
+    assert not (out / "summary.json").exists()
+
+    resumed = RecordingJob()
+    run_experiment(settings(), out, job=resumed)
+    assert resumed.ran == [("gen1-12", "hlp"), ("gen1-12", "sto")]
+    assert (out / "results.csv").read_text() == (reference / "results.csv").read_text()
+    run = json.loads((out / "run.json").read_text())
+    assert run["status"] == "complete" and run["jobs"]["kept"] == 4 and len(run["earlier_runs"]) == 1
+
+
+def test_interrupt_in_a_process_pool_then_resume(tmp_path):
+    reference = tmp_path / "reference"
+    run_experiment(settings(), reference, job=cheap_job)
+    out = tmp_path / "run"
+    with pytest.raises(KeyboardInterrupt):
+        run_experiment(settings(workers=2), out, job=interrupt_on_gen1_11_hlp)
+    rows = assert_well_formed(out / "results.csv")
+    assert ("gen1-11", "hlp") not in {(r["scene"], r["planner"]) for r in rows} and len(rows) < 6
+    run_experiment(settings(workers=2), out, job=cheap_job)
+    assert (out / "results.csv").read_text() == (reference / "results.csv").read_text()
+
+
+def test_all_rows_done_writes_the_summary_without_running_jobs(tmp_path):
+    run_experiment(settings(), tmp_path, job=cheap_job)
+    for name in ("summary.md", "summary.json", "success.png", "times.png"):
+        (tmp_path / name).unlink()
+    run_experiment(settings(), tmp_path, job=never_called)
+    assert all((tmp_path / name).exists() for name in OUTPUTS)
+
+
+def test_local_pool_gives_the_same_results_as_in_process(tmp_path):
+    run_experiment(settings("gen2", scenes=2, objects=(3,)), tmp_path / "one", job=cheap_job)
+    run_experiment(settings("gen2", scenes=2, objects=(3,), workers=2), tmp_path / "two", job=cheap_job)
+    for name in ("results.csv", "summary.json"):
+        one, two = ((tmp_path / d / name).read_text() for d in ("one", "two"))
+        if name == "results.csv":
+            assert one == two
+        else:
+            assert json.loads(one)["conditions"] == json.loads(two)["conditions"]
+
+
+def test_dask_gives_the_same_results_as_local(tmp_path):
+    distributed = pytest.importorskip(
+        "distributed", reason='dask.distributed is not installed: pip install "hlp_drake[cluster]"')
+    run_experiment(settings(scenes=2), tmp_path / "local", job=cheap_job)
+    run_experiment(settings(scenes=2, workers=2, executor="dask"), tmp_path / "dask", job=cheap_job)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, dashboard_address=None) as cluster:
+        on_cluster = settings(scenes=2, executor="dask", scheduler=cluster.scheduler_address)
+        run_experiment(on_cluster, tmp_path / "scheduler", job=cheap_job)
+    expected = (tmp_path / "local" / "results.csv").read_text()
+    for run in ("dask", "scheduler"):
+        assert (tmp_path / run / "results.csv").read_text() == expected
+        assert json.loads((tmp_path / run / "run.json").read_text())["executor"] == "dask"
+
+
+def test_a_different_run_in_the_directory_is_refused_unless_fresh(tmp_path, capsys):
+    run_experiment(settings(), tmp_path, job=cheap_job)
+    before = {name: (tmp_path / name).read_bytes() for name in OUTPUTS}
+    argv = ["gen1", "--scenes", "2", "--seed", "20", "--workers", "1", "--quiet", "--out", str(tmp_path)]
+    assert run_cli(lambda a: main(a, job=cheap_job), argv) == 2
+    message = capsys.readouterr().err.strip()
+    assert message.count("\n") == 0 and "different seed" in message and "--fresh" in message
+    assert {name: (tmp_path / name).read_bytes() for name in OUTPUTS} == before
+    assert run_cli(lambda a: main(a, job=cheap_job), [*argv, "--fresh"]) == 0
+    assert [r["scene"] for r in read_rows(tmp_path / "results.csv")] == ["gen1-20"] * 2 + ["gen1-21"] * 2
+    with pytest.raises(HlpError, match="world config"):
+        run_experiment(settings(seed=20, config_yaml="motion: {tcp_speed: 0.05}"), tmp_path, job=cheap_job)
+
+
+@pytest.mark.parametrize("argv", [
+    ["gen1", "--scenes", "0"],
+    ["gen2", "--objects", "5", "0"],
+    ["gen3"],
+    ["gen1", "--workers", "0"],
+    ["gen1", "--scenes", "many"],
+    ["gen1", "--scheduler", "tcp://127.0.0.1:8786"],
+])
+def test_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, capsys, argv):
+    out = tmp_path / "out"
+    assert run_cli(lambda a: main(a, job=never_called), [*argv, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and err.count("\n") == 1 and not out.exists()
+
+
+def test_dask_not_installed_says_how_to_install_it(tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(__import__("sys").modules, "distributed", None)  # makes "import distributed" fail
+    out = tmp_path / "out"
+    argv = ["gen1", "--executor", "dask", "--out", str(out)]
+    assert run_cli(lambda a: main(a, job=never_called), argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and 'pip install "hlp_drake[cluster]"' in err and not out.exists()
+
+
+def test_summary_matches_the_csv_and_shows_the_paper_numbers(tmp_path):
+    run_experiment(settings("gen2", scenes=4, objects=(5, 9)), tmp_path, job=cheap_job)
+    frame = pd.read_csv(tmp_path / "results.csv")
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["table"].startswith("Table III")
+    for condition in summary["conditions"]:
+        for planner, stats in condition["planners"].items():
+            group = frame[(frame.objects == condition["objects"]) & (frame.planner == planner)]
+            assert stats["n"] == len(group) == 4
+            assert stats["success_pct"] == pytest.approx(100 * group.success.mean())
+            assert stats["total_s"] == pytest.approx(group.total_s.mean(), abs=1e-4)
+            assert stats["init_s"] + stats["optimise_s"] == pytest.approx(stats["total_s"], abs=2e-4)
+            assert stats["paper"]["total_s"] is None
+        means = {p: frame[(frame.objects == condition["objects"]) & (frame.planner == p)].total_s.mean()
+                 for p in ("hlp", "sto")}
+        assert condition["hlp_to_sto_total"] == pytest.approx(means["hlp"] / means["sto"], rel=1e-3)
+    papers = {c["objects"]: tuple(c["planners"][p]["paper"]["success_pct"] for p in ("hlp", "sto"))
+              for c in summary["conditions"]}
+    assert papers == {5: (93.0, 96.0), 9: (95.0, 98.0)}
+    markdown = (tmp_path / "summary.md").read_text()
+    assert "| 5 objects | HLP | 4 |" in markdown and "(93)" in markdown and "n/a" in markdown
+    for name in ("success.png", "times.png"):
+        data = (tmp_path / name).read_bytes()
+        assert data.startswith(b"\x89PNG\r\n\x1a\n") and len(data) > 10_000
+
+
+def test_gen1_summary_has_table_ii_paper_figures():
+    rows = [{"scene": f"gen1-{i}", "objects": 6, "planner": p, "success": i != 0, "failure_reason": None,
+             "init_s": 0.5, "optimise_s": 1.0 if p == "hlp" else 10.0, "total_s": 1.5 if p == "hlp" else 10.5,
+             "execute_s": 3.0} for i in range(4) for p in ("hlp", "sto")]
+    rows.append({**rows[0], "scene": "gen1-4", "success": False, "failure_reason": "crashed: RuntimeError: x",
+                 "init_s": float("nan"), "optimise_s": float("nan"), "total_s": float("nan")})
+    (condition,) = summarise("gen1", rows)["conditions"]
+    hlp, sto = condition["planners"]["hlp"], condition["planners"]["sto"]
+    assert hlp["paper"] == {"success_pct": 94.0, "init_s": 0.59, "optimise_s": 0.97, "total_s": 1.56}
+    assert sto["paper"] == {"success_pct": 84.0, "init_s": 0.04, "optimise_s": 17.84, "total_s": 17.88}
+    assert (hlp["n"], hlp["success_pct"], hlp["crashed"], hlp["total_s"]) == (5, 60.0, 1, 1.5)
+    assert condition["hlp_to_sto_total"] == pytest.approx(1.5 / 10.5, abs=1e-4)
+    assert condition["paper_hlp_to_sto_total"] == pytest.approx(1.56 / 17.88, abs=1e-4)
+    assert hlp["success_ci95"][0] < 60.0 < hlp["success_ci95"][1]
+
+
+def test_durable_write_leaves_the_old_file_when_it_fails(tmp_path, monkeypatch):
+    path = tmp_path / "results.csv"
+    write_durable(path, results_csv([]))
+    monkeypatch.setattr("os.fsync", lambda fd: (_ for _ in ()).throw(OSError("disk full")))
+    with pytest.raises(OSError, match="disk full"):
+        write_durable(path, "scene\npartial")
+    assert path.read_text() == ",".join(COLUMNS) + "\n" and not list(tmp_path.glob(".*.tmp"))
+
+
+def test_cli_fast_public_api(tmp_path, capsys):
+    argv = ["gen2", "--scenes", "2", "--objects", "3", "--seed", "5", "--workers", "1", "--quiet",
+            "--out", str(tmp_path)]
+    assert run_cli(lambda a: main(a, job=cheap_job), argv) == 0
+    printed = capsys.readouterr().out
+    assert "Table III" in printed and "| 3 objects | HLP | 2 |" in printed and "summary.md" in printed
+    run = json.loads((tmp_path / "run.json").read_text())
+    assert run["command"].startswith("python -m hlp_drake.experiments gen2 --scenes 2")
+    assert run["seeds"] == {"first": 5, "last": 6, "scenes": 2} and run["status"] == "complete"
+    assert run["software"]["drake"] and run["software"]["numpy"] and run["machine"]["cpu_count"]
+    assert "sto:" in run["world_config"]
+
+
+def test_cli_end_to_end_with_the_real_planners(tmp_path):
+    config = tmp_path / "world.yaml"  # a small optimiser budget keeps the test's time bounded
+    config.write_text("sto:\n  max_iterations: 2\n  samples: 2\n  time_budget_s: 10.0\n  workers: 1\n")
+    out = tmp_path / "out"
+    result = run_module("hlp_drake.experiments", "gen1", "--scenes", "1", "--workers", "1", "--quiet",
+                        "--config", str(config), "--out", str(out))
+    assert result.returncode == 0, result.stderr
+    rows = assert_well_formed(out / "results.csv")
+    assert [(r["scene"], r["planner"]) for r in rows] == [("gen1-0", "hlp"), ("gen1-0", "sto")]
+    for row in rows:
+        assert not row["failure_reason"].startswith("crashed"), row["failure_reason"]
+        assert float(row["init_s"]) > 0 and float(row["execute_s"]) > 0 and int(row["objects"]) == 6
+        assert int(row["iterations"]) <= 2
+    assert "max_iterations: 2" in json.loads((out / "run.json").read_text())["world_config"]
+    assert "Table II" in result.stdout and (out / "times.png").exists()
+
+
+def sleepy_job(job: Job) -> dict:
+    """A job far longer than the test: Ctrl-C must not wait for it."""
+    time.sleep(40)
+    return cheap_job(job)
+
+
+def test_interrupt_stops_a_process_pool_without_waiting_for_running_jobs(tmp_path):
+    timer = threading.Timer(4.0, os.kill, (os.getpid(), signal.SIGINT))  # Ctrl-C while both workers sleep
+    started = time.perf_counter()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            run_experiment(settings(workers=2), tmp_path, job=sleepy_job)
+    finally:
+        timer.cancel()
+    assert time.perf_counter() - started < 20
+    assert not multiprocessing.active_children()
+    assert read_rows(tmp_path / "results.csv") == []
+
+
+def test_rows_finishing_in_any_order_are_written_sorted(tmp_path):
+    run_experiment(settings("gen2", scenes=3, objects=(2, 3)), tmp_path, job=cheap_job)
+    text = (tmp_path / "results.csv").read_text()
+    rows = read_results(tmp_path / "results.csv")
+    random.Random(0).shuffle(rows)
+    assert results_csv(rows) == text and results_csv(reversed(rows)) == text

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 import yaml
 
 from conftest import run_module
@@ -100,3 +101,40 @@ def test_run_scene_rejects_a_bad_worker_count(tmp_path):
     result = run_module("hlp_drake.run_scene", "--workers", "0", "--json", str(out))
     assert result.returncode == 2 and result.stderr.strip() == "error: --workers must be >= 1, got 0"
     assert not out.exists()
+
+
+def test_pushes_stop_short_of_the_table_edge_and_the_other_objects():
+    from hlp_drake.planner.transfer import EDGE_MARGIN, OBJECT_MARGIN, push_travel
+
+    scene = generate_scene("gen1", 13)
+    space = TaskSpace(scene)
+    x_min, y_min, x_max, y_max = scene.table.bounds
+    for name in scene_obstacle_names(scene):
+        rect = space.rects[name]
+        for unit in (np.array([0.0, 1.0]), np.array([0.0, -1.0]), np.array([1.0, 0.0])):
+            travel = push_travel(space, scene, name, unit, 1.0)
+            assert 0.0 <= travel < 1.0  # a 1 m push never fits on these tables
+            dx, dy = travel * unit
+            assert x_min + EDGE_MARGIN <= rect.x_min + dx and rect.x_max + dx <= x_max - EDGE_MARGIN
+            assert y_min + EDGE_MARGIN <= rect.y_min + dy and rect.y_max + dy <= y_max - EDGE_MARGIN
+            for other, r in space.rects.items():
+                if other != name:
+                    apart = (rect.x_min + dx >= r.x_max + OBJECT_MARGIN or r.x_min >= rect.x_max + dx + OBJECT_MARGIN
+                             or rect.y_min + dy >= r.y_max + OBJECT_MARGIN or r.y_min >= rect.y_max + dy + OBJECT_MARGIN)
+                    assert apart or travel == 0.0, (name, other, travel)
+    # Unobstructed, the push goes as far as wanted.
+    lone = scene_with_one_obstacle(scene)
+    lone_space = TaskSpace(lone)
+    assert push_travel(lone_space, lone, lone.obstacles[0].name, np.array([0.0, 1.0]), 0.02) == pytest.approx(0.02)
+
+
+def scene_obstacle_names(scene):
+    return [o.name for o in scene.obstacles]
+
+
+def scene_with_one_obstacle(scene):
+    from dataclasses import replace
+
+    obstacle = replace(scene.obstacles[0], x=scene.table.length / 2, y=0.0)
+    target = replace(scene.target, x=scene.table.length * 0.85, y=0.0)
+    return replace(scene, obstacles=(obstacle,), target=target)

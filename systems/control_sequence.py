@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from pydrake.trajectories import PiecewisePolynomial
 
-BASE_COLUMNS = slice(0, 3)
+BASE_COLUMNS = (0, 1, 2)
 """Columns of a knot holding the base's x, y and yaw (the first three robot positions)."""
 
 

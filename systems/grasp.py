@@ -7,13 +7,13 @@ from pydrake.math import RotationMatrix
 from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.solvers import Solve
 
-from hlp_drake.systems.robot import BASE_JOINTS, GRIPPER_CLOSED, GRIPPER_JOINTS, GRIPPER_MIMIC_JOINTS, TCP_FRAME
+from hlp_drake.systems.control_sequence import BASE_COLUMNS
+from hlp_drake.systems.robot import GRIPPER_CLOSED, GRIPPER_JOINTS, GRIPPER_MIMIC_JOINTS, TCP_FRAME
 from hlp_drake.systems.world import ik_solver_options, kinematic_robot, robot_position_names
 from hlp_drake.systems.world_config import WorldConfig
 
 _NAMES = robot_position_names()
 FINGER_COLUMNS = [_NAMES.index(name) for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS]
-BASE_COLUMNS = [_NAMES.index(name) for name in BASE_JOINTS]
 
 
 def lifted_configuration(q: np.ndarray, height: float, *, max_iterations: int = 200) -> np.ndarray | None:
@@ -25,7 +25,7 @@ def lifted_configuration(q: np.ndarray, height: float, *, max_iterations: int = 
     tcp = plant.GetFrameByName(TCP_FRAME, robot)
     pose = tcp.CalcPoseInWorld(context)
     ik = InverseKinematics(plant, context, with_joint_limits=True)
-    fixed = BASE_COLUMNS + FINGER_COLUMNS
+    fixed = [*BASE_COLUMNS, *FINGER_COLUMNS]
     prog = ik.get_mutable_prog()
     prog.AddBoundingBoxConstraint(q[fixed], q[fixed], ik.q()[fixed])
     target = pose.translation() + np.array([0.0, 0.0, height])

@@ -16,7 +16,7 @@ from __future__ import annotations
 import copy
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, replace
 
 import numpy as np
 from pydrake.systems.analysis import Simulator
@@ -25,7 +25,7 @@ from pydrake.systems.framework import DiagramBuilder
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.robot import TCP_FRAME
-from hlp_drake.systems.scene_models import TABLE_NAME, object_body, off_table_mask
+from hlp_drake.systems.scene_models import TABLE_NAME, object_body, off_table_mask, over_table_mask
 from hlp_drake.systems.sto_config import StoConfig
 from hlp_drake.systems.world import add_position_trajectory, make_world_diagram, tcp_keypoint_height, world_plant
 from hlp_drake.systems.world_config import WorldConfig
@@ -77,7 +77,6 @@ class RolloutOutcome:
     fallen: tuple[str, ...] = ()
     simulated_s: float = 0.0
     wall_s: float = 0.0
-    extras: dict = field(default_factory=dict, compare=False)
 
 
 def _half_extent(size: tuple[float, float, float]) -> float:
@@ -108,9 +107,10 @@ def rollout_cost(samples: RolloutSamples, scene: Scene, sto: StoConfig, *, tcp_h
     """The cost of a rollout from its samples (see ``StoCost`` for the terms)."""
     weights = sto.cost
     names = [obj.name for obj in scene.objects]
+    simulated = float(samples.times[-1]) if len(samples.times) else 0.0
     if samples.blew_up is not None:
         return RolloutOutcome(BLOWN_UP_COST, {"blew_up": BLOWN_UP_COST}, False,
-                              f"the simulation blew up: {samples.blew_up}", math.inf)
+                              f"the simulation blew up: {samples.blew_up}", math.inf, simulated_s=simulated)
     positions, tcp = samples.positions, samples.tcp
     per_step = (samples.times[1] - samples.times[0]) / step_duration if len(samples.times) > 1 else 1.0
     off = np.array([off_table_mask(p, scene.table) for p in positions])  # (T, m)
@@ -136,8 +136,7 @@ def rollout_cost(samples: RolloutSamples, scene: Scene, sto: StoConfig, *, tcp_h
     }
     fallen = tuple(name for name, f in zip(names, off[-1]) if f)
     reason = reach_problem(fallen, inside, distance)
-    return RolloutOutcome(float(sum(terms.values())), terms, reason is None, reason, distance, fallen,
-                          float(samples.times[-1]))
+    return RolloutOutcome(float(sum(terms.values())), terms, reason is None, reason, distance, fallen, simulated)
 
 
 def rollout_world_config(config: WorldConfig) -> WorldConfig:
@@ -205,12 +204,11 @@ class RolloutWorld:
         problem = None
         sto = self.config.sto
         table = self.scene.table
-        x_min, y_min, x_max, y_max = table.bounds
         if not (np.all(np.isfinite(positions)) and np.all(np.isfinite(tcp))):
             return positions, tcp, max_force, table_contact, "a position is not finite"
         # Objects pushed off the edge fall freely (a legitimate outcome); only objects over the table
         # are checked for impossible speeds and for sinking into it.
-        over = (positions[:, 0] >= x_min) & (positions[:, 0] <= x_max) & (positions[:, 1] >= y_min) & (positions[:, 1] <= y_max)
+        over = over_table_mask(positions, table)
         speeds = np.where(over, speeds, 0.0)
         sunk = over & (positions[:, 2] < table.height - sto.max_sink)  # a centre inside the table top
         if np.max(speeds) > sto.max_object_speed:
@@ -256,7 +254,4 @@ class RolloutWorld:
         samples = self.simulate(sequence)
         outcome = rollout_cost(samples, self.scene, self.config.sto, tcp_height=self._tcp_height,
                                effort=sequence.effort(), step_duration=float(np.mean(sequence.steps)))
-        return RolloutOutcome(outcome.cost, outcome.terms, outcome.success, outcome.failure_reason,
-                              outcome.target_distance, outcome.fallen,
-                              float(samples.times[-1]) if len(samples.times) else 0.0,
-                              time.perf_counter() - started)
+        return replace(outcome, wall_s=time.perf_counter() - started)

@@ -218,14 +218,19 @@ def object_planar_poses(
     return result
 
 
+def over_table_mask(positions: np.ndarray, table) -> np.ndarray:
+    """Per object centre in ``positions`` (m, 3): whether it lies within the table's footprint."""
+    positions = np.asarray(positions, dtype=float).reshape(-1, 3)
+    x_min, y_min, x_max, y_max = table.bounds
+    x, y = positions[:, 0], positions[:, 1]
+    return (x >= x_min) & (x <= x_max) & (y >= y_min) & (y <= y_max)
+
+
 def off_table_mask(positions: np.ndarray, table) -> np.ndarray:
     """Per object centre in ``positions`` (m, 3): whether it is off the table (below the top or
     outside its footprint)."""
     positions = np.asarray(positions, dtype=float).reshape(-1, 3)
-    x_min, y_min, x_max, y_max = table.bounds
-    x, y, z = positions.T
-    inside = (x >= x_min) & (x <= x_max) & (y >= y_min) & (y <= y_max)
-    return ~(inside & (z >= table.height))
+    return ~(over_table_mask(positions, table) & (positions[:, 2] >= table.height))
 
 
 def fallen_objects(plant: MultibodyPlant, context: Context, scene: Scene) -> list[str]:
@@ -273,6 +278,7 @@ __all__ = [
     "object_pose",
     "object_poses",
     "off_table_mask",
+    "over_table_mask",
     "scene_from_plant",
     "set_object_poses",
     "tilted_objects",

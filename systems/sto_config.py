@@ -10,7 +10,6 @@ In a world YAML file it sits under ``sto:``::
 """
 
 # No "from __future__ import annotations": yaml_load_typed reads the field types at run time.
-import math
 from dataclasses import dataclass, field
 
 UPDATES = ("greedy", "mppi")
@@ -122,33 +121,3 @@ class GraspConfig:
     lift_s: float = 1.5
     hold_s: float = 0.5
     held_height: float = 0.05
-
-
-def sto_config_problems(sto: StoConfig, grasp: GraspConfig) -> list[str]:
-    """The reasons ``sto`` or ``grasp`` cannot be used (empty when they are fine)."""
-    problems: list[str] = []
-
-    def positive(where: str, value: float, *, zero_ok: bool = False) -> None:
-        if not math.isfinite(value) or value < 0 or (value == 0 and not zero_ok):
-            problems.append(f"{where} must be {'>= 0' if zero_ok else '> 0'}, got {value}")
-
-    for name in ("samples", "max_iterations", "workers"):
-        if int(getattr(sto, name)) < 1:
-            problems.append(f"sto.{name} must be >= 1, got {getattr(sto, name)}")
-    for name in ("time_budget_s", "step_duration", "mppi_temperature", "rollout_time_step",
-                 "sample_period", "max_object_speed", "max_sink"):
-        positive(f"sto.{name}", getattr(sto, name))
-    positive("sto.settle_s", sto.settle_s, zero_ok=True)
-    for name in ("vx", "vy", "yaw_rate"):
-        positive(f"sto.noise.{name}", getattr(sto.noise, name), zero_ok=True)
-    if not 0.0 <= sto.noise.end_fraction <= 1.0:
-        problems.append(f"sto.noise.end_fraction must be in [0, 1], got {sto.noise.end_fraction}")
-    if sto.update not in UPDATES:
-        problems.append(f"sto.update must be one of {', '.join(UPDATES)}, got {sto.update!r}")
-    for name in StoCost.__dataclass_fields__:
-        positive(f"sto.cost.{name}", getattr(sto.cost, name), zero_ok=True)
-    for name in ("close_s", "lift_s", "held_height"):
-        positive(f"grasp.{name}", getattr(grasp, name))
-    for name in ("lift_height", "hold_s"):
-        positive(f"grasp.{name}", getattr(grasp, name), zero_ok=True)
-    return problems

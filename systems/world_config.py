@@ -27,7 +27,7 @@ from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 from pydrake.multibody.plant import MultibodyPlantConfig
 
 from hlp_drake.errors import HlpError
-from hlp_drake.systems.sto_config import GraspConfig, StoConfig, sto_config_problems
+from hlp_drake.systems.sto_config import UPDATES, GraspConfig, StoConfig, StoCost
 
 SAP_APPROXIMATIONS = ("sap", "lagged", "similar")
 """Discrete contact approximations solved by SAP (TAMSI, "tamsi", cannot simulate the mimic finger)."""
@@ -258,7 +258,26 @@ def config_problems(config: WorldConfig) -> list[str]:
     positive("motion.tcp_speed", config.motion.tcp_speed)
     positive("motion.joint_speed_fraction", config.motion.joint_speed_fraction)
     positive("motion.min_segment_duration", config.motion.min_segment_duration)
-    problems.extend(sto_config_problems(config.sto, config.grasp))
+    sto, grasp = config.sto, config.grasp
+    for name in ("samples", "max_iterations", "workers"):
+        if int(getattr(sto, name)) < 1:
+            problems.append(f"sto.{name} must be >= 1, got {getattr(sto, name)}")
+    for name in ("time_budget_s", "step_duration", "mppi_temperature", "rollout_time_step",
+                 "sample_period", "max_object_speed", "max_sink"):
+        positive(f"sto.{name}", getattr(sto, name))
+    positive("sto.settle_s", sto.settle_s, zero_ok=True)
+    for name in ("vx", "vy", "yaw_rate"):
+        positive(f"sto.noise.{name}", getattr(sto.noise, name), zero_ok=True)
+    if not 0.0 <= sto.noise.end_fraction <= 1.0:
+        problems.append(f"sto.noise.end_fraction must be in [0, 1], got {sto.noise.end_fraction}")
+    if sto.update not in UPDATES:
+        problems.append(f"sto.update must be one of {', '.join(UPDATES)}, got {sto.update!r}")
+    for name in StoCost.__dataclass_fields__:
+        positive(f"sto.cost.{name}", getattr(sto.cost, name), zero_ok=True)
+    for name in ("close_s", "lift_s", "held_height"):
+        positive(f"grasp.{name}", getattr(grasp, name))
+    for name in ("lift_height", "hold_s"):
+        positive(f"grasp.{name}", getattr(grasp, name), zero_ok=True)
     return problems
 
 

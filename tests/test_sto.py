@@ -67,6 +67,11 @@ def test_sequence_keeps_every_keyframe_and_bounds_the_step(trajectories):
 
 
 def test_base_velocity_is_integrated_and_the_start_stays():
+    from hlp_drake.systems.control_sequence import BASE_COLUMNS
+    from hlp_drake.systems.robot import BASE_JOINTS
+    from hlp_drake.systems.world import robot_position_names
+
+    assert tuple(robot_position_names()[i] for i in BASE_COLUMNS) == BASE_JOINTS
     sequence = ControlSequence(np.array([0.0, 0.5, 1.5]), np.zeros((3, 11)))
     velocity = np.array([[0.2, -0.1, 0.05], [0.1, 0.0, 0.0]])
     moved = sequence.with_base_velocity(velocity)

@@ -105,6 +105,10 @@ def test_config_loads_from_yaml_and_overrides(tmp_path):
         ("plant: {discrete_contact_approximation: tamsi}\n", "SAP"),
         ("plant: {time_step: 0.0}\n", "time_step"),
         ("scene: {object_min_mass: 1.0, object_max_mass: 0.5}\n", "object_max_mass"),
+        ("sto: {update: annealing}\n", "sto.update"),
+        ("sto: {samples: 0}\n", "sto.samples"),
+        ("sto: {noise: {end_fraction: 1.5}}\n", "sto.noise.end_fraction"),
+        ("grasp: {lift_s: 0.0}\n", "grasp.lift_s"),
     ],
 )
 def test_bad_config_file_raises_a_one_line_hlp_error_naming_the_file(tmp_path, text, problem):

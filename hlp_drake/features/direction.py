@@ -35,25 +35,45 @@ def direction_features(space: TaskSpace, name: str, *, hand: Sequence[float], mo
         training: whether the features describe a demonstration (faithful mode only).
         hand_to_object: the demonstration's approach direction (faithful training only).
     """
-    rect = rect_array([space.rects[name]])
-    target = rect_array([space.target])
-    faithful = is_faithful(mode)
-    if faithful and training:
-        occluders = space.occluders()
-    elif faithful:
-        occluders = space.occluders(target=True, walls=("back", "left", "right"))
-    else:
-        occluders = space.occluders(target=True)
-    free = free_fractions(block_array(rect, space.alpha), rect_array(occluders))[0]
-    if faithful:
-        corner, target_corner = corner_origin(rect[0]), corner_origin(target[0])
-        if training:
-            to_object = hand_to_object
+    table = DirectionTable(space, [name], mode=mode, training=training)
+    to_object = hand_to_object if is_faithful(mode) and training else table.hand_direction(0, hand)
+    return table.features(0, direction_index(to_object))
+
+
+class DirectionTable:
+    """The hand-independent part of Xd for several obstacles, computed together.
+
+    Attributes:
+        free: (k, 8) free fractions of the direction blocks.
+        origins: (k, 2) the points directions are measured from (centres; corner origins in faithful mode).
+        to_target: (k,) class index of the direction from each obstacle to the target.
+    """
+
+    def __init__(self, space: TaskSpace, names: Sequence[str], *, mode: Mode, training: bool = False) -> None:
+        self.faithful = is_faithful(mode)
+        rects = space.obstacle_bounds[[space.obstacle_index[n] for n in names]].reshape(-1, 4)
+        if self.faithful and training:
+            occluders = space.occluder_bounds()
+        elif self.faithful:
+            occluders = space.occluder_bounds(target=True, walls=("back", "left", "right"))
         else:
-            to_object = direction_of(*(corner - np.asarray(hand, float)), faithful=True)
-        to_target = direction_of(*(target_corner - corner), faithful=True)
-    else:
-        centre = np.array(space.rects[name].center)
-        to_object = direction_of(*(centre - np.asarray(hand, float)))
-        to_target = direction_of(*(np.array(space.target.center) - centre))
-    return np.concatenate([free, [direction_index(to_object), direction_index(to_target)]])
+            occluders = space.occluder_bounds(target=True)
+        self.free = free_fractions(block_array(rects, space.alpha), occluders)
+        target = rect_array([space.target])
+        if self.faithful:
+            self.origins, target_origin = corner_origin(rects), corner_origin(target[0])
+        else:
+            self.origins = np.column_stack([(rects[:, 0] + rects[:, 2]) / 2.0, (rects[:, 1] + rects[:, 3]) / 2.0])
+            target_origin = np.array(space.target.center)
+        self.to_target = np.array([direction_index(direction_of(*(target_origin - o), faithful=self.faithful))
+                                   for o in self.origins], dtype=int).reshape(-1)
+
+    def hand_direction(self, k: int, hand: Sequence[float]) -> str | None:
+        """Direction class from a hand at ``hand`` to obstacle ``k``."""
+        return direction_of(*(self.origins[k] - np.asarray(hand, float)), faithful=self.faithful)
+
+    def features(self, index: int | np.ndarray, hand_class: int | np.ndarray) -> np.ndarray:
+        """Xd of obstacles ``index`` approached from direction class indices ``hand_class``
+        (broadcast together): (..., 10)."""
+        index, hand_class = np.broadcast_arrays(index, hand_class)
+        return np.concatenate([self.free[index], hand_class[..., None], self.to_target[index][..., None]], axis=-1)

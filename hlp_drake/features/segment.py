@@ -28,7 +28,7 @@ def path_occluders(space: TaskSpace, *, faithful: bool) -> np.ndarray:
     (misplaced as the original does, bug B3, in faithful mode)."""
     walls = [space.walls[w] for w in PATH_WALLS]
     walls = [_misread_wall(w) for w in walls] if faithful else walls
-    return rect_array([space.rects[n] for n in space.obstacle_names] + walls)
+    return np.vstack([space.obstacle_bounds, rect_array(walls)])
 
 
 def segment_feature_matrix(space: TaskSpace, near: list[Node], far: list[Node], *, mode: Mode,
@@ -43,17 +43,36 @@ def segment_feature_matrix(space: TaskSpace, near: list[Node], far: list[Node], 
     mode and the original's sampled estimate, with its tilted offset vector (B5) and misplaced
     walls (B3), in faithful mode.
     """
+    return pair_features(space, *node_pairs(space, near, far), mode=mode, training=training)
+
+
+def node_pairs(space: TaskSpace, near: list[Node], far: list[Node]) -> tuple[np.ndarray, ...]:
+    """The arguments ``pa, pb, own_a, own_b`` of ``pair_features`` for every pair (a in ``near``,
+    b in ``far``), a-major."""
+    a, b = (np.array([n.center for n in nodes], float).reshape(-1, 2) for nodes in (near, far))
+    own_a, own_b = (np.array([-1 if n.obstacle is None else space.obstacle_index[n.obstacle] for n in nodes], dtype=int)
+                    for nodes in (near, far))
+    return (np.repeat(a, len(far), axis=0), np.tile(b, (len(near), 1)), np.repeat(own_a, len(far)),
+            np.tile(own_b, len(near)))
+
+
+def pair_features(space: TaskSpace, pa: np.ndarray, pb: np.ndarray, own_a: np.ndarray, own_b: np.ndarray, *,
+                  mode: Mode, training: bool = False) -> np.ndarray:
+    """Xc of the segments pa[i] -> pb[i] (see ``segment_feature_matrix``): (n, 4).
+
+    Args:
+        pa, pb: (n, 2) segment ends (node centres).
+        own_a, own_b: (n,) the ends' obstacles (positions in scene order; -1 for a gap), which are
+            not occluders of their segment.
+    """
     faithful = is_faithful(mode)
     table = space.scene.table
     norm = table.width if (faithful and training) else table_diagonal(table)
-    pa = np.repeat(np.array([n.center for n in near], float).reshape(-1, 2), len(far), axis=0)
-    pb = np.tile(np.array([n.center for n in far], float).reshape(-1, 2), (len(near), 1))
     start, target = np.asarray(space.scene.start, float), np.asarray(space.target.center, float)
     d = pb - pa
     # Lateral coordinates grow to the right (-y), as the original's x does.
     span = np.abs(d[:, 1]) / norm
     slope = -d[:, 1] / d[:, 0] - (-(target[1] - start[1])) / (target[0] - start[0])
-    names = space.obstacle_names
     rects = path_occluders(space, faithful=faithful)
     half = HAND_WIDTH / 2.0
     if faithful:
@@ -64,15 +83,14 @@ def segment_feature_matrix(space: TaskSpace, near: list[Node], far: list[Node], 
         length = np.linalg.norm(d, axis=1, keepdims=True)
         offsets = np.column_stack([-d[:, 1], d[:, 0]]) / np.where(length > 0.0, length, 1.0)
         coverage = band_coverage(pa, pb, offsets, half, half, rects)
-    # Each pair's own obstacles are not occluders of its segment.
     own = np.zeros_like(coverage, dtype=bool)
-    ends = [n.obstacle for n in near for _ in far], [n.obstacle for _ in near for n in far]
-    for column, name in enumerate(names):
-        own[:, column] = [name in pair for pair in zip(*ends)]
+    pairs = np.arange(len(pa))
+    for ends in (own_a, own_b):
+        own[pairs[ends >= 0], ends[ends >= 0]] = True
     collision = np.where(own, 0.0, coverage).sum(axis=1) / (~own).sum(axis=1)
     lateral_a, lateral_b, lateral_t = -pa[:, 1], -pb[:, 1], -target[1]
     low, high = np.minimum(lateral_a, lateral_b), np.maximum(lateral_a, lateral_b)
-    overlap = np.clip(np.minimum(high, lateral_t + TARGET_BAND) - np.maximum(low, lateral_t - TARGET_BAND), 0.0, None)
+    overlap = np.maximum(np.minimum(high, lateral_t + TARGET_BAND) - np.maximum(low, lateral_t - TARGET_BAND), 0.0)
     return np.column_stack([span, slope, collision, overlap / norm])
 
 

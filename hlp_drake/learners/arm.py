@@ -8,9 +8,9 @@ from sklearn.gaussian_process import GaussianProcessRegressor
 from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from hlp_drake.learners.inputs import prediction_input
-
 from hlp_drake.learners.encoding import expand_directions
+from hlp_drake.learners.inputs import prediction_input
+from hlp_drake.learners.kernel import distance_weights, gaussian_kernel
 
 CATEGORICAL = (4,)  # direction class index in Xa
 
@@ -57,19 +57,46 @@ class ArmRegressor(RegressorMixin, BaseEstimator):
         self.amplitude_ = np.array(self.amplitude_, dtype=float)
         self.y_mean_ = np.array(self.y_mean_, dtype=float).ravel()
         self.y_std_ = np.array(self.y_std_, dtype=float).ravel()
+        self._weights = distance_weights(self.train_)
         return self
 
     def predict(self, X: np.ndarray) -> np.ndarray:
         """(n, outputs) predicted angles."""
-        X = prediction_input(self, X)
-        Z = (expand_directions(X, CATEGORICAL) - self.mean_) / self.scale_
-        sq = (Z**2).sum(1)[:, None] + (self.train_**2).sum(1)[None, :] - 2.0 * Z @ self.train_.T
-        sq = np.clip(sq, 0.0, None)
-        out = []
-        for k in range(len(self.alpha_)):
-            K = self.amplitude_[k] * np.exp(-0.5 * sq / self.length_scale_[k] ** 2)
-            out.append((K @ self.alpha_[k]) * self.y_std_[k] + self.y_mean_[k])
-        return np.column_stack(out)
+        return self._predict(self._standardised(prediction_input(self, X)))
+
+    def rollout(self, start: np.ndarray, parent: list[int], moves: np.ndarray,
+                limits: tuple[float, float] = (-np.inf, np.inf)) -> np.ndarray:
+        """The angles at every node of a tree of hand moves, each predicted from its parent's.
+
+        Args:
+            start: (q1, q2) at node 0, the root.
+            parent: each node's parent, an earlier node (node 0's is ignored).
+            moves: (n, 3) the move into each node: (dx, dy) / arm length and its direction class.
+            limits: the range predicted angles are clipped to.
+
+        Returns:
+            (n, 2) angles; one prediction covers all nodes of a depth.
+        """
+        depth = [0] * len(parent)
+        for node in range(1, len(parent)):
+            depth[node] = depth[parent[node]] + 1
+        depth, parent = np.array(depth), np.asarray(parent)
+        Z = self._standardised(prediction_input(self, np.column_stack([np.zeros((len(parent), 2)), moves])))
+        q = np.zeros((len(parent), 2))
+        q[0] = start
+        for d in range(1, depth.max(initial=0) + 1):
+            nodes = np.flatnonzero(depth == d)
+            Z[nodes, :2] = (q[parent[nodes]] - self.mean_[:2]) / self.scale_[:2]
+            q[nodes] = np.minimum(np.maximum(self._predict(Z[nodes]), limits[0]), limits[1])
+        return q
+
+    def _standardised(self, X: np.ndarray) -> np.ndarray:
+        return (expand_directions(X, CATEGORICAL) - self.mean_) / self.scale_
+
+    def _predict(self, Z: np.ndarray) -> np.ndarray:
+        kernels = gaussian_kernel(Z, self._weights, tuple(0.5 / self.length_scale_**2))
+        return np.column_stack([self.amplitude_[k] * (K @ self.alpha_[k]) * self.y_std_[k] + self.y_mean_[k]
+                                for k, K in enumerate(kernels)])
 
     def get_state(self) -> dict[str, np.ndarray]:
         check_is_fitted(self)
@@ -80,5 +107,6 @@ class ArmRegressor(RegressorMixin, BaseEstimator):
     def set_state(self, state: dict[str, np.ndarray]) -> ArmRegressor:
         for name in ("mean", "scale", "train", "alpha", "length_scale", "amplitude", "y_mean", "y_std"):
             setattr(self, f"{name}_", state[name])
+        self._weights = distance_weights(self.train_)
         self.n_features_in_ = 5
         return self

@@ -7,10 +7,9 @@ from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.svm import SVC
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from hlp_drake.learners.inputs import prediction_input
-
 from hlp_drake.learners.balance import oversample
 from hlp_drake.learners.encoding import expand_directions
+from hlp_drake.learners.inputs import prediction_input
 
 CATEGORICAL = (8, 9)  # hand_to_object, object_to_target class indices in Xd
 
@@ -34,21 +33,20 @@ class DirectionClassifier(ClassifierMixin, BaseEstimator):
         self.classes_ = svc.classes_
         self.coef_ = svc.coef_
         self.intercept_ = svc.intercept_
+        self._set_pairs()
         return self
 
-    def _pairs(self) -> list[tuple[int, int]]:
-        n = len(self.classes_)
-        return [(i, j) for i in range(n) for j in range(i + 1, n)]
+    def _set_pairs(self) -> None:
+        """(pairs, classes) indicators of each one-vs-one pair's first and second class."""
+        first, second = np.triu_indices(len(self.classes_), k=1)  # (0, 1), (0, 2), ... as libsvm's pairs
+        eye = np.eye(len(self.classes_))
+        self._first, self._second = eye[first], eye[second]
 
     def votes(self, X: np.ndarray) -> np.ndarray:
         """(n, classes) one-vs-one votes."""
         X = prediction_input(self, X)
         scores = expand_directions(X, CATEGORICAL) @ self.coef_.T + self.intercept_
-        votes = np.zeros((len(X), len(self.classes_)))
-        for k, (i, j) in enumerate(self._pairs()):
-            votes[:, i] += scores[:, k] > 0
-            votes[:, j] += scores[:, k] <= 0
-        return votes
+        return (scores > 0) @ self._first + (scores <= 0) @ self._second
 
     def predict(self, X: np.ndarray) -> np.ndarray:
         return self.classes_[np.argmax(self.votes(X), axis=1)]
@@ -60,4 +58,5 @@ class DirectionClassifier(ClassifierMixin, BaseEstimator):
     def set_state(self, state: dict[str, np.ndarray]) -> DirectionClassifier:
         self.classes_, self.coef_, self.intercept_ = state["classes"], state["coef"], state["intercept"]
         self.n_features_in_ = 10
+        self._set_pairs()
         return self

@@ -11,11 +11,10 @@ def expand_directions(X: np.ndarray, columns: tuple[int, ...]) -> np.ndarray:
     """Replace the class-index ``columns`` of ``X`` by 8 one-hot columns each (appended at the end)."""
     X = np.asarray(X, dtype=float)
     keep = [c for c in range(X.shape[1]) if c not in columns]
-    parts = [X[:, keep]]
-    for c in columns:
+    out = np.zeros((len(X), len(keep) + N_DIRECTIONS * len(columns)))
+    out[:, :len(keep)] = X[:, keep]
+    for k, c in enumerate(columns):
         index = X[:, c].astype(int)
-        hot = np.zeros((len(X), N_DIRECTIONS))
-        valid = index >= 0
-        hot[np.flatnonzero(valid), index[valid]] = 1.0
-        parts.append(hot)
-    return np.hstack(parts)
+        valid = np.flatnonzero(index >= 0)
+        out[valid, len(keep) + N_DIRECTIONS * k + index[valid]] = 1.0
+    return out

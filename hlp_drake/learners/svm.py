@@ -7,9 +7,9 @@ from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.svm import SVC
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from hlp_drake.learners.inputs import prediction_input
-
 from hlp_drake.learners.balance import oversample
+from hlp_drake.learners.inputs import prediction_input
+from hlp_drake.learners.kernel import distance_weights, gaussian_kernel
 
 
 class RbfSvmClassifier(ClassifierMixin, BaseEstimator):
@@ -51,14 +51,14 @@ class RbfSvmClassifier(ClassifierMixin, BaseEstimator):
         self.support_vectors_ = svc.support_vectors_
         self.dual_coef_ = svc.dual_coef_[0]
         self.intercept_ = float(svc.intercept_[0])
+        self._weights = distance_weights(self.support_vectors_)
         return self
 
     def decision_function(self, X: np.ndarray) -> np.ndarray:
         """Signed distance-like score; > 0 means the positive class (``classes_[1]``)."""
         X = prediction_input(self, X)
-        Z = (X - self.mean_) / self.scale_
-        sq = (Z**2).sum(1)[:, None] + (self.support_vectors_**2).sum(1)[None, :] - 2.0 * Z @ self.support_vectors_.T
-        return np.exp(-self.gamma_ * np.clip(sq, 0.0, None)) @ self.dual_coef_ + self.intercept_
+        kernel, = gaussian_kernel((X - self.mean_) / self.scale_, self._weights, (self.gamma_,))
+        return kernel @ self.dual_coef_ + self.intercept_
 
     def predict(self, X: np.ndarray) -> np.ndarray:
         return self.classes_[(self.decision_function(X) > 0).astype(int)]
@@ -74,5 +74,6 @@ class RbfSvmClassifier(ClassifierMixin, BaseEstimator):
         self.classes_, self.mean_, self.scale_ = state["classes"], state["mean"], state["scale"]
         self.gamma_, self.intercept_ = float(state["gamma"]), float(state["intercept"])
         self.support_vectors_, self.dual_coef_ = state["support_vectors"], state["dual_coef"]
+        self._weights = distance_weights(self.support_vectors_)
         self.n_features_in_ = len(self.mean_)
         return self

@@ -23,6 +23,15 @@ def arm_joints(hand: np.ndarray, q: np.ndarray, upper_arm: float, forearm: float
     return np.stack([neck, shoulder, elbow, hand], axis=-2)
 
 
+def _is_convex(quad: np.ndarray) -> np.ndarray:
+    """Whether quadrilaterals (..., 4, 2) are convex (or degenerate): no two turns of opposite sense."""
+    following = np.roll(np.arange(4), -1)
+    edge = quad[..., following, :] - quad
+    nxt = edge[..., following, :]
+    turn = edge[..., 0] * nxt[..., 1] - edge[..., 1] * nxt[..., 0]
+    return np.all(turn >= 0.0, axis=-1) | np.all(turn <= 0.0, axis=-1)
+
+
 def _inflate(rects: np.ndarray, margin: float) -> np.ndarray:
     return rects + np.array([-margin, -margin, margin, margin])
 
@@ -47,14 +56,17 @@ def sweep_collision(before: np.ndarray, after: np.ndarray, occluders: np.ndarray
         return np.zeros(n)
     counted = np.maximum(mask.sum(axis=1), 1)
     if not faithful:
-        # Two triangles per link sweep, all links and motions clipped in one batch.
+        # A link sweeps the quadrilateral of its two poses: as one polygon where it is convex, else
+        # as two triangles (the second polygon of a convex sweep is a point); all in one batch.
         inflated = _inflate(occluders, band)
         areas = (inflated[:, 2] - inflated[:, 0]) * (inflated[:, 3] - inflated[:, 1])
         a0, b0, a1, b1 = before[:, :3], before[:, 1:], after[:, :3], after[:, 1:]  # (n, 3, 2) per link
-        first = np.stack([a0, b0, b1, b1], axis=2)
-        second = np.stack([a0, b1, a1, a1], axis=2)
-        triangles = np.concatenate([first, second], axis=1).reshape(-1, 4, 2)  # (n * 6, 4, 2)
-        cover = convex_rect_overlap(triangles, inflated).reshape(n, 2, 3, -1).sum(axis=1) / areas
+        quad = np.stack([a0, b0, b1, a1], axis=2)
+        convex = _is_convex(quad)[..., None, None]
+        first = np.where(convex, quad, np.stack([a0, b0, b1, b1], axis=2))
+        second = np.where(convex, a0[:, :, None], np.stack([a0, b1, a1, a1], axis=2))
+        polygons = np.concatenate([first, second], axis=1).reshape(-1, 4, 2)  # (n * 6, 4, 2)
+        cover = convex_rect_overlap(polygons, inflated).reshape(n, 2, 3, -1).sum(axis=1) / areas
         cover = np.minimum(cover, 1.0)  # (n, 3 links, m)
         return (np.where(mask[:, None, :], cover, 0.0).sum(axis=2) / counted[:, None]).sum(axis=1)
     total = np.zeros(n)

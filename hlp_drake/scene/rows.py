@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import statistics
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,21 +32,24 @@ class Row:
     members: tuple[str, ...]
 
 
-def find_rows(scene: Scene, tolerance: float | None = None) -> list[Row]:
+def find_rows(scene: Scene, tolerance: float | None = None,
+              bounds: Mapping[str, tuple[float, float, float, float]] | None = None) -> list[Row]:
     """Cluster obstacle centres along x (single linkage): neighbours closer than ``tolerance`` join.
 
     Args:
         scene: the scene.
         tolerance: largest depth difference (m) between neighbouring centres of one row; by default
             half the median obstacle depth, so exact rows and roughly aligned rows both cluster.
+        bounds: the obstacles' footprint bounds by name, if already known.
     """
     obstacles = list(scene.obstacles)
     if not obstacles:
         return []
-    bounds = {o.name: footprint_bounds(o) for o in obstacles}
+    if bounds is None:
+        bounds = {o.name: footprint_bounds(o) for o in obstacles}
     if tolerance is None:
-        depths = [b[2] - b[0] for b in bounds.values()]
-        tolerance = DEFAULT_TOLERANCE_FRACTION * float(np.median(depths))
+        depths = [bounds[o.name][2] - bounds[o.name][0] for o in obstacles]
+        tolerance = DEFAULT_TOLERANCE_FRACTION * statistics.median(depths)
     order = sorted(obstacles, key=lambda o: (o.x, -o.y))
     clusters: list[list] = [[order[0]]]
     for obstacle in order[1:]:

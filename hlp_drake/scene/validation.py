@@ -3,19 +3,24 @@
 from __future__ import annotations
 
 import math
+from functools import cache
 from numbers import Real
 
+import numpy as np
 import shapely
 
 from hlp_drake.errors import SceneError
-from hlp_drake.scene.geometry import footprint, footprint_bounds
+from hlp_drake.scene.geometry import footprint, footprint_bounds, overlapping_bounds
 from hlp_drake.scene.model import SHAPES, Scene, SceneObject
 
 LENGTH_TOLERANCE = 1e-9  # m: how far a footprint may poke past the table edge (float noise)
 AREA_TOLERANCE = 1e-9  # m^2: overlap area below which two objects only touch
+BOUNDS_MARGIN = 1e-6  # m: boxes this close may touch (footprints vs their float bounding boxes)
 
 
 def _is_finite(value: object) -> bool:
+    if type(value) is float:  # the common case, without the abstract-class check
+        return math.isfinite(value)
     return isinstance(value, Real) and not isinstance(value, bool) and math.isfinite(value)
 
 
@@ -24,29 +29,28 @@ def _label(obj: SceneObject, role: str) -> str:
 
 
 def _object_problems(obj: SceneObject, role: str) -> list[str]:
-    label = _label(obj, role)
     problems = []
     if obj.shape not in SHAPES:
-        problems.append(f"{label}: unknown shape {obj.shape!r} (expected one of {', '.join(SHAPES)})")
-    for attr in ("x", "y", "yaw"):
-        value = getattr(obj, attr)
+        problems.append(f"unknown shape {obj.shape!r} (expected one of {', '.join(SHAPES)})")
+    for attr, value in (("x", obj.x), ("y", obj.y), ("yaw", obj.yaw)):
         if not _is_finite(value):
-            problems.append(f"{label}: {attr} must be a finite number, got {value!r}")
+            problems.append(f"{attr} must be a finite number, got {value!r}")
     size = obj.size
-    if len(size) != 3 or not all(_is_finite(v) for v in size):
-        problems.append(f"{label}: size must be 3 finite numbers, got {list(size)!r}")
+    if len(size) != 3 or not all(map(_is_finite, size)):
+        problems.append(f"size must be 3 finite numbers, got {list(size)!r}")
     elif min(size) <= 0.0:
-        problems.append(f"{label}: size must be positive, got {list(size)!r}")
+        problems.append(f"size must be positive, got {list(size)!r}")
     elif obj.shape == "cylinder" and not math.isclose(size[0], size[1], rel_tol=1e-6, abs_tol=1e-9):
         problems.append(
-            f"{label}: a cylinder's first two sizes are its diameter and must be equal, "
+            "a cylinder's first two sizes are its diameter and must be equal, "
             f"got {size[0]!r} and {size[1]!r}"
         )
-    return problems
+    return [f"{_label(obj, role)}: {problem}" for problem in problems]
 
 
-def _off_table(obj: SceneObject, role: str, scene: Scene) -> str | None:
-    x_min, y_min, x_max, y_max = footprint_bounds(obj)
+def _off_table(obj: SceneObject, role: str, bounds: tuple[float, ...], scene: Scene) -> str | None:
+    """What sides of the table the footprint ``bounds`` pokes past, if any."""
+    x_min, y_min, x_max, y_max = bounds
     tx_min, ty_min, tx_max, ty_max = scene.table.bounds
     tol = LENGTH_TOLERANCE
     sides = []
@@ -102,6 +106,8 @@ def scene_problems(scene: Scene) -> list[str]:
         if not own:
             sound.append((obj, role))
 
+    bounds = [footprint_bounds(obj) for obj, _ in sound]
+    boxes = np.array(bounds, dtype=float).reshape(-1, 4)
     if table_ok:
         if start_ok:
             x, y = scene.start
@@ -109,27 +115,42 @@ def scene_problems(scene: Scene) -> list[str]:
             tol = LENGTH_TOLERANCE
             if not (x_min - tol <= x <= x_max + tol and y_min - tol <= y <= y_max + tol):
                 problems.append(f"start point ({x:.3f}, {y:.3f}) is off the table")
-        for obj, role in sound:
-            message = _off_table(obj, role, scene)
-            if message:
-                problems.append(message)
-
-    shapes = [(obj, role, footprint(obj)) for obj, role in sound]
-    for i, (a, role_a, poly_a) in enumerate(shapes):
-        for b, role_b, poly_b in shapes[i + 1 :]:
-            if not poly_a.intersects(poly_b):
-                continue
-            area = poly_a.intersection(poly_b).area
-            if area > AREA_TOLERANCE:
-                problems.append(
-                    f"{_label(a, role_a)} and {_label(b, role_b)} overlap ({area * 1e4:.2f} cm^2)"
-                )
+        edges = np.array(table.bounds)
+        outside = (np.any(boxes[:, :2] < edges[:2] - LENGTH_TOLERANCE, axis=1)
+                   | np.any(boxes[:, 2:] > edges[2:] + LENGTH_TOLERANCE, axis=1))
+        for k in np.flatnonzero(outside).tolist():  # the message names the sides
+            problems.append(_off_table(*sound[k], bounds[k], scene))
+    problems += _overlaps(sound, boxes)
     if start_ok:
-        start_point = shapely.Point(*scene.start)
-        for obj, role, poly in shapes:
-            if poly.contains(start_point):
-                problems.append(f"start point lies inside {_label(obj, role)}")
+        problems += _start_inside(sound, bounds, scene.start)
     return problems
+
+
+def _overlaps(sound: list[tuple[SceneObject, str]], bounds: np.ndarray) -> list[str]:
+    """A message per pair of footprints sharing more than ``AREA_TOLERANCE`` (only pairs whose
+    bounding boxes meet are intersected)."""
+    problems = []
+    pairs = overlapping_bounds(bounds, BOUNDS_MARGIN).tolist()
+    shape = cache(lambda i: footprint(sound[i][0])) if pairs else None
+    for i, j in pairs:
+        (a, role_a), (b, role_b) = sound[i], sound[j]
+        poly_a, poly_b = shape(i), shape(j)
+        if not poly_a.intersects(poly_b):
+            continue
+        area = poly_a.intersection(poly_b).area
+        if area > AREA_TOLERANCE:
+            problems.append(f"{_label(a, role_a)} and {_label(b, role_b)} overlap ({area * 1e4:.2f} cm^2)")
+    return problems
+
+
+def _start_inside(sound: list[tuple[SceneObject, str]], bounds: list[tuple[float, ...]],
+                  start: tuple[float, float]) -> list[str]:
+    """A message per footprint the start point lies in (only footprints whose box holds it are tested)."""
+    x, y = start
+    m = BOUNDS_MARGIN
+    near = [obj_role for obj_role, (x0, y0, x1, y1) in zip(sound, bounds) if x0 - m < x < x1 + m and y0 - m < y < y1 + m]
+    point = shapely.Point(x, y) if near else None
+    return [f"start point lies inside {_label(obj, role)}" for obj, role in near if footprint(obj).contains(point)]
 
 
 def validate_scene(scene: Scene) -> Scene:

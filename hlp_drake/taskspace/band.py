@@ -34,50 +34,76 @@ def normal_of(p0: Sequence[float], p1: Sequence[float]) -> np.ndarray:
     return np.array([0.0, 1.0]) if length == 0.0 else np.array([-d[1], d[0]]) / length
 
 
-def _clip(points: np.ndarray, axis: int, bound: np.ndarray, keep_above: bool) -> np.ndarray:
-    """Clip closed polygons (k, K, 2) to the half-plane coordinate ``axis`` >= (or <=) ``bound`` (k,).
-
-    Each edge contributes the two ends of its part inside the half-plane; an end outside is moved
-    onto the clipping line (where the edge crosses it, else anywhere on the line). Consecutive
-    points off the original edges then lie on the clipping line, which adds no area in the
-    shoelace formula, so the fixed-size result (k, 2K, 2) has exactly the area of the clipped
-    polygon (for convex input).
-    """
-    p = points
-    q = np.concatenate([p[:, 1:], p[:, :1]], axis=1)
-    b = bound[:, None]
-    sign = 1.0 if keep_above else -1.0
-    dp, dq = sign * (p[..., axis] - b), sign * (q[..., axis] - b)
+def _relu_mean(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Mean of max(0, v) along a segment over which v runs linearly from ``a`` to ``b``."""
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
     with np.errstate(divide="ignore", invalid="ignore"):
-        t = np.nan_to_num(np.clip(dp / (dp - dq), 0.0, 1.0))
-    cut = p + t[..., None] * (q - p)
-    cut[..., axis] = b
-    start = np.where((dp >= 0.0)[..., None], p, cut)
-    end = np.where((dq >= 0.0)[..., None], q, cut)
-    return np.stack([start, end], axis=2).reshape(len(p), -1, 2)
+        crossing = hi * hi / (2.0 * (hi - lo))
+    return np.where(lo >= 0.0, 0.5 * (a + b), np.where(hi > 0.0, crossing, 0.0))
+
+
+def _relation(x: np.ndarray, y: np.ndarray, qx: np.ndarray, qy: np.ndarray,
+              box: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Whether each convex polygon (edges (x, y) -> (qx, qy), each (k, K)) is apart from its box
+    (k, 4) (on the outer side of one of its own edges, touching included: they share no area),
+    and whether it contains it."""
+    ex, ey = qx - x, qy - y
+    orientation = np.sign(np.sum(x * qy - qx * y, axis=1))[:, None, None]
+    cx, cy = box[:, None, [0, 2, 2, 0]], box[:, None, [1, 1, 3, 3]]  # the corners, (k, 1, 4)
+    left = orientation * (ex[..., None] * (cy - y[..., None]) - ey[..., None] * (cx - x[..., None]))
+    edge = (ex != 0.0) | (ey != 0.0)
+    apart = np.any(np.all(left <= 0.0, axis=2) & edge, axis=1)
+    contains = (orientation[:, 0, 0] != 0.0) & np.all((left >= 0.0) | ~edge[..., None], axis=(1, 2))
+    return apart, contains
+
+
+def _paired_overlap(poly: np.ndarray, box: np.ndarray) -> np.ndarray:
+    """Areas of convex polygons (k, K, 2) inside boxes (k, 4), paired: (k,).
+
+    Green's theorem over the polygon's edges: each edge's part within the box's x range adds its
+    integral of the height of the box below the edge (its y clamped to the box), signed by its
+    direction. Shapes that share no area get exactly 0, a contained box exactly its area.
+    """
+    x, y = poly[..., 0], poly[..., 1]
+    following = np.roll(np.arange(poly.shape[1]), -1)
+    qx, qy = x[:, following], y[:, following]
+    lo, hi = box[:, 0, None], box[:, 2, None]
+    u, v = np.minimum(np.maximum(x, lo), hi), np.minimum(np.maximum(qx, lo), hi)
+    dx = qx - x
+    slope = (qy - y) / np.where(dx != 0.0, dx, 1.0)
+    # The edge's y at u and at v, each above the box's bottom and above its top: (k, K, 2, 2).
+    above = (y[..., None] + (np.stack([u, v], axis=-1) - x[..., None]) * slope[..., None])[..., None] \
+        - box[:, None, None, [1, 3]]
+    mean = _relu_mean(above[..., 0, :], above[..., 1, :])
+    inside = mean[..., 0] - mean[..., 1]
+    apart, contains = _relation(x, y, qx, qy, box)
+    full = (box[:, 2] - box[:, 0]) * (box[:, 3] - box[:, 1])
+    return np.where(apart, 0.0, np.where(contains, full, np.abs(np.sum((u - v) * inside, axis=1))))
+
+
+def _touching(lo: np.ndarray, hi: np.ndarray, rects: np.ndarray) -> np.ndarray:
+    """Whether boxes [lo, hi] (..., 2) and rectangles (..., 4) overlap (broadcast)."""
+    return ((lo[..., 0] < rects[..., 2]) & (hi[..., 0] > rects[..., 0])
+            & (lo[..., 1] < rects[..., 3]) & (hi[..., 1] > rects[..., 1]))
 
 
 def convex_rect_overlap(polygons: np.ndarray, rects: np.ndarray) -> np.ndarray:
     """Exact areas of convex polygons (n, K, 2) inside rectangles (m, 4): (n, m).
 
-    Only pairs whose bounding boxes overlap are clipped, so sparse scenes stay cheap.
+    Only pairs whose bounding boxes overlap are measured, so sparse scenes stay cheap.
     """
     poly = np.asarray(polygons, float)
     r = np.asarray(rects, float).reshape(-1, 4)
+    areas = np.zeros((len(poly), len(r)))
+    if len(poly) == 0:
+        return areas
     lo, hi = poly.min(axis=1), poly.max(axis=1)
-    touching = (
-        (lo[:, None, 0] < r[None, :, 2]) & (hi[:, None, 0] > r[None, :, 0])
-        & (lo[:, None, 1] < r[None, :, 3]) & (hi[:, None, 1] > r[None, :, 1])
-    )
-    i, j = np.nonzero(touching)
-    areas = np.zeros(touching.shape)
+    near = np.flatnonzero(_touching(lo.min(axis=0), hi.max(axis=0), r))  # rectangles within reach of any
+    i, j = np.nonzero(_touching(lo[:, None], hi[:, None], r[near][None]))
     if len(i) == 0:
         return areas
-    clipped, box = poly[i], r[j]
-    for axis, column, above in ((0, 0, True), (0, 2, False), (1, 1, True), (1, 3, False)):
-        clipped = _clip(clipped, axis, box[:, column], above)
-    x, y = clipped[..., 0], clipped[..., 1]
-    areas[i, j] = 0.5 * np.abs(np.sum(x * np.roll(y, -1, axis=-1) - np.roll(x, -1, axis=-1) * y, axis=-1))
+    j = near[j]
+    areas[i, j] = _paired_overlap(poly[i], r[j])
     return areas
 
 

@@ -15,6 +15,7 @@ from hlp_drake.taskspace.rect import Rect
 
 ALPHA = 1.5  # scaling factor of the direction blocks (the original's scaling_factor)
 WALL_THICKNESS = 0.05  # virtual walls just outside the table edges, m
+WALLS = ("back", "left", "right", "front")
 
 
 @dataclass(frozen=True)
@@ -66,6 +67,23 @@ class Node:
         return self.obstacle if self.kind == "object" else str(self.gap)
 
 
+@dataclass(frozen=True, eq=False)
+class GapTable:
+    """Every gap of a task space as arrays (the fields of ``Gap``), rows in order, left to right."""
+
+    row: np.ndarray
+    index: np.ndarray
+    bounds: np.ndarray
+    left: tuple[str | None, ...]
+    right: tuple[str | None, ...]
+
+    @property
+    def centers(self) -> np.ndarray:
+        """(n, 2) centres, as ``Rect.center``."""
+        b = self.bounds
+        return np.column_stack([(b[:, 0] + b[:, 2]) / 2.0, (b[:, 1] + b[:, 3]) / 2.0])
+
+
 def rect_array(rects: list[Rect] | tuple[Rect, ...]) -> np.ndarray:
     """(n, 4) array of (x_min, y_min, x_max, y_max)."""
     return np.array([(r.x_min, r.y_min, r.x_max, r.y_max) for r in rects], dtype=float).reshape(-1, 4)
@@ -75,7 +93,7 @@ def overlap_areas(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Overlap areas of rectangle arrays ``a`` (..., 4) and ``b`` (..., 4), broadcast."""
     dx = np.minimum(a[..., 2], b[..., 2]) - np.maximum(a[..., 0], b[..., 0])
     dy = np.minimum(a[..., 3], b[..., 3]) - np.maximum(a[..., 1], b[..., 1])
-    return np.clip(dx, 0.0, None) * np.clip(dy, 0.0, None)
+    return np.maximum(dx, 0.0) * np.maximum(dy, 0.0)
 
 
 # Per direction (order DIRECTIONS): which of (x_min, x_max, x_max + alpha*depth, x_min - alpha*depth)
@@ -133,8 +151,9 @@ class TaskSpace:
                  wall_thickness: float = WALL_THICKNESS) -> None:
         self.scene = scene
         self.alpha = alpha
-        self.rows: list[Row] = find_rows(scene, row_tolerance)
-        self.rects: dict[str, Rect] = {o.name: Rect(*footprint_bounds(o)) for o in scene.objects}
+        bounds = {o.name: footprint_bounds(o) for o in scene.objects}
+        self.rows: list[Row] = find_rows(scene, row_tolerance, bounds)
+        self.rects: dict[str, Rect] = {name: Rect(*b) for name, b in bounds.items()}
         x0, y0, x1, y1 = scene.table.bounds
         t = wall_thickness
         self.walls: dict[str, Rect] = {
@@ -153,22 +172,54 @@ class TaskSpace:
         return [o.name for o in self.scene.obstacles]
 
     @cached_property
-    def gaps(self) -> list[list[Gap]]:
-        """Gaps per row (list index = row index - 1), left to right; empty intervals are skipped."""
-        y_left, y_right = self.scene.table.width / 2.0, -self.scene.table.width / 2.0
-        result = []
+    def obstacle_bounds(self) -> np.ndarray:
+        """(n_obstacles, 4) rectangles of the obstacles, in scene order."""
+        return rect_array([self.rects[n] for n in self.obstacle_names])
+
+    @cached_property
+    def obstacle_index(self) -> dict[str, int]:
+        """Each obstacle's position in scene order."""
+        return {n: i for i, n in enumerate(self.obstacle_names)}
+
+    @cached_property
+    def obstacle_rows(self) -> np.ndarray:
+        """(n_obstacles,) row index of each obstacle, in scene order."""
+        rows = np.zeros(len(self.obstacle_index), dtype=int)
         for row in self.rows:
+            rows[[self.obstacle_index[n] for n in row.members]] = row.index
+        return rows
+
+    @cached_property
+    def gap_table(self) -> GapTable:
+        """Every gap as arrays, rows in order (nearest first), left to right; empty intervals skipped."""
+        y_left, y_right = self.scene.table.width / 2.0, -self.scene.table.width / 2.0
+        row, index, bounds, left, right = [], [], [], [], []
+        for r in self.rows:
             edges: list[tuple[float, str | None]] = [(y_left, None)]
-            for name in row.members:  # left to right
+            for name in r.members:  # left to right
                 rect = self.rects[name]
                 edges += [(rect.y_max, name), (rect.y_min, name)]
             edges.append((y_right, None))
-            gaps = []
-            for (y_hi, left), (y_lo, right) in zip(edges[0::2], edges[1::2]):
+            count = 0
+            for (y_hi, name_left), (y_lo, name_right) in zip(edges[0::2], edges[1::2]):
                 if y_hi - y_lo > 0.0:
-                    rect = Rect(row.x_min, y_lo, row.x_max, y_hi)
-                    gaps.append(Gap(row.index, len(gaps) + 1, rect, left, right))
-            result.append(gaps)
+                    count += 1
+                    row.append(r.index)
+                    index.append(count)
+                    bounds.append((r.x_min, y_lo, r.x_max, y_hi))
+                    left.append(name_left)
+                    right.append(name_right)
+        return GapTable(np.array(row, dtype=int), np.array(index, dtype=int),
+                        np.array(bounds, dtype=float).reshape(-1, 4), tuple(left), tuple(right))
+
+    @cached_property
+    def gaps(self) -> list[list[Gap]]:
+        """Gaps per row (list index = row index - 1), left to right; empty intervals are skipped."""
+        table = self.gap_table
+        result: list[list[Gap]] = [[] for _ in self.rows]
+        for k, (row, index) in enumerate(zip(table.row.tolist(), table.index.tolist())):
+            rect = Rect(*table.bounds[k].tolist())
+            result[row - 1].append(Gap(row, index, rect, table.left[k], table.right[k]))
         return result
 
     def nodes(self, row: int) -> list[Node]:
@@ -188,13 +239,18 @@ class TaskSpace:
         """The eight direction blocks around object ``name``."""
         return direction_blocks(self.rects[name], self.alpha)
 
-    def occluders(self, *, target: bool = False, walls: tuple[str, ...] = ("back", "left", "right", "front"),
+    def occluders(self, *, target: bool = False, walls: tuple[str, ...] = WALLS,
                   exclude: tuple[str, ...] = ()) -> list[Rect]:
         """Obstacle rectangles (and the target's, and the named walls), minus ``exclude``."""
         names = [n for n in self.obstacle_names if n not in exclude]
         if target:
             names.append(self.scene.target.name)
         return [self.rects[n] for n in names] + [self.walls[w] for w in walls]
+
+    def occluder_bounds(self, *, target: bool = False, walls: tuple[str, ...] = WALLS) -> np.ndarray:
+        """``occluders`` (nothing excluded) as an (m, 4) array."""
+        extra = ([self.target] if target else []) + [self.walls[w] for w in walls]
+        return np.vstack([self.obstacle_bounds, rect_array(extra)])
 
     def free_space(self, name: str, occluders: list[Rect] | None = None) -> np.ndarray:
         """Free fraction of each direction block of ``name`` (order ``DIRECTIONS``)."""

@@ -124,6 +124,15 @@ class Keyframes:
         )
 
 
+def _grandparents(plant, robot) -> list[tuple]:
+    """(body, its parent's parent) for every body of model instance ``robot`` that has one."""
+    parent = {}
+    for index in plant.GetJointIndices(robot):
+        joint = plant.get_joint(index)
+        parent[joint.child_body().index()] = joint.parent_body().index()
+    return [(plant.get_body(child), plant.get_body(parent[p])) for child, p in parent.items() if p in parent]
+
+
 def _describe(index: int, keypoint: PlanKeypoint) -> str:
     element = f" {keypoint.element}" if keypoint.element else ""
     x, y = keypoint.position
@@ -157,13 +166,17 @@ class KeypointIk(LeafSystem):
         # Robot-object contact is allowed (objects may be pushed): hide those pairs from the IK's
         # distance constraint in this private context only; the model keeps them for other queries.
         scene_graph_context = self._model.scene_graph.GetMyMutableContextFromRoot(self._model.context)
-        # The robot's own links are left out too: the distance constraint is robot-vs-table only.
-        robot_geometries = GeometrySet(self._model.robot_geometries())
-        self._model.scene_graph.collision_filter_manager(scene_graph_context).Apply(
-            CollisionFilterDeclaration()
-            .ExcludeBetween(robot_geometries, GeometrySet(self._model.object_geometries()))
-            .ExcludeWithin(robot_geometries)
+        # The distance constraint is then robot-vs-table and robot-vs-robot, less the links one joint
+        # apart (the plant's own filter) or two (by design within a few mm, e.g. forearm and wrist 2).
+        declaration = CollisionFilterDeclaration().ExcludeBetween(
+            GeometrySet(self._model.robot_geometries()), GeometrySet(self._model.object_geometries())
         )
+        for body, grandparent in _grandparents(plant, robot):
+            declaration.ExcludeBetween(
+                GeometrySet(plant.GetCollisionGeometriesForBody(body)),
+                GeometrySet(plant.GetCollisionGeometriesForBody(grandparent)),
+            )
+        self._model.scene_graph.collision_filter_manager(scene_graph_context).Apply(declaration)
         self._start = start_configuration(scene, plant, robot, config=self._config)
         self._names = robot_position_names()
         self._index = {name: plant.GetJointByName(name, robot).position_start() for name in self._names}
@@ -274,7 +287,8 @@ class KeypointIk(LeafSystem):
         )
 
     def _target(self, keypoint: PlanKeypoint) -> np.ndarray:
-        return np.array([keypoint.position[0], keypoint.position[1], self._height], dtype=float)
+        height = self._height if keypoint.height is None else self._scene.table.height + keypoint.height
+        return np.array([keypoint.position[0], keypoint.position[1], height], dtype=float)
 
     def _shifted(self, reference: np.ndarray, target: np.ndarray) -> np.ndarray:
         """``reference`` with the base moved by the tcp's offset to ``target`` (clipped to the bounds)."""
@@ -376,19 +390,22 @@ class KeypointIk(LeafSystem):
     def trajectory(self, keyframes: Keyframes) -> PiecewisePolynomial:
         """The first-order hold from the start through ``keyframes``' successful keyframes."""
         motion = self._config.motion
-        knots = [self._start]
-        for q, ok in zip(keyframes.positions, keyframes.success):
+        knots, lifted = [self._start], [False]
+        for q, ok, keypoint in zip(keyframes.positions, keyframes.success, keyframes.keypoints):
             if ok and np.max(np.abs(q - knots[-1])) > 1e-9:
                 knots.append(q)
+                lifted.append(keypoint.height is not None)  # lifted clear of the objects
         if len(knots) == 1:
             knots.append(self._start)  # hold the start
+            lifted.append(False)
         times = [0.0]
         tcp = [self.tcp_position(q) for q in knots]
         for i in range(1, len(knots)):
             joint_time = np.max(
                 np.abs(knots[i] - knots[i - 1]) / (motion.joint_speed_fraction * self._velocity_limits)
             )
-            tcp_time = np.linalg.norm(tcp[i] - tcp[i - 1]) / motion.tcp_speed
+            speed = motion.transit_speed if lifted[i] or lifted[i - 1] else motion.tcp_speed
+            tcp_time = np.linalg.norm(tcp[i] - tcp[i - 1]) / speed
             times.append(times[-1] + max(motion.min_segment_duration, float(joint_time), float(tcp_time)))
         return PiecewisePolynomial.FirstOrderHold(times, np.column_stack(knots))
 

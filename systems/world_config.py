@@ -160,11 +160,13 @@ class IkConfig:
 class MotionConfig:
     """Timing of the joint trajectory through the keyframes (straight lines in joint space).
 
-    A segment lasts the longest of: its tcp path length over ``tcp_speed``, each joint's travel over
+    A segment lasts the longest of: its tcp path length over ``tcp_speed`` (``transit_speed`` on the
+    way to or from a waypoint lifted clear of the objects), each joint's travel over
     ``joint_speed_fraction`` of its velocity limit, and ``min_segment_duration``.
     """
 
     tcp_speed: float = 0.1
+    transit_speed: float = 0.25
     joint_speed_fraction: float = 0.5
     min_segment_duration: float = 0.25
 
@@ -256,6 +258,7 @@ def config_problems(config: WorldConfig) -> list[str]:
             f"ik.max_iterations and ik.attempts must be >= 1, got {ik.max_iterations}, {ik.attempts}"
         )
     positive("motion.tcp_speed", config.motion.tcp_speed)
+    positive("motion.transit_speed", config.motion.transit_speed)
     positive("motion.joint_speed_fraction", config.motion.joint_speed_fraction)
     positive("motion.min_segment_duration", config.motion.min_segment_duration)
     sto, grasp = config.sto, config.grasp

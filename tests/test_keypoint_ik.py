@@ -220,3 +220,39 @@ def test_tcp_reaches_0_95_m_past_the_front_edge_and_the_edge_itself(height):
     assert_reaches(keyframes, plan, height + CONFIG.ik.height)
     # The base stays outside the table's footprint.
     assert np.all(keyframes.positions[:, 0] + BASE_FOOTPRINT[0] / 2.0 <= CONFIG.ik.base_under_table + 1e-6)
+
+
+def test_transit_keypoints_are_reached_at_their_height_and_timed_at_the_transit_speed(system, scene):
+    gap = gap_centres(scene)[0]
+    height = 0.25
+    plan = HighLevelPlan(scene=scene.name, keypoints=(
+        PlanKeypoint("start", scene.start),
+        PlanKeypoint("transit", scene.start, height=height),
+        PlanKeypoint("transit", gap, height=height),
+        PlanKeypoint("gap", gap, row=0, element="0"),
+    ))
+    keyframes, trajectory = evaluate(system, plan)
+    assert keyframes.ok, keyframes.failures
+    z = keyframes.tcp_positions[:, 2] - scene.table.height
+    np.testing.assert_allclose(z, [CONFIG.ik.height, height, height, CONFIG.ik.height], atol=0.005)
+    np.testing.assert_allclose(keyframes.tcp_positions[1:3, :2], [scene.start, gap], atol=0.005)
+    # Segments to, between and from transit waypoints may go at the transit speed, not slower.
+    breaks = trajectory.get_segment_times()
+    paths = np.linalg.norm(np.diff(keyframes.tcp_positions, axis=0), axis=1)
+    slow = [max(p / CONFIG.motion.tcp_speed, CONFIG.motion.min_segment_duration) for p in paths]
+    assert any(d < s - 1e-3 for d, s in zip(np.diff(breaks), slow))
+    for d, p in zip(np.diff(breaks), paths):
+        assert d >= p / CONFIG.motion.transit_speed - 1e-9
+
+
+def test_keyframes_keep_the_robot_clear_of_itself(system, scene, solved):
+    """The IK's distance constraint includes the robot's own links (all but adjacent ones)."""
+    keyframes, _ = solved
+    model = system.planning_model
+    robot = set(model.robot_geometries())
+    for q in keyframes.positions:
+        model.plant.SetPositions(model.plant_context, model.robot, q)
+        query = model.scene_graph.get_query_output_port().Eval(model.scene_graph.GetMyContextFromRoot(model.context))
+        pairs = [p for p in query.ComputeSignedDistancePairwiseClosestPoints(0.05) if p.id_A in robot and p.id_B in robot]
+        assert pairs, "the robot's self pairs should be checked"
+        assert min(p.distance for p in pairs) >= CONFIG.ik.table_clearance - 1e-4

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 
 import numpy as np
 import pytest
@@ -19,13 +20,22 @@ from hlp_drake.taskspace import DIRECTION_VECTORS, TaskSpace
 
 
 def test_push_transfer_puts_the_tcp_behind_the_obstacle():
-    scene = generate_scene("vr", 1)
+    scene = generate_scene("vr", 0)
     human = plan(scene, default_models())
     robot = robot_plan(human, scene)
     space = TaskSpace(scene)
-    assert [k.action for k in robot.keypoints] == [k.action for k in human.keypoints]
+    assert [k.action for k in robot.keypoints if k.action != "transit"] == [k.action for k in human.keypoints]
+    lifted = max(o.size[2] for o in scene.objects) + 0.07
+    transits = [i for i, k in enumerate(robot.keypoints) if k.action == "transit"]
+    # The second push's start is free to come down on, the first one's is not (an object under the arm).
+    assert [robot.keypoints[i + 1].action for i in transits[1::2]] == ["move"] and len(transits) == 2
+    for i in transits[1::2]:  # lifted above the previous waypoint, then above the push start
+        before, up, over, push = robot.keypoints[i - 2:i + 2]
+        assert (up.position, over.position) == (before.position, push.position)
+        assert up.height == over.height == pytest.approx(lifted)
     for k in robot.keypoints:
         if k.action == "move":
+            assert k.height is None
             rect, unit = space.rects[k.element], np.array(DIRECTION_VECTORS[k.direction], float)
             assert k.direction not in ("BB", "BL", "BR")  # the robot only pushes away or sideways
             # The push starts outside the obstacle, on the side opposite the push.
@@ -138,3 +148,113 @@ def scene_with_one_obstacle(scene):
     obstacle = replace(scene.obstacles[0], x=scene.table.length / 2, y=0.0)
     target = replace(scene.target, x=scene.table.length * 0.85, y=0.0)
     return replace(scene, obstacles=(obstacle,), target=target)
+
+
+def test_a_backward_move_becomes_the_sideways_push_that_clears_the_corridor():
+    from hlp_drake.planner.transfer import _robot_direction
+
+    scene = generate_scene("gen1", 14)
+    space = TaskSpace(scene)
+    # Long lies right of the start-target line (y = 0) with Short close on its right: pushed right it
+    # moves 4 cm out of the corridor, pushed left it would cross the line. Both count as backward.
+    assert scene.start[1] == scene.target.y == 0.0
+    long = space.rects["FailOnTouchObstacleLong"]
+    assert long.center[1] < 0.0 < long.y_max
+    for direction in ("BL", "BR", "BB"):
+        assert _robot_direction(space, scene, "FailOnTouchObstacleLong", direction) == "RR"
+    # On the left of the line, with room on both sides, it goes left whatever the person's side.
+    assert {_robot_direction(space, scene, "FailOnTouchObstacleMed", d) for d in ("BL", "BR", "BB")} == {"LL"}
+    # Forward and sideways moves are kept.
+    assert _robot_direction(space, scene, "FailOnTouchObstacleLong", "LL") == "LL"
+    assert _robot_direction(space, scene, "FailOnTouchObstacleLong", "FR") == "FR"
+
+
+def _websocket_frames(url: str, *, seconds: float) -> bytes:
+    """Every payload a WebSocket server at ``url`` (ws://host:port) sends in ``seconds`` (a minimal
+    client: the upgrade handshake, then unmasked server frames read until the time is up)."""
+    import base64
+    import os
+    import socket
+    import time
+
+    host, port = url.removeprefix("ws://").split(":")
+    with socket.create_connection((host, int(port)), timeout=seconds) as sock:
+        key = base64.b64encode(os.urandom(16)).decode()
+        sock.sendall((f"GET / HTTP/1.1\r\nHost: {host}:{port}\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                      f"Sec-WebSocket-Key: {key}\r\nSec-WebSocket-Version: 13\r\n\r\n").encode())
+        data, deadline = b"", time.monotonic() + seconds
+        while time.monotonic() < deadline:
+            sock.settimeout(max(deadline - time.monotonic(), 0.01))
+            try:
+                chunk = sock.recv(1 << 16)
+            except socket.timeout:
+                break
+            if not chunk:
+                break
+            data += chunk
+    header, _, frames = data.partition(b"\r\n\r\n")
+    assert header.startswith(b"HTTP/1.1 101"), header[:100]
+    payloads, i = b"", 0
+    while i + 2 <= len(frames):
+        length, i = frames[i + 1] & 0x7F, i + 2
+        if length == 126:
+            length, i = int.from_bytes(frames[i:i + 2], "big"), i + 2
+        elif length == 127:
+            length, i = int.from_bytes(frames[i:i + 8], "big"), i + 8
+        payloads += frames[i:i + length]
+        i += length
+    return payloads
+
+
+def test_run_scene_meshcat_serves_the_run_live(tmp_path):
+    """``--meshcat``: the URL is printed, the viewer page is served, a browser's WebSocket receives
+    the robot, the objects and the plan's keypoints, and Ctrl-C ends the run cleanly."""
+    import signal
+    import subprocess
+    import sys
+    import urllib.request
+
+    out = tmp_path / "run.json"
+    process = subprocess.Popen(
+        [sys.executable, "-m", "hlp_drake.run_scene", "--meshcat", "--workers", "1", "--json", str(out)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        env={**os.environ, "DRAKE_ALLOW_NETWORK": "meshcat"})
+    try:
+        lines = []
+        for line in process.stdout:
+            lines.append(line)
+            if "keeps serving" in line:
+                break
+        url = next((line.split("MeshCat: ")[1].strip() for line in lines if line.startswith("MeshCat: ")), None)
+        if url is None:
+            pytest.skip(f"MeshCat did not start here: {process.stderr.read() if process.poll() is not None else lines}")
+        page = urllib.request.urlopen(url, timeout=10).read()
+        assert b"<title>Drake MeshCat</title>" in page
+        scene_tree = _websocket_frames(url.replace("http://", "ws://"), seconds=3.0)
+        for path in (b"/drake/plan/00_start", b"/drake/plan/", b"mobile_ur5", b"Target", b"table"):
+            assert path in scene_tree, path
+        process.send_signal(signal.SIGINT)
+        assert process.wait(timeout=30) == 0
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert json.loads(out.read_text())["success"] is True
+
+
+def test_transit_goes_over_the_objects_where_the_arm_can_come_down():
+    from hlp_drake.planner.plan import PlanKeypoint
+    from hlp_drake.planner.transfer import ARM_SHADOW_LENGTH, transit
+    from hlp_drake.taskspace import Rect
+
+    previous = PlanKeypoint("release", (0.30, -0.20), row=0, element="a")
+    push = PlanKeypoint("move", (0.60, 0.20), row=1, element="b", direction="RR")
+    # Nothing under the arm at the push start: up, across, and straight down onto it.
+    beside = [Rect(0.10, -0.50, 0.15, -0.40), Rect(0.40, 0.27, 0.45, 0.35), Rect(0.62, 0.15, 0.70, 0.25)]
+    up, over = transit(previous, push, 0.25, beside)
+    assert (up.position, over.position) == (previous.position, push.position)
+    assert up.action == over.action == "transit" and up.height == over.height == 0.25
+    assert (over.row, over.element) == (push.row, push.element)
+    # An object under the wrist there: no transit, the push start is reached at push height.
+    assert transit(previous, push, 0.25, [*beside, Rect(0.40, 0.25, 0.45, 0.30)]) == []
+    assert transit(previous, push, 0.25, [Rect(0.60 - ARM_SHADOW_LENGTH - 0.05, 0.1, 0.60 - ARM_SHADOW_LENGTH + 0.01, 0.3)]) == []
+    assert len(transit(previous, push, 0.25, [Rect(0.60 - ARM_SHADOW_LENGTH - 0.05, 0.1, 0.60 - ARM_SHADOW_LENGTH - 0.01, 0.3)])) == 2

@@ -16,13 +16,17 @@ class PlanKeypoint:
 
     Attributes:
         action: "start"; "gap" (pass through a gap); "move" (reach an obstacle and push/carry it);
-            "release" (where the moved obstacle is left); "target" (reach the target).
+            "release" (where the moved obstacle is left); "target" (reach the target). A robot's
+            plan (``planner.transfer.robot_plan``) adds "transit": a waypoint lifted clear of the
+            objects on the way to a push.
         position: (x, y) of the hand, m.
         row: the row the keypoint belongs to (None for start and target).
         element: the obstacle's name for "move"/"release", the gap's index (from the left, as text)
             for "gap", the target's name for "target", None for the start.
         direction: the direction class the obstacle is moved towards ("move"/"release" only).
         arm: the predicted human-like (shoulder, elbow) angles at this keypoint, radians.
+        height: the hand's height above the table top, m, where it differs from the robot's usual
+            keypoint height (``IkConfig.height``); None otherwise.
     """
 
     action: str
@@ -31,12 +35,13 @@ class PlanKeypoint:
     element: str | None = None
     direction: str | None = None
     arm: tuple[float, float] | None = None
+    height: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return {
             "action": self.action, "x": self.position[0], "y": self.position[1], "row": self.row,
             "element": self.element, "direction": self.direction,
-            "arm": None if self.arm is None else list(self.arm),
+            "arm": None if self.arm is None else list(self.arm), "height": self.height,
         }
 
 

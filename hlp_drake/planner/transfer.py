@@ -4,8 +4,16 @@ A person picks an obstacle up; the robot pushes it with the side of its gripper,
 horizontally from the start's side. So a "move" keypoint (the obstacle's centre in the plan)
 becomes the point just behind the obstacle's face opposite the push direction, and the "release"
 keypoint the same point once the obstacle's centre has reached its new place. The robot cannot
-pull an obstacle towards itself: backward directions (BB, BL, BR) become the sideways push of
-their side (BL -> LL, BR -> RR, BB -> the freer of LL and RR).
+pull an obstacle towards itself: a backward direction (BB, BL, BR) becomes the sideways push (LL or
+RR) that leaves the least of the obstacle in the corridor along the straight start-target line (a
+person lifts the obstacle back over the table; pushed sideways into the corridor it would block the
+way), the side the obstacle lies on when both leave the same.
+
+A person lifts their hand over the table on the way to an obstacle; a robot arm moving sideways at
+push height would sweep its forearm through everything between the base and the gripper. So the
+way to each push start goes over the objects: two "transit" waypoints ``TRANSIT_CLEARANCE`` over
+the tallest object, above the previous waypoint and above the push start, where the arm comes
+down, if nothing lies under the arm there (else the push start is reached directly).
 """
 
 from __future__ import annotations
@@ -17,25 +25,60 @@ import numpy as np
 from hlp_drake.planner.plan import HighLevelPlan, PlanKeypoint
 from hlp_drake.planner.relocation import relocated
 from hlp_drake.scene.model import Scene
-from hlp_drake.taskspace import DIRECTION_VECTORS, TaskSpace
+from hlp_drake.taskspace import DIRECTION_VECTORS, Rect, TaskSpace
 
 # Gap between the obstacle's face and the tcp at the push start: the fingertips reach ~1 cm ahead
 # of the tcp, the open fingers' outer sides ~5.5 cm beside it; plus 2 cm of free approach.
 FORWARD_CLEARANCE = 0.03
 SIDEWAYS_CLEARANCE = 0.075
-ROBOT_DIRECTIONS = {"BL": "LL", "BR": "RR"}
+BACKWARD = ("BB", "BL", "BR")
+# Half-width of the corridor along the start-target line that a backward move should clear: the open
+# gripper's half-width (5.5 cm) plus 2.5 cm.
+CORRIDOR_HALF_WIDTH = 0.08
 # A pushed obstacle stops this far short of the table's edge and of the other objects: a person
 # lifts an obstacle over its neighbours, a pushing robot would shove them along (or off the table).
 EDGE_MARGIN = 0.03
 OBJECT_MARGIN = 0.01
 TRAVEL_STEP = 0.005
+# The tcp's height over the tallest object on transit waypoints: the palm reaches 3 cm below the tcp
+# when the fingers open sideways, the wrist ~5 cm; plus 2 cm.
+TRANSIT_CLEARANCE = 0.07
+# Under the arm at push height: the tcp, the fingers and palm (14 cm behind it) and the wrist
+# (another ~20 cm), the wrist's half-width plus 1.5 cm to the sides. The arm only comes down where
+# nothing lies there: pressing it down onto an object would crush it into the table.
+ARM_SHADOW_LENGTH = 0.35
+ARM_SHADOW_HALF_WIDTH = 0.06
 
 
-def _robot_direction(space: TaskSpace, name: str, direction: str) -> str:
-    if direction == "BB":
-        free = dict(zip(("FF", "BB", "LL", "RR", "FR", "FL", "BR", "BL"), space.free_space(name)))
-        return "LL" if free["LL"] >= free["RR"] else "RR"
-    return ROBOT_DIRECTIONS.get(direction, direction)
+def _robot_direction(space: TaskSpace, scene: Scene, name: str, direction: str) -> str:
+    """The robot's push direction for a person's move of obstacle ``name`` towards ``direction``."""
+    if direction not in BACKWARD:
+        return direction
+    start = np.asarray(scene.start, float)
+    line = np.array([scene.target.x, scene.target.y]) - start
+    normal = np.array([-line[1], line[0]]) / np.linalg.norm(line)
+    rect = space.rects[name]
+    corners = np.array([[x, y] for x in (rect.x_min, rect.x_max) for y in (rect.y_min, rect.y_max)])
+    away = "LL" if float(np.dot(np.array(rect.center) - start, normal)) >= 0 else "RR"
+
+    def blocking(side: str) -> float:  # how much of the corridor the obstacle still covers after the push
+        unit = _unit(side)
+        lateral = (corners + push_travel(space, scene, name, unit, _wanted(space, name, side)) * unit - start) @ normal
+        return max(0.0, min(lateral.max(), CORRIDOR_HALF_WIDTH) - max(lateral.min(), -CORRIDOR_HALF_WIDTH))
+
+    return min((away, "RR" if away == "LL" else "LL"), key=blocking)
+
+
+def _unit(direction: str) -> np.ndarray:
+    unit = np.array(DIRECTION_VECTORS[direction], float)
+    return unit / np.linalg.norm(unit)
+
+
+def _wanted(space: TaskSpace, name: str, direction: str) -> float:
+    """How far obstacle ``name``'s centre moves along ``direction`` to its relocated place."""
+    rect = space.rects[name]
+    shift = np.subtract(relocated(rect, direction, space.alpha).center, rect.center)
+    return max(float(np.dot(shift, _unit(direction))), 0.0)
 
 
 def push_travel(space: TaskSpace, scene: Scene, name: str, unit: np.ndarray, wanted: float) -> float:
@@ -60,26 +103,53 @@ def push_travel(space: TaskSpace, scene: Scene, name: str, unit: np.ndarray, wan
 
 
 def robot_plan(plan: HighLevelPlan, scene: Scene) -> HighLevelPlan:
-    """The plan with each move/release pair turned into the push's start and end points."""
+    """The plan with each move/release pair turned into the push's start and end points, each push
+    start reached over the objects where the arm can come down there (see ``transit``)."""
     if not plan.ok:
         return plan
     space = TaskSpace(scene)
+    placed = dict(space.rects)  # the objects' footprints as the pushes so far leave them
     keypoints: list[PlanKeypoint] = []
     for k in plan.keypoints:
         if k.action not in ("move", "release") or k.element not in space.rects:
             keypoints.append(k)
             continue
         rect = space.rects[k.element]
-        direction = _robot_direction(space, k.element, k.direction)
-        unit = np.array(DIRECTION_VECTORS[direction], float)
-        unit /= np.linalg.norm(unit)
+        direction = _robot_direction(space, scene, k.element, k.direction)
+        unit = _unit(direction)
         # Distance from the centre to the face opposite the push, along the push direction.
         clearance = abs(unit[0]) * FORWARD_CLEARANCE + abs(unit[1]) * SIDEWAYS_CLEARANCE
         reach = abs(unit[0]) * rect.depth / 2.0 + abs(unit[1]) * rect.width / 2.0 + clearance
         centre = np.array(rect.center)
         if k.action == "release":  # towards the relocated place, short of the edge and the others
-            wanted = float(np.dot(np.subtract(relocated(rect, direction, space.alpha).center, centre), unit))
-            centre = centre + push_travel(space, scene, k.element, unit, max(wanted, 0.0)) * unit
+            shift = push_travel(space, scene, k.element, unit, _wanted(space, k.element, direction)) * unit
+            centre = centre + shift
+            placed[k.element] = Rect(rect.x_min + shift[0], rect.y_min + shift[1], rect.x_max + shift[0],
+                                     rect.y_max + shift[1])
         point = centre - reach * unit
-        keypoints.append(replace(k, position=(float(point[0]), float(point[1])), direction=direction))
+        push = replace(k, position=(float(point[0]), float(point[1])), direction=direction)
+        if k.action == "move" and keypoints:
+            keypoints += transit(keypoints[-1], push, transit_height(scene), placed.values())
+        keypoints.append(push)
     return replace(plan, keypoints=tuple(keypoints))
+
+
+def transit_height(scene: Scene) -> float:
+    """The tcp's height above the table top on transit waypoints."""
+    return max(obj.size[2] for obj in scene.objects) + TRANSIT_CLEARANCE
+
+
+def arm_shadow(x: float, y: float) -> Rect:
+    """The table area under the gripper and wrist when the tcp is at (x, y) at push height."""
+    return Rect(x - ARM_SHADOW_LENGTH, y - ARM_SHADOW_HALF_WIDTH, x, y + ARM_SHADOW_HALF_WIDTH)
+
+
+def transit(previous: PlanKeypoint, push: PlanKeypoint, height: float, objects) -> list[PlanKeypoint]:
+    """The waypoints over the objects from ``previous`` to the push start ``push``: lifted above
+    ``previous`` and above the push start, from where the arm comes straight down. None if an
+    object lies under the arm at the push start (``arm_shadow``): the push start is then reached
+    directly, at push height."""
+    if any(arm_shadow(*push.position).overlap(o) > 0.0 for o in objects):
+        return []
+    return [PlanKeypoint("transit", point, push.row, push.element, height=height)
+            for point in (previous.position, push.position)]

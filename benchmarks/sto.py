@@ -1,12 +1,17 @@
 """Benchmarks of the stochastic trajectory optimiser (STO).
 
-    python benchmarks/sto.py [--out DIR] [--gen1 10] [--throughput-rollouts 16] [--skip-comparison]
+    python benchmarks/sto.py [--out DIR] [--gen1 10] [--throughput-rollouts 16] [--throughput-repeats 2]
+                             [--agreement-sequences 8] [--validation-scenes 2] [--skip-comparison]
 
 1. Rollout throughput: rollouts of a 3 s horizon per second on a 9-object Generalization II scene,
-   on 1 and on 2 worker processes (the same noisy sequences), and the real-time factor of one
-   rollout at the rollout time step and at the execution time step.
-2. The coarse rollout model against the full one: the same noisy sequences rolled out at the
-   rollout time step and at the execution time step; how often their success verdicts agree.
+   on 1 and on 2 worker processes (the same noisy sequences), with the full and with the reduced
+   rollout model (``sto.reduced_model``: unreachable objects welded) side by side, repeated; and
+   the real-time factor of one rollout at the rollout time steps and at the execution time step.
+2. The rollout models against each other: the same sequences (noisy copies of both planners'
+   initial sequences on the default scene, the throughput scene's noisy 3 s sequences, and both
+   planners' initial sequences with a noisy copy on Generalization I and II scenes) rolled out on
+   the full and the reduced model at each rollout time step, and on the full model at the
+   execution time step; how often the success verdicts agree, and how far the costs are apart.
 3. HLP-initialised vs straight-line-initialised optimisation, side by side in one run, on the
    bundled default scene and the Generalization I scenes of seeds 0..N-1: success (after execution)
    and optimisation time per scene, with medians, means and the ratio.
@@ -17,6 +22,7 @@ Writes ``DIR/sto_benchmark.json``, ``DIR/sto_comparison.csv`` and ``DIR/sto_comp
 from __future__ import annotations
 
 import argparse
+import copy
 import csv
 import json
 import os
@@ -32,7 +38,7 @@ from hlp_drake.scene.io import load_scene
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.execution import plan_and_execute
 from hlp_drake.systems.planning import make_planning_diagram
-from hlp_drake.systems.rollout import RolloutWorld
+from hlp_drake.systems.rollout import RolloutOutcome, RolloutWorld, SceneRollouts
 from hlp_drake.systems.rollout_pool import RolloutPool
 from hlp_drake.systems.sto import sample_base_noise
 from hlp_drake.systems.world_config import WorldConfig
@@ -41,11 +47,15 @@ DEFAULT_SCENE = Path(__file__).resolve().parents[1] / "hlp_drake" / "scenes" / "
 HORIZON = 3.0
 
 
-def initial_sequence(scene, planner: str, config: WorldConfig) -> ControlSequence:
+def initial_sequence(scene, planner: str, config: WorldConfig) -> ControlSequence | None:
+    """The planner's initial (IK) sequence on ``scene``; None if it has no trajectory at all."""
     diagram = make_planning_diagram(scene, planner=planner, config=config)
     context = diagram.CreateDefaultContext()
     diagram.GetInputPort("scene").FixValue(context, scene)
-    return ControlSequence.from_trajectory(diagram.GetOutputPort("trajectory").Eval(context), config.sto.step_duration)
+    trajectory = diagram.GetOutputPort("trajectory").Eval(context)
+    if trajectory.get_number_of_segments() == 0:
+        return None
+    return ControlSequence.from_trajectory(trajectory, config.sto.step_duration)
 
 
 def truncated(sequence: ControlSequence, horizon: float) -> ControlSequence:
@@ -60,55 +70,158 @@ def noisy(sequence: ControlSequence, config: WorldConfig, count: int, seed: int)
     return [sequence.with_base_velocity(v) for v in sample_base_noise(rng, sequence, config.sto.noise, count)]
 
 
-def throughput(count: int, steps: tuple[float, ...]) -> dict:
-    """Rollouts per second on 1 and 2 workers (same sequences) at each rollout time step, and the
-    real-time factor of one rollout at those steps and at the execution's."""
+def throughput_sequences(count: int) -> tuple:
+    """The throughput scene (gen2 seed 0, 9 obstacles), a configuration without settling, and
+    ``count`` noisy copies of the first ``HORIZON`` s of its straight-line initial sequence."""
     scene = generate_scene("gen2", 0, 9)
     config = WorldConfig()
     config.sto.settle_s = 0.0
     base = truncated(initial_sequence(scene, "sto", config), HORIZON)
-    sequences = noisy(base, config, count, seed=1)
-    result = {"scene": scene.name, "objects": len(scene.objects), "horizon_s": HORIZON, "rollouts": count}
-    for step in steps:
-        config.sto.rollout_time_step = step
-        entry = result[f"step_{step * 1000:g}ms"] = {}
-        for workers in (1, 2):
-            with RolloutPool(workers) as pool:
-                pool.rollouts(scene, config, sequences[:workers])  # build the worlds first
-                started = time.perf_counter()
-                outcomes = pool.rollouts(scene, config, sequences)
-                elapsed = time.perf_counter() - started
-            entry[f"workers_{workers}"] = {"rollouts_per_s": count / elapsed, "wall_s": elapsed,
-                                           "costs": [o.cost for o in outcomes]}
-        entry["same_costs_1_vs_2_workers"] = entry["workers_1"]["costs"] == entry["workers_2"]["costs"]
+    return scene, config, noisy(base, config, count, seed=1)
+
+
+def model_config(config: WorldConfig, step: float, reduced: bool) -> WorldConfig:
+    """``config`` with the rollout time step ``step`` and the reduced model on or off."""
+    config = copy.deepcopy(config)
+    config.sto.rollout_time_step = step
+    config.sto.reduced_model = reduced
+    return config
+
+
+def throughput(count: int, steps: tuple[float, ...], repeats: int) -> dict:
+    """Rollouts per second on 1 and 2 workers (same sequences), full and reduced model, at each
+    rollout time step, ``repeats`` times, each time on cold worlds (only the full one built) and then
+    on warm ones; the CPU time per rollout on 1 worker (in this process: less sensitive to other
+    load than the rate); and the real-time factor of one rollout at those steps and at the
+    execution's."""
+    scene, config, sequences = throughput_sequences(count)
+    result = {"scene": scene.name, "objects": len(scene.objects), "horizon_s": HORIZON, "rollouts": count,
+              "load_before": os.getloadavg()}
+    for repeat in range(repeats):
+        for step in steps:
+            for model in ("full", "reduced"):
+                cfg = model_config(config, step, model == "reduced")
+                entry = result.setdefault(f"step_{step * 1000:g}ms", {}).setdefault(model, {})
+                for workers in (1, 2):
+                    with RolloutPool(workers) as pool:
+                        pool.rollouts(scene, cfg, sequences[:workers])  # build the full worlds first
+                        for rerun in ("cold", "warm"):  # warm: every reduced world built by the cold pass
+                            started, cpu = time.perf_counter(), time.process_time()
+                            outcomes = pool.rollouts(scene, cfg, sequences)
+                            elapsed, cpu = time.perf_counter() - started, time.process_time() - cpu
+                            runs = entry.setdefault(f"workers_{workers}", {}).setdefault(rerun, [])
+                            runs.append({"rollouts_per_s": count / elapsed, "wall_s": elapsed,
+                                         "cpu_s_per_rollout": cpu / count if workers == 1 else None,
+                                         "load": os.getloadavg()[0],
+                                         "welded_mean": float(np.mean([len(o.welded) for o in outcomes])),
+                                         "switches": [o.switches for o in outcomes],
+                                         "costs": [o.cost for o in outcomes]})
+                runs = [run for w in (1, 2) for rerun in ("cold", "warm") for run in entry[f"workers_{w}"][rerun]]
+                entry["same_costs_everywhere"] = all(run["costs"] == runs[0]["costs"] for run in runs)
     for step in (*steps, WorldConfig().plant.time_step):
-        timed = WorldConfig()
-        timed.sto.settle_s = 0.0
-        timed.sto.rollout_time_step = step
-        world = RolloutWorld(scene, timed)
+        world = RolloutWorld(scene, model_config(config, step, False))
         world.rollout(sequences[0])
         walls = [world.rollout(s).wall_s for s in sequences[:4]]
         result.setdefault("real_time_factor", {})[f"{step * 1000:g}ms"] = HORIZON / float(np.median(walls))
     return result
 
 
-def model_agreement(count: int, steps: tuple[float, ...]) -> dict:
-    """Success verdicts of rollouts at each rollout time step vs the execution's, on the same noisy
-    sequences around both planners' initial trajectories of the default scene."""
-    scene = load_scene(DEFAULT_SCENE)
-    full_step = WorldConfig().plant.time_step
-    verdicts: dict[float, list[bool]] = {}
+def validation_sequences(count: int, scenes: int) -> list[tuple]:
+    """(scene, label, sequence, settle) triples for the model agreement (see the module's docstring;
+    ``count`` noisy copies per planner on the default scene, ``scenes`` Generalization I and II
+    scenes each); settle says whether the rollout settles after the sequence (the 3 s throughput
+    sequences do not)."""
+    default = load_scene(DEFAULT_SCENE)
+    triples = []
     for planner in ("hlp", "sto"):
-        sequences = noisy(initial_sequence(scene, planner, WorldConfig()), WorldConfig(), count, seed=2)
-        for step in (*steps, full_step):
-            cfg = WorldConfig()
-            cfg.sto.rollout_time_step = step
-            world = RolloutWorld(scene, cfg)
-            verdicts.setdefault(step, []).extend(world.rollout(s).success for s in sequences)
-    full = verdicts[full_step]
-    return {"scene": scene.name, "sequences": len(full), "successes_full_model": int(np.sum(full)),
-            **{f"step_{step * 1000:g}ms": {"agreement": float(np.mean([a == b for a, b in zip(verdicts[step], full)])),
-                                           "successes": int(np.sum(verdicts[step]))} for step in steps}}
+        for i, sequence in enumerate(noisy(initial_sequence(default, planner, WorldConfig()), WorldConfig(), count, seed=2)):
+            triples.append((default, f"default/{planner}/noisy{i}", sequence, True))
+    scene, _, sequences = throughput_sequences(2 * count)
+    triples += [(scene, f"throughput/noisy{i}", s, False) for i, s in enumerate(sequences)]
+    for kind, seed in [(kind, seed) for seed in range(scenes) for kind in ("gen1", "gen2")]:
+        scene = generate_scene(kind, seed, 9 if kind == "gen2" else None)
+        for planner in ("hlp", "sto"):
+            sequence = initial_sequence(scene, planner, WorldConfig())
+            if sequence is None:
+                print(f"{kind} seed {seed}, {planner}: no initial trajectory, left out")
+                continue
+            triples.append((scene, f"{kind}{seed}/{planner}", sequence, True))
+            triples.append((scene, f"{kind}{seed}/{planner}/noisy", noisy(sequence, WorldConfig(), 1, seed=3)[0], True))
+    return triples
+
+
+def nudged(sequence: ControlSequence, offset: float = 1e-6) -> ControlSequence:
+    """``sequence`` with the base's x shifted by ``offset`` m after the start (for the full model's own
+    sensitivity: how far apart two rollouts get that no model difference separates)."""
+    knots = sequence.knots.copy()
+    knots[1:, 0] += offset
+    return ControlSequence(sequence.times, knots)
+
+
+def _cost_gap(a: RolloutOutcome, b: RolloutOutcome) -> dict:
+    """Absolute differences of two outcomes' costs and terms (None where one blew up)."""
+    if "blew_up" in a.terms or "blew_up" in b.terms:
+        return {"cost": None}
+    return {"cost": abs(a.cost - b.cost), **{k: abs(a.terms[k] - b.terms[k]) for k in a.terms}}
+
+
+def model_agreement(triples: list[tuple], steps: tuple[float, ...]) -> dict:
+    """Success verdicts and costs of every sequence on the full and the reduced model at each rollout
+    time step, and on the full model at the execution time step (the reference); and, as the scale
+    of the differences, the full model's own sensitivity: the sequence nudged by 1 um (``nudged``)."""
+    full_step = WorldConfig().plant.time_step
+    rows = []
+    models: dict = {}
+
+    def rollouts(scene, step: float, settle: bool) -> SceneRollouts:
+        key = (id(scene), step, settle)
+        if key not in models:
+            config = model_config(WorldConfig(), step, True)
+            if not settle:
+                config.sto.settle_s = 0.0
+            models[key] = SceneRollouts(scene, config)
+        return models[key]
+
+    for scene, label, sequence, settle in tqdm(triples, desc="model agreement", unit="sequence"):
+        row = {"sequence": label, "objects": len(scene.objects), "duration_s": sequence.duration}
+        row["reference"] = rollouts(scene, full_step, settle).full.rollout(sequence)
+        for step in steps:
+            model = rollouts(scene, step, settle)
+            row[f"full_{step * 1000:g}ms"] = model.full.rollout(sequence)
+            row[f"reduced_{step * 1000:g}ms"] = model.rollout(sequence)
+            row[f"nudged_{step * 1000:g}ms"] = model.full.rollout(nudged(sequence))
+        rows.append(row)
+    summary = {"sequences": len(rows), "successes_reference": int(sum(r["reference"].success for r in rows))}
+    for step in steps:
+        full, reduced, nudge = (f"{m}_{step * 1000:g}ms" for m in ("full", "reduced", "nudged"))
+        entry = summary[f"step_{step * 1000:g}ms"] = {
+            "full_vs_reference": int(sum(r[full].success == r["reference"].success for r in rows)),
+            "reduced_vs_reference": int(sum(r[reduced].success == r["reference"].success for r in rows)),
+            "successes_full": int(sum(r[full].success for r in rows)),
+            "successes_reduced": int(sum(r[reduced].success for r in rows)),
+            "welded_at_end_mean": float(np.mean([len(r[reduced].welded) for r in rows])),
+            "objects_mean": float(np.mean([r["objects"] for r in rows])),
+            "switches": int(sum(r[reduced].switches for r in rows)),
+            "wall_s_full": float(sum(r[full].wall_s for r in rows)),
+            "wall_s_reduced": float(sum(r[reduced].wall_s for r in rows)),
+        }
+        for other, name in ((reduced, "reduced_vs_full"), (nudge, "nudged_vs_full")):
+            gaps = [_cost_gap(r[other], r[full]) for r in rows]
+            sane = [g for g in gaps if g["cost"] is not None]
+            costs = [g["cost"] for g in sane]
+            entry[name] = {
+                "verdicts_agree": int(sum(r[other].success == r[full].success for r in rows)),
+                "blown_up_pairs": len(gaps) - len(sane),
+                "cost_gap_median": float(np.median(costs)) if sane else 0.0,
+                "cost_gap_p90": float(np.percentile(costs, 90)) if sane else 0.0,
+                "cost_gap_max": max(costs, default=0.0),
+                "term_gap_max": {k: max(g[k] for g in sane) for k in sane[0] if k != "cost"} if sane else {},
+            }
+    summary["rows"] = [{"sequence": r["sequence"], "objects": r["objects"], "duration_s": r["duration_s"],
+                        **{k: {"success": o.success, "cost": o.cost, "welded": len(o.welded), "switches": o.switches,
+                               "wall_s": o.wall_s}
+                           for k, o in r.items() if isinstance(o, RolloutOutcome)}} for r in rows]
+    return summary
 
 
 def comparison(config: WorldConfig, seeds: int, out: Path) -> dict:
@@ -165,30 +278,65 @@ def plot_comparison(rows: list[dict], path: Path) -> None:
     plt.close(fig)
 
 
+def print_throughput(t: dict, steps: tuple[float, ...]) -> None:
+    print(f"throughput ({t['objects']} objects, {HORIZON:g} s horizon, {t['rollouts']} rollouts; "
+          f"load before {t['load_before'][0]:.2f}), rollouts/s per repeat:")
+    for step in steps:
+        for model in ("full", "reduced"):
+            entry = t[f"step_{step * 1000:g}ms"][model]
+            for w in (1, 2):
+                cells = "; ".join(f"{rerun} " + ", ".join(f"{run['rollouts_per_s']:.2f} (load {run['load']:.1f})"
+                                                          for run in entry[f"workers_{w}"][rerun])
+                                  for rerun in ("cold", "warm"))
+                print(f"  {step * 1000:g} ms, {model} model, {w} worker{'s' if w > 1 else ''}: {cells}")
+            cpu = [run["cpu_s_per_rollout"] for rerun in ("cold", "warm") for run in entry["workers_1"][rerun]]
+            print(f"  {step * 1000:g} ms, {model} model: CPU time per rollout on 1 worker "
+                  + ", ".join(f"{c:.3f}" for c in cpu) + " s")
+            print(f"  {step * 1000:g} ms, {model} model: welded at the end "
+                  f"{entry['workers_1']['cold'][0]['welded_mean']:.1f} objects on average; same costs on 1 and 2 "
+                  f"workers, cold and warm: {entry['same_costs_everywhere']}")
+    print("real-time factor of one rollout (full model): "
+          + ", ".join(f"{rtf:.1f} at {k}" for k, rtf in t["real_time_factor"].items()))
+
+
+def print_agreement(a: dict, steps: tuple[float, ...]) -> None:
+    n = a["sequences"]
+    print(f"rollout models vs the full model at the execution step ({n} sequences, "
+          f"{a['successes_reference']} successes):")
+    for step in steps:
+        e = a[f"step_{step * 1000:g}ms"]
+        print(f"  {step * 1000:g} ms: verdicts agree with the reference: full {e['full_vs_reference']}/{n}, "
+              f"reduced {e['reduced_vs_reference']}/{n}; welded at the end {e['welded_at_end_mean']:.1f} of "
+              f"{e['objects_mean']:.1f} objects, {e['switches']} switches; wall {e['wall_s_full']:.0f} s full, "
+              f"{e['wall_s_reduced']:.0f} s reduced")
+        for name in ("reduced_vs_full", "nudged_vs_full"):
+            g = e[name]
+            print(f"    {name.replace('_', ' ')}: verdicts agree {g['verdicts_agree']}/{n}, |cost gap| median "
+                  f"{g['cost_gap_median']:.3g}, p90 {g['cost_gap_p90']:.3g}, max {g['cost_gap_max']:.3g}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--out", default="benchmark-results", help="output directory")
     parser.add_argument("--gen1", type=int, default=10, help="Generalization I scenes (seeds 0..N-1)")
     parser.add_argument("--throughput-rollouts", type=int, default=16)
+    parser.add_argument("--throughput-repeats", type=int, default=2, help="throughput measurements per setting")
     parser.add_argument("--agreement-sequences", type=int, default=8, help="noisy sequences per planner")
+    parser.add_argument("--validation-scenes", type=int, default=2,
+                        help="Generalization I and II scenes (seeds 0..N-1) in the model agreement")
+    parser.add_argument("--skip-agreement", action="store_true", help="skip the rollout models' agreement")
     parser.add_argument("--skip-comparison", action="store_true")
     args = parser.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     report = {"machine": {"platform": platform.platform(), "cpus": os.cpu_count(), "python": platform.python_version()}}
     steps = (WorldConfig().sto.rollout_time_step, 0.01)
-    report["throughput"] = t = throughput(args.throughput_rollouts, steps)
-    for step in steps:
-        entry = t[f"step_{step * 1000:g}ms"]
-        print(f"throughput at {step * 1000:g} ms ({t['objects']} objects, {HORIZON:g} s horizon): "
-              f"{entry['workers_1']['rollouts_per_s']:.2f} rollouts/s on 1 worker, "
-              f"{entry['workers_2']['rollouts_per_s']:.2f} on 2; same costs: {entry['same_costs_1_vs_2_workers']}")
-    print("real-time factor of one rollout: " + ", ".join(f"{rtf:.1f} at {k}" for k, rtf in t["real_time_factor"].items()))
-    report["model_agreement"] = a = model_agreement(args.agreement_sequences, steps)
-    for step in steps:
-        entry = a[f"step_{step * 1000:g}ms"]
-        print(f"rollout model at {step * 1000:g} ms vs execution step: {entry['agreement']:.0%} of {a['sequences']} "
-              f"verdicts agree ({entry['successes']} vs {a['successes_full_model']} successes)")
+    report["throughput"] = throughput(args.throughput_rollouts, steps, args.throughput_repeats)
+    print_throughput(report["throughput"], steps)
+    if not args.skip_agreement:
+        report["model_agreement"] = model_agreement(
+            validation_sequences(args.agreement_sequences, args.validation_scenes), steps)
+        print_agreement(report["model_agreement"], steps)
     if not args.skip_comparison:
         report["comparison"] = c = comparison(WorldConfig(), args.gen1, out)
         for planner in ("hlp", "sto"):

@@ -1,9 +1,9 @@
 """``RolloutPool``: STO rollouts on one or several worker processes.
 
-Each worker process keeps pre-built ``RolloutWorld``s (one per scene and configuration, the latest
-few), so a rollout only swaps a trajectory and resets a context. With one worker the rollouts run in
-this process. The results are the same in both cases: a rollout is a pure function of the scene,
-the configuration and the sequence.
+Each worker process keeps pre-built ``SceneRollouts`` (one per scene and configuration, the latest
+few, each with its full and reduced ``RolloutWorld``s), so a rollout only swaps a trajectory and
+resets a context. With one worker the rollouts run in this process. The results are the same in both
+cases: a rollout is a pure function of the scene, the configuration and the sequence.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.world_config import WorldConfig, dump_world_config, load_world_config
 
 _WORLDS_KEPT = 2
-_worlds: OrderedDict = OrderedDict()  # per process: key -> RolloutWorld
+_worlds: OrderedDict = OrderedDict()  # per process: key -> SceneRollouts
 
 
 def _world_key(scene: Scene, config_yaml: str) -> str:
@@ -27,12 +27,12 @@ def _world_key(scene: Scene, config_yaml: str) -> str:
 
 
 def _world(scene: Scene, config_yaml: str, config: WorldConfig | None = None):
-    """This process's ``RolloutWorld`` for ``scene`` and the configuration (built on first use)."""
-    from hlp_drake.systems.rollout import RolloutWorld
+    """This process's ``SceneRollouts`` for ``scene`` and the configuration (built on first use)."""
+    from hlp_drake.systems.rollout import SceneRollouts
 
     key = _world_key(scene, config_yaml)
     if key not in _worlds:
-        _worlds[key] = RolloutWorld(scene, config if config is not None else load_world_config(overrides=config_yaml))
+        _worlds[key] = SceneRollouts(scene, config if config is not None else load_world_config(overrides=config_yaml))
         while len(_worlds) > _WORLDS_KEPT:
             _worlds.popitem(last=False)
     _worlds.move_to_end(key)
@@ -70,7 +70,7 @@ class RolloutPool:
             self.startup_s = time.perf_counter() - started
 
     def world(self, scene: Scene, config: WorldConfig):
-        """This process's pre-built world for ``scene`` (for start checks and in-process rollouts)."""
+        """This process's pre-built ``SceneRollouts`` for ``scene`` (for start checks and in-process rollouts)."""
         return _world(scene, dump_world_config(config), config)
 
     def rollouts(self, scene: Scene, config: WorldConfig, sequences: list[ControlSequence]) -> list:

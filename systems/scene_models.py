@@ -16,6 +16,7 @@ polygon. With 2 ms steps resting objects stay within ~0.1 mm.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -43,11 +44,13 @@ class SceneModels:
         table: the table's model instance (one body, ``table``, welded to the world).
         objects: per scene object name (target first), its model instance; its body has the same name.
         welded: whether the objects were welded at their scene poses (a planning model) rather than free.
+        welded_objects: the names of the objects welded at their scene poses (all of them if ``welded``).
     """
 
     table: ModelInstanceIndex
     objects: dict[str, ModelInstanceIndex]
     welded: bool = False
+    welded_objects: frozenset[str] = frozenset()
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -99,7 +102,12 @@ def _support_points(obj: SceneObject, contact: ContactConfig) -> list[np.ndarray
 
 
 def _add_object(
-    plant: MultibodyPlant, obj: SceneObject, config: WorldConfig, *, color: np.ndarray
+    plant: MultibodyPlant,
+    obj: SceneObject,
+    config: WorldConfig,
+    *,
+    color: np.ndarray,
+    support_spheres: bool = True,
 ) -> tuple[ModelInstanceIndex, RigidBody]:
     sx, sy, height = obj.size
     if obj.shape not in ("box", "cylinder"):
@@ -117,7 +125,7 @@ def _add_object(
     plant.RegisterCollisionGeometry(body, RigidTransform(), shape, f"{obj.name}_collision", properties)
     plant.RegisterVisualGeometry(body, RigidTransform(), shape, f"{obj.name}_visual", color)
     sphere = Sphere(config.contact.corner_sphere_radius) if config.contact.corner_sphere_radius > 0 else None
-    for index, centre in enumerate(_support_points(obj, config.contact)):
+    for index, centre in enumerate(_support_points(obj, config.contact) if support_spheres else []):
         plant.RegisterCollisionGeometry(
             body, RigidTransform(centre), sphere, f"{obj.name}_support_{index}", properties
         )
@@ -125,7 +133,12 @@ def _add_object(
 
 
 def add_scene(
-    plant: MultibodyPlant, scene: Scene, config: WorldConfig | None = None, *, weld_objects: bool = False
+    plant: MultibodyPlant,
+    scene: Scene,
+    config: WorldConfig | None = None,
+    *,
+    weld_objects: bool = False,
+    welded_objects: Iterable[str] = (),
 ) -> SceneModels:
     """Add ``scene``'s table and objects to ``plant`` (not yet finalized).
 
@@ -135,17 +148,27 @@ def add_scene(
         config: contact and model settings (``WorldConfig()`` by default).
         weld_objects: weld the objects to the world at their scene poses (a planning model) instead
             of leaving them free.
+        welded_objects: names of objects to weld at their scene poses while the others stay free
+            (objects a motion cannot reach, to shrink a simulation's contact problem); they get no
+            support spheres (they rest on nothing, and their shape holds the spheres anyway).
 
     Returns:
         The model instances; the objects' free-body default poses are their scene poses.
 
     Raises:
-        ValueError: an object's name is taken by another model instance of the plant, or the plant
-            is finalized.
+        ValueError: an object's name is taken by another model instance of the plant, the plant
+            is finalized, or ``welded_objects`` names an object the scene does not have.
     """
     config = WorldConfig() if config is None else config
     if plant.is_finalized():
         raise ValueError("add_scene needs a plant that is not finalized yet")
+    names = [obj.name for obj in scene.objects]
+    welded = frozenset(welded_objects)
+    unknown = sorted(welded - set(names))
+    if unknown:
+        raise ValueError(f"cannot weld objects the scene does not have: {', '.join(unknown)}")
+    if weld_objects:
+        welded = frozenset(names)
     for name in (TABLE_NAME, *(obj.name for obj in scene.objects)):
         if plant.HasModelInstanceNamed(name):
             raise ValueError(f"the plant already has a model instance named {name!r}")
@@ -170,14 +193,16 @@ def add_scene(
     objects: dict[str, ModelInstanceIndex] = {}
     for obj in scene.objects:
         color = TARGET_COLOR if obj is scene.target else OBSTACLE_COLOR
-        instance, body = _add_object(plant, obj, config, color=color)
+        instance, body = _add_object(
+            plant, obj, config, color=color, support_spheres=weld_objects or obj.name not in welded
+        )
         objects[obj.name] = instance
         X_WO = object_pose(obj, table.height)
-        if weld_objects:
+        if obj.name in welded:
             plant.WeldFrames(plant.world_frame(), body.body_frame(), X_WO)
         else:
             plant.SetDefaultFloatingBaseBodyPose(body, X_WO)
-    return SceneModels(table=table_instance, objects=objects, welded=weld_objects)
+    return SceneModels(table=table_instance, objects=objects, welded=weld_objects, welded_objects=welded)
 
 
 def object_body(plant: MultibodyPlant, name: str) -> RigidBody:

@@ -79,6 +79,15 @@ class StoConfig:
         seed: seed of the noise.
         rollout_time_step: plant time step of the rollouts, s (coarser than the execution's; the
             executed result is checked on the full model).
+        reduced_model: roll out on reduced models in which objects nothing has come near yet are
+            welded at their scene poses (fewer bodies and contacts; every cost term still covers every
+            object, a welded one simply stays put); off: every rollout simulates every object.
+        weld_clearance: in the reduced model, an object is freed ``weld_lookahead`` before the robot's
+            collision geometry, following the commanded motion, first comes within this of it, m.
+        weld_lookahead: see ``weld_clearance``, s.
+        weld_margin: in the reduced model, when at a sample the robot or an object that has moved
+            comes within this (plus the largest motion of a body since the previous sample) of a
+            welded object, the rollout goes back to the previous sample and on with it freed, m.
         settle_s: simulated time after the last control step before the final state is read, s.
         sample_period: how often a rollout's state is read for the cost, s.
         max_object_speed: an object faster than this (m/s) means the simulation blew up.
@@ -97,6 +106,10 @@ class StoConfig:
     workers: int = 2
     seed: int = 0
     rollout_time_step: float = 0.005
+    reduced_model: bool = True
+    weld_clearance: float = 0.15
+    weld_lookahead: float = 0.5
+    weld_margin: float = 0.01
     settle_s: float = 0.5
     sample_period: float = 0.1
     max_object_speed: float = 5.0

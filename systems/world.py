@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Iterable
 
 import numpy as np
 from pydrake.geometry import (
@@ -326,7 +327,11 @@ def _add_gravity_compensation(
 
 
 def make_world_diagram(
-    scene: Scene, config: WorldConfig | None = None, *, meshcat: Meshcat | None = None
+    scene: Scene,
+    config: WorldConfig | None = None,
+    *,
+    meshcat: Meshcat | None = None,
+    welded_objects: Iterable[str] = (),
 ) -> Diagram:
     """Build the world for ``scene``: see the module's docstring for the ports.
 
@@ -334,6 +339,9 @@ def make_world_diagram(
         scene: the table, start, target and obstacles.
         config: plant, contact, model and control settings (``WorldConfig()`` by default).
         meshcat: if given, illustration geometry and contact forces are drawn there.
+        welded_objects: names of scene objects welded to the world at their scene poses instead of
+            free (a reduced model: they neither move nor join the contact problem with the table);
+            ``state`` then holds only the free objects' states.
     """
     config = WorldConfig() if config is None else config
     builder = DiagramBuilder()
@@ -341,7 +349,7 @@ def make_world_diagram(
     instance = add_robot(plant)
     _set_robot_contact(plant, scene_graph, instance, config)
     _set_pd_gains(plant, instance, config.control)
-    add_scene(plant, scene, config)
+    add_scene(plant, scene, config, welded_objects=welded_objects)
     plant.Finalize()
     plant.SetDefaultPositions(instance, start_configuration(scene, plant, instance, config=config))
 

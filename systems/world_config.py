@@ -269,6 +269,13 @@ def config_problems(config: WorldConfig) -> list[str]:
                  "sample_period", "max_object_speed", "max_sink"):
         positive(f"sto.{name}", getattr(sto, name))
     positive("sto.settle_s", sto.settle_s, zero_ok=True)
+    positive("sto.weld_clearance", sto.weld_clearance)
+    positive("sto.weld_lookahead", sto.weld_lookahead, zero_ok=True)
+    positive("sto.weld_margin", sto.weld_margin, zero_ok=True)
+    if sto.weld_margin > sto.weld_clearance:
+        problems.append(
+            f"sto.weld_margin ({sto.weld_margin}) must not exceed sto.weld_clearance ({sto.weld_clearance})"
+        )
     for name in ("vx", "vy", "yaw_rate"):
         positive(f"sto.noise.{name}", getattr(sto.noise, name), zero_ok=True)
     if not 0.0 <= sto.noise.end_fraction <= 1.0:

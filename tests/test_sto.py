@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
@@ -12,7 +13,7 @@ from hlp_drake.scene.io import load_scene
 from hlp_drake.scene.model import SceneObject
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.planning import make_planning_diagram
-from hlp_drake.systems.rollout import BLOWN_UP_COST, RolloutSamples, RolloutWorld, rollout_cost
+from hlp_drake.systems.rollout import BLOWN_UP_COST, RolloutSamples, RolloutWorld, SceneRollouts, rollout_cost
 from hlp_drake.systems.rollout_pool import RolloutPool
 from hlp_drake.systems.sto import StochasticTrajectoryOptimiser, mppi_weights, optimise, sample_base_noise
 from hlp_drake.systems.world import tcp_keypoint_height
@@ -165,16 +166,74 @@ def test_impossible_object_speed_counts_as_a_blow_up(scene, trajectories):
     assert not outcome.success and outcome.cost == BLOWN_UP_COST and "over the table" in outcome.failure_reason
 
 
-def test_two_workers_give_the_same_outcomes_as_one(scene, trajectories, world):
+def test_two_workers_give_the_same_outcomes_as_one(scene, trajectories):
     base = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)
     config = WorldConfig()
     noise = sample_base_noise(np.random.default_rng(0), base, config.sto.noise, 3)
     sequences = [base.with_base_velocity(v) for v in noise]
-    local = [world.rollout(s) for s in sequences]
+    local = [SceneRollouts(scene, config).rollout(s) for s in sequences]  # a fresh set of worlds for each
     with RolloutPool(2) as pool:
         assert pool.startup_s > 0
         remote = pool.rollouts(scene, config, sequences)
     assert [o.cost for o in remote] == [o.cost for o in local]
+    assert [o.welded for o in remote] == [o.welded for o in local] and all(o.welded for o in local)
+
+
+# --- The reduced rollout model ---------------------------------------------------------------------
+
+PUSHING_HORIZON = 3.0
+"""The straight line's first 3 s on the default scene push two obstacles (Long, then Med-1 with it)."""
+
+
+def test_the_reduced_model_welds_only_objects_nothing_comes_near(scene, trajectories, world):
+    config = WorldConfig()
+    reduced = SceneRollouts(scene, config)
+    sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), PUSHING_HORIZON)
+    full, samples = world.simulate(sequence), reduced.simulate(sequence)
+    names = [obj.name for obj in scene.objects]
+    pushed = {n for n, d in zip(names, np.linalg.norm(full.positions[-1] - full.positions[0], axis=1)) if d > 0.01}
+    assert len(pushed) == 2 and samples.welded and samples.switches > 0
+    assert not pushed & set(samples.welded)  # a pushed object is never welded
+    approach = world.approach_times(sequence, config.sto.weld_clearance)
+    assert all(approach[name] == math.inf for name in samples.welded)  # nor one the robot's sweep comes near
+    np.testing.assert_allclose(samples.positions, full.positions, atol=1e-3)  # welded ones simply stay put
+    a, b = reduced.rollout(sequence), world.rollout(sequence)
+    assert a.success == b.success and a.fallen == b.fallen
+    assert a.cost == pytest.approx(b.cost, rel=1e-3)
+    assert a.terms["disturbance"] == pytest.approx(b.terms["disturbance"], rel=1e-2)
+    assert a.welded == samples.welded and b.welded == () and b.switches == 0
+    off = dataclasses.replace(config, sto=dataclasses.replace(config.sto, reduced_model=False))
+    assert SceneRollouts(scene, off).rollout(sequence).terms == b.terms  # off: the full model
+
+
+def test_an_object_pushed_towards_a_welded_one_frees_it_from_the_sample_before(scene, trajectories, world):
+    sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), PUSHING_HORIZON)
+    chained = "FailOnTouchObstacleMed-1"  # pushed by Long before the robot itself comes near it
+    alone = RolloutWorld(scene, WorldConfig(), welded_objects=[chained]).simulate(sequence)
+    assert alone.touched == (chained,) and alone.times[-1] < 2.5  # no world to go on with: it stops there
+    config = WorldConfig()
+    config.sto.weld_clearance, config.sto.weld_lookahead = 0.01, 0.0  # the schedule frees late...
+    assert world.approach_times(sequence, config.sto.weld_clearance)[chained] > alone.times[-1] + 0.1
+    samples = SceneRollouts(scene, config).simulate(sequence)  # ...so the check during the rollout must
+    assert chained not in samples.welded and samples.switches >= 2 and samples.touched == ()
+    np.testing.assert_allclose(samples.positions, world.simulate(sequence).positions, atol=1e-3)
+    with pytest.raises(ValueError, match=chained):
+        world.cost(alone, sequence)
+
+
+def test_a_rollout_carried_over_to_another_world_goes_on_exactly(scene, trajectories, world):
+    sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 2.0)
+    other = RolloutWorld(scene, WorldConfig())
+    world.begin(sequence)
+    world.advance_to(2.0)
+    end = world.states()
+    world.begin(sequence)
+    world.advance_to(1.0)
+    other.begin(sequence, time=1.0, states=world.states())
+    other.advance_to(2.0)
+    assert other.states().keys() == end.keys()
+    for name, x in other.states().items():
+        np.testing.assert_array_equal(x, end[name])
 
 
 # --- The optimiser ---------------------------------------------------------------------------------

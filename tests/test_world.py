@@ -108,6 +108,8 @@ def test_config_loads_from_yaml_and_overrides(tmp_path):
         ("sto: {update: annealing}\n", "sto.update"),
         ("sto: {samples: 0}\n", "sto.samples"),
         ("sto: {noise: {end_fraction: 1.5}}\n", "sto.noise.end_fraction"),
+        ("sto: {weld_clearance: 0.0}\n", "sto.weld_clearance"),
+        ("sto: {weld_margin: 0.5}\n", "sto.weld_margin"),
         ("grasp: {lift_s: 0.0}\n", "grasp.lift_s"),
     ],
 )
@@ -177,6 +179,31 @@ def test_fallen_objects_and_scene_readback(worlds, scenes):
     assert moved.target == scene.target
     set_object_poses(plant, context, scene)
     assert fallen_objects(plant, context, scene) == []
+
+
+def test_chosen_objects_can_be_welded(scenes):
+    scene = scenes["gen2"]
+    welded = {scene.obstacles[0].name, scene.obstacles[2].name}
+    plant = MultibodyPlant(time_step=0.002)
+    scene_graph = SceneGraph()
+    plant.RegisterAsSourceForSceneGraph(scene_graph)
+    models = add_scene(plant, scene, welded_objects=welded)
+    plant.Finalize()
+    assert models.welded_objects == welded and not models.welded
+    assert plant.num_positions() == 7 * (len(scene.objects) - len(welded))
+    context = plant.CreateDefaultContext()
+    for obj in scene.objects:
+        body = object_body(plant, obj.name)
+        assert body.is_floating_base_body() != (obj.name in welded)
+        spheres = len(plant.GetCollisionGeometriesForBody(body)) - 1
+        assert (spheres == 0) == (obj.name in welded)  # welded objects need no support spheres
+    poses = object_planar_poses(plant, context, scene)
+    for obj in scene.objects:
+        np.testing.assert_allclose(poses[obj.name], (obj.x, obj.y, obj.yaw), atol=1e-12)
+    world = make_world_diagram(scene, welded_objects=welded)
+    assert world_plant(world)[0].num_positions() == 11 + 7 * (len(scene.objects) - len(welded))
+    with pytest.raises(ValueError, match="Nowhere"):
+        add_scene(MultibodyPlant(time_step=0.0), scene, welded_objects=["Nowhere"])
 
 
 def test_planning_model_welds_the_objects(scenes):

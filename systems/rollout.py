@@ -33,17 +33,22 @@ from collections.abc import Iterable
 from dataclasses import dataclass, replace
 
 import numpy as np
+from hlp_drake.systems.control_sequence import ControlSequence
+from hlp_drake.systems.robot import TCP_FRAME
+from hlp_drake.systems.scene_models import TABLE_NAME, object_body, off_table_mask, over_table_mask
+from hlp_drake.systems.sto_config import StoConfig
+from hlp_drake.systems.world import (
+    add_position_trajectory,
+    make_world_diagram,
+    tcp_keypoint_height,
+    world_plant,
+)
+from hlp_drake.systems.world_config import WorldConfig
 from pydrake.geometry import CollisionFilterDeclaration, GeometrySet, Role
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from hlp_drake.scene.model import Scene
-from hlp_drake.systems.control_sequence import ControlSequence
-from hlp_drake.systems.robot import TCP_FRAME
-from hlp_drake.systems.scene_models import TABLE_NAME, object_body, off_table_mask, over_table_mask
-from hlp_drake.systems.sto_config import StoConfig
-from hlp_drake.systems.world import add_position_trajectory, make_world_diagram, tcp_keypoint_height, world_plant
-from hlp_drake.systems.world_config import WorldConfig
 
 BLOWN_UP_COST = 1.0e9
 """Cost of a rollout whose simulation failed or blew up (ranked below every sane one)."""
@@ -407,10 +412,15 @@ class RolloutWorld:
 
     def rollout(self, sequence: ControlSequence) -> RolloutOutcome:
         """Simulate ``sequence`` and cost it (see ``cost``)."""
-        started = time.perf_counter()
-        samples = self.simulate(sequence)
-        outcome = replace(self.cost(samples, sequence), welded=samples.welded, switches=samples.switches)
-        return replace(outcome, wall_s=time.perf_counter() - started)
+        return timed_rollout(sequence, self.simulate, self)
+
+
+def timed_rollout(sequence: ControlSequence, simulate, costing: RolloutWorld) -> RolloutOutcome:
+    """``simulate(sequence)`` costed by ``costing``, with the welding record and the wall time."""
+    started = time.perf_counter()
+    samples = simulate(sequence)
+    outcome = replace(costing.cost(samples, sequence), welded=samples.welded, switches=samples.switches)
+    return replace(outcome, wall_s=time.perf_counter() - started)
 
 
 def sample_rollout(sequence: ControlSequence, sto: StoConfig, world_for, welded_at) -> RolloutSamples:
@@ -519,7 +529,4 @@ class SceneRollouts:
 
     def rollout(self, sequence: ControlSequence) -> RolloutOutcome:
         """Simulate ``sequence`` and cost it."""
-        started = time.perf_counter()
-        samples = self.simulate(sequence)
-        outcome = replace(self.full.cost(samples, sequence), welded=samples.welded, switches=samples.switches)
-        return replace(outcome, wall_s=time.perf_counter() - started)
+        return timed_rollout(sequence, self.simulate, self.full)

@@ -6,9 +6,9 @@ import math
 
 import numpy as np
 import shapely
-from shapely.geometry import Polygon, box
+from shapely.geometry import Polygon
 
-from hlp_drake.scene.model import SceneObject, Table
+from hlp_drake.scene.model import SceneObject
 
 CYLINDER_SEGMENTS = 16  # quarter-circle segments used to approximate a cylinder's footprint
 
@@ -21,10 +21,6 @@ def footprint(obj: SceneObject) -> Polygon:
     c, s = math.cos(obj.yaw), math.sin(obj.yaw)
     corners = [(-half_x, -half_y), (half_x, -half_y), (half_x, half_y), (-half_x, half_y)]
     return Polygon([(obj.x + c * u - s * v, obj.y + s * u + c * v) for u, v in corners])
-
-
-def table_polygon(table: Table) -> Polygon:
-    return box(*table.bounds)
 
 
 def footprint_bounds(obj: SceneObject) -> tuple[float, float, float, float]:

@@ -16,6 +16,8 @@ from hlp_drake.systems.robot import (
     robot_joint_limits,
     set_robot_positions,
 )
+from hlp_drake.systems.rollout import RolloutOutcome, RolloutWorld, SceneRollouts
+from hlp_drake.systems.rollout_pool import RolloutPool
 from hlp_drake.systems.scene_models import (
     SceneModels,
     add_scene,
@@ -24,8 +26,6 @@ from hlp_drake.systems.scene_models import (
     scene_from_plant,
     set_object_poses,
 )
-from hlp_drake.systems.rollout import RolloutOutcome, RolloutWorld
-from hlp_drake.systems.rollout_pool import RolloutPool
 from hlp_drake.systems.sto import StochasticTrajectoryOptimiser, StoResult, optimise
 from hlp_drake.systems.sto_config import GraspConfig, StoConfig
 from hlp_drake.systems.world import (
@@ -46,6 +46,7 @@ __all__ = [
     "RolloutOutcome",
     "RolloutPool",
     "RolloutWorld",
+    "SceneRollouts",
     "StoConfig",
     "StoResult",
     "StochasticTrajectoryOptimiser",

@@ -138,6 +138,25 @@ def test_pushes_stop_short_of_the_table_edge_and_the_other_objects():
     assert push_travel(lone_space, lone, lone.obstacles[0].name, np.array([0.0, 1.0]), 0.02) == pytest.approx(0.02)
 
 
+def test_pushes_stop_short_of_where_earlier_pushes_left_the_other_objects():
+    from hlp_drake.planner.transfer import OBJECT_MARGIN, push_travel
+    from hlp_drake.taskspace import Rect
+
+    scene = generate_scene("gen1", 13)
+    space = TaskSpace(scene)
+    name, other = scene_obstacle_names(scene)[:2]
+    rect = space.rects[name]
+    unit = np.array([0.0, 1.0])
+    # Another object moved to 5 cm beyond the pushed one's left face: the push stops 1 cm short of it.
+    moved = dict(space.rects)
+    moved[other] = Rect(rect.x_min, rect.y_max + 0.05, rect.x_max, rect.y_max + 0.10)
+    travel = push_travel(space, scene, name, unit, 0.2, footprints=moved)
+    assert travel == pytest.approx(0.05 - OBJECT_MARGIN, abs=0.005 + 1e-9) and travel < 0.05 - OBJECT_MARGIN + 1e-9
+    # With every other object pushed far away, nothing but the table's edge limits it.
+    cleared = {n: (r if n == name else Rect(-10.0, -10.0, -9.9, -9.9)) for n, r in space.rects.items()}
+    assert push_travel(space, scene, name, unit, 0.2, footprints=cleared) >= push_travel(space, scene, name, unit, 0.2)
+
+
 def scene_obstacle_names(scene):
     return [o.name for o in scene.obstacles]
 
@@ -187,7 +206,7 @@ def _websocket_frames(url: str, *, seconds: float) -> bytes:
             sock.settimeout(max(deadline - time.monotonic(), 0.01))
             try:
                 chunk = sock.recv(1 << 16)
-            except socket.timeout:
+            except TimeoutError:
                 break
             if not chunk:
                 break

@@ -18,6 +18,7 @@ down, if nothing lies under the arm there (else the push start is reached direct
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import replace
 
 import numpy as np
@@ -50,8 +51,10 @@ ARM_SHADOW_LENGTH = 0.35
 ARM_SHADOW_HALF_WIDTH = 0.06
 
 
-def _robot_direction(space: TaskSpace, scene: Scene, name: str, direction: str) -> str:
-    """The robot's push direction for a person's move of obstacle ``name`` towards ``direction``."""
+def _robot_direction(space: TaskSpace, scene: Scene, name: str, direction: str,
+                     footprints: Mapping[str, Rect] | None = None) -> str:
+    """The robot's push direction for a person's move of obstacle ``name`` towards ``direction``
+    (the other objects at ``footprints``, by default where the scene has them)."""
     if direction not in BACKWARD:
         return direction
     start = np.asarray(scene.start, float)
@@ -63,7 +66,8 @@ def _robot_direction(space: TaskSpace, scene: Scene, name: str, direction: str) 
 
     def blocking(side: str) -> float:  # how much of the corridor the obstacle still covers after the push
         unit = _unit(side)
-        lateral = (corners + push_travel(space, scene, name, unit, _wanted(space, name, side)) * unit - start) @ normal
+        travel = push_travel(space, scene, name, unit, _wanted(space, name, side), footprints=footprints)
+        lateral = (corners + travel * unit - start) @ normal
         return max(0.0, min(lateral.max(), CORRIDOR_HALF_WIDTH) - max(lateral.min(), -CORRIDOR_HALF_WIDTH))
 
     return min((away, "RR" if away == "LL" else "LL"), key=blocking)
@@ -81,12 +85,15 @@ def _wanted(space: TaskSpace, name: str, direction: str) -> float:
     return max(float(np.dot(shift, _unit(direction))), 0.0)
 
 
-def push_travel(space: TaskSpace, scene: Scene, name: str, unit: np.ndarray, wanted: float) -> float:
+def push_travel(space: TaskSpace, scene: Scene, name: str, unit: np.ndarray, wanted: float,
+                footprints: Mapping[str, Rect] | None = None) -> float:
     """How far (<= ``wanted``) obstacle ``name`` can be pushed along ``unit`` before its footprint
-    comes within ``EDGE_MARGIN`` of the table's edge or ``OBJECT_MARGIN`` of another object."""
+    comes within ``EDGE_MARGIN`` of the table's edge or ``OBJECT_MARGIN`` of another object, the
+    objects' footprints being ``footprints`` (by default where the scene has them)."""
+    footprints = space.rects if footprints is None else footprints
     rect = space.rects[name]
     x_min, y_min, x_max, y_max = scene.table.bounds
-    others = [r for other, r in space.rects.items() if other != name]
+    others = [r for other, r in footprints.items() if other != name]
     steps = np.arange(TRAVEL_STEP, wanted + 1e-9, TRAVEL_STEP)
     travel = 0.0
     for t in steps:
@@ -115,14 +122,16 @@ def robot_plan(plan: HighLevelPlan, scene: Scene) -> HighLevelPlan:
             keypoints.append(k)
             continue
         rect = space.rects[k.element]
-        direction = _robot_direction(space, scene, k.element, k.direction)
+        direction = _robot_direction(space, scene, k.element, k.direction, footprints=placed)
         unit = _unit(direction)
         # Distance from the centre to the face opposite the push, along the push direction.
         clearance = abs(unit[0]) * FORWARD_CLEARANCE + abs(unit[1]) * SIDEWAYS_CLEARANCE
         reach = abs(unit[0]) * rect.depth / 2.0 + abs(unit[1]) * rect.width / 2.0 + clearance
         centre = np.array(rect.center)
         if k.action == "release":  # towards the relocated place, short of the edge and the others
-            shift = push_travel(space, scene, k.element, unit, _wanted(space, k.element, direction)) * unit
+            travel = push_travel(space, scene, k.element, unit, _wanted(space, k.element, direction),
+                                 footprints=placed)
+            shift = travel * unit
             centre = centre + shift
             placed[k.element] = Rect(rect.x_min + shift[0], rect.y_min + shift[1], rect.x_max + shift[0],
                                      rect.y_max + shift[1])

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -169,6 +170,42 @@ def scene_with_one_obstacle(scene):
     return replace(scene, obstacles=(obstacle,), target=target)
 
 
+def test_a_push_with_no_room_to_move_the_obstacle_is_left_out():
+    from hlp_drake.planner.transfer import MIN_PUSH_TRAVEL, _robot_direction, _unit, _wanted, push_travel
+
+    # gen1 seed 27: the person's plan moves FailOnTouchObstacleMed back-left (for the robot a push
+    # to the left), then pushes FailOnTouchObstacleLong-1 to the right; the first push has no room,
+    # so the robot plan leaves it out and keeps the second.
+    scene = generate_scene("gen1", 27)
+    space = TaskSpace(scene)
+    human = plan(scene, default_models())
+    robot = robot_plan(human, scene)
+    moves = [(k.element, k.direction) for k in human.keypoints if k.action == "move"]
+    assert moves == [("FailOnTouchObstacleMed", "BL"), ("FailOnTouchObstacleLong-1", "RR")]
+    name = moves[0][0]
+    direction = _robot_direction(space, scene, name, moves[0][1])
+    wanted = _wanted(space, name, direction)
+    assert wanted > MIN_PUSH_TRAVEL > push_travel(space, scene, name, _unit(direction), wanted)
+    pushes = [k for k in robot.keypoints if k.action in ("move", "release")]
+    assert [(k.action, k.element) for k in pushes] == [("move", moves[1][0]), ("release", moves[1][0])]
+    assert np.hypot(*np.subtract(pushes[1].position, pushes[0].position)) >= MIN_PUSH_TRAVEL
+
+
+def test_an_obstacle_already_near_an_edge_can_be_pushed_along_it_but_not_towards_it():
+    from hlp_drake.planner.transfer import EDGE_MARGIN, push_travel
+
+    scene = generate_scene("gen1", 13)
+    lone = scene_with_one_obstacle(scene)
+    obstacle = lone.obstacles[0]
+    half = TaskSpace(lone).rects[obstacle.name].width / 2
+    y_max = lone.table.bounds[3]
+    near = replace(lone, obstacles=(replace(obstacle, y=y_max - half - EDGE_MARGIN / 2),))  # 1.5 cm from the edge
+    space = TaskSpace(near)
+    assert push_travel(space, near, obstacle.name, np.array([1.0, 0.0]), 0.05) == pytest.approx(0.05)
+    assert push_travel(space, near, obstacle.name, np.array([0.0, 1.0]), 0.05) == 0.0
+    assert push_travel(space, near, obstacle.name, np.array([0.0, -1.0]), 0.05) == pytest.approx(0.05)
+
+
 def test_a_backward_move_becomes_the_sideways_push_that_clears_the_corridor():
     from hlp_drake.planner.transfer import _robot_direction
 
@@ -277,3 +314,29 @@ def test_transit_goes_over_the_objects_where_the_arm_can_come_down():
     assert transit(previous, push, 0.25, [*beside, Rect(0.40, 0.25, 0.45, 0.30)]) == []
     assert transit(previous, push, 0.25, [Rect(0.60 - ARM_SHADOW_LENGTH - 0.05, 0.1, 0.60 - ARM_SHADOW_LENGTH + 0.01, 0.3)]) == []
     assert len(transit(previous, push, 0.25, [Rect(0.60 - ARM_SHADOW_LENGTH - 0.05, 0.1, 0.60 - ARM_SHADOW_LENGTH - 0.01, 0.3)])) == 2
+
+
+def test_a_way_that_would_pass_over_an_object_goes_over_it():
+    from hlp_drake.planner.transfer import PATH_CLEARANCE, crosses, transit_height
+    from hlp_drake.taskspace import Rect
+
+    box = Rect(0.40, 0.00, 0.50, 0.10)
+    assert crosses((0.30, 0.05), (0.60, 0.05), [box])  # straight through
+    assert crosses((0.30, 0.10 + PATH_CLEARANCE - 0.005), (0.60, 0.10 + PATH_CLEARANCE - 0.005), [box])
+    assert not crosses((0.30, 0.10 + PATH_CLEARANCE + 0.005), (0.60, 0.10 + PATH_CLEARANCE + 0.005), [box])
+    assert not crosses((0.30, 0.05), (0.60, 0.05), [])
+    # gen2 seed 0, 9 obstacles: from where obstacle_2's push ends, the way to the next gap would
+    # sweep the gripper through obstacle_7 at push height; the robot plan goes over it instead.
+    scene = generate_scene("gen2", 0, 9)
+    space = TaskSpace(scene)
+    keypoints = robot_plan(plan(scene, default_models()), scene).keypoints
+    i = next(i for i, k in enumerate(keypoints) if k.action == "release" and k.element == "obstacle_2")
+    release, up, over, gap = keypoints[i:i + 4]
+    assert crosses(release.position, gap.position, [space.rects["obstacle_7"]])
+    assert (up.action, over.action, gap.action) == ("transit", "transit", "gap")
+    assert (up.position, over.position) == (release.position, gap.position)
+    assert up.height == over.height == pytest.approx(transit_height(scene))
+    # The gap to the next push start passes behind obstacle_8, clear of everything: no lift.
+    following = keypoints[i + 4]
+    assert following.action == "move" and not crosses(gap.position, following.position,
+                                                      [r for n, r in space.rects.items() if n != scene.target.name])

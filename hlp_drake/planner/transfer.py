@@ -7,13 +7,17 @@ keypoint the same point once the obstacle's centre has reached its new place. Th
 pull an obstacle towards itself: a backward direction (BB, BL, BR) becomes the sideways push (LL or
 RR) that leaves the least of the obstacle in the corridor along the straight start-target line (a
 person lifts the obstacle back over the table; pushed sideways into the corridor it would block the
-way), the side the obstacle lies on when both leave the same.
+way), the side the obstacle lies on when both leave the same. A push that cannot move the obstacle
+``MIN_PUSH_TRAVEL`` before it nears the table's edge or another object is left out: pressing it
+into its neighbours would only shove them along (or off the table).
 
 A person lifts their hand over the table on the way to an obstacle; a robot arm moving sideways at
 push height would sweep its forearm through everything between the base and the gripper. So the
-way to each push start goes over the objects: two "transit" waypoints ``TRANSIT_CLEARANCE`` over
-the tallest object, above the previous waypoint and above the push start, where the arm comes
-down, if nothing lies under the arm there (else the push start is reached directly).
+way to each push start, and any other way whose tcp path would pass over an object (within
+``PATH_CLEARANCE`` of its footprint, the objects where the pushes so far left them), goes over the
+objects: two "transit" waypoints ``TRANSIT_CLEARANCE`` over the tallest object, above the previous
+waypoint and above the next one, where the arm comes down, if nothing lies under the arm there
+(else the waypoint is reached directly, at push height).
 """
 
 from __future__ import annotations
@@ -36,6 +40,8 @@ BACKWARD = ("BB", "BL", "BR")
 # Half-width of the corridor along the start-target line that a backward move should clear: the open
 # gripper's half-width (5.5 cm) plus 2.5 cm.
 CORRIDOR_HALF_WIDTH = 0.08
+# Pushes that would move the obstacle less than this are left out of the robot plan.
+MIN_PUSH_TRAVEL = 0.01
 # A pushed obstacle stops this far short of the table's edge and of the other objects: a person
 # lifts an obstacle over its neighbours, a pushing robot would shove them along (or off the table).
 EDGE_MARGIN = 0.03
@@ -49,6 +55,8 @@ TRANSIT_CLEARANCE = 0.07
 # nothing lies there: pressing it down onto an object would crush it into the table.
 ARM_SHADOW_LENGTH = 0.35
 ARM_SHADOW_HALF_WIDTH = 0.06
+# A way between waypoints whose tcp path passes this close to an object's footprint goes over it.
+PATH_CLEARANCE = 0.02
 
 
 def _robot_direction(space: TaskSpace, scene: Scene, name: str, direction: str,
@@ -87,26 +95,35 @@ def _wanted(space: TaskSpace, name: str, direction: str) -> float:
 
 def push_travel(space: TaskSpace, scene: Scene, name: str, unit: np.ndarray, wanted: float,
                 footprints: Mapping[str, Rect] | None = None) -> float:
-    """How far (<= ``wanted``) obstacle ``name`` can be pushed along ``unit`` before its footprint
-    comes within ``EDGE_MARGIN`` of the table's edge or ``OBJECT_MARGIN`` of another object, the
-    objects' footprints being ``footprints`` (by default where the scene has them)."""
+    """How far (<= ``wanted``, in ``TRAVEL_STEP`` steps) obstacle ``name`` can be pushed along
+    ``unit`` before its footprint comes within ``EDGE_MARGIN`` of the table's edge or
+    ``OBJECT_MARGIN`` of another object, the objects' footprints being ``footprints`` (by default
+    where the scene has them). An edge or object already nearer than that only stops a push that
+    brings the obstacle closer to it."""
     footprints = space.rects if footprints is None else footprints
     rect = space.rects[name]
-    x_min, y_min, x_max, y_max = scene.table.bounds
-    others = [r for other, r in footprints.items() if other != name]
     steps = np.arange(TRAVEL_STEP, wanted + 1e-9, TRAVEL_STEP)
-    travel = 0.0
-    for t in steps:
-        dx, dy = t * unit
-        moved = (rect.x_min + dx, rect.y_min + dy, rect.x_max + dx, rect.y_max + dy)
-        if (moved[0] < x_min + EDGE_MARGIN or moved[2] > x_max - EDGE_MARGIN
-                or moved[1] < y_min + EDGE_MARGIN or moved[3] > y_max - EDGE_MARGIN):
-            break
-        if any(moved[0] < r.x_max + OBJECT_MARGIN and r.x_min - OBJECT_MARGIN < moved[2]
-               and moved[1] < r.y_max + OBJECT_MARGIN and r.y_min - OBJECT_MARGIN < moved[3] for r in others):
-            break
-        travel = float(t)
-    return travel
+    if steps.size == 0:
+        return 0.0
+    start = np.array([rect.x_min, rect.y_min, rect.x_max, rect.y_max])
+    boxes = np.vstack([start, start + np.outer(steps, [unit[0], unit[1], unit[0], unit[1]])])
+    x_min, y_min, x_max, y_max = scene.table.bounds
+    edges = np.column_stack([boxes[:, 0] - x_min, boxes[:, 1] - y_min, x_max - boxes[:, 2], y_max - boxes[:, 3]])
+    blocked = _nearing(edges, EDGE_MARGIN)
+    others = np.array([[r.x_min, r.y_min, r.x_max, r.y_max] for other, r in footprints.items() if other != name])
+    if others.size:  # the gap to each other object along the axis that separates them most
+        gaps = np.max([others[None, :, 0] - boxes[:, None, 2], boxes[:, None, 0] - others[None, :, 2],
+                       others[None, :, 1] - boxes[:, None, 3], boxes[:, None, 1] - others[None, :, 3]], axis=0)
+        blocked |= _nearing(gaps, OBJECT_MARGIN)
+    stops = np.flatnonzero(blocked[1:])  # blocked[i + 1]: after steps[i]
+    if stops.size == 0:
+        return float(steps[-1])
+    return float(steps[stops[0] - 1]) if stops[0] > 0 else 0.0
+
+
+def _nearing(distances: np.ndarray, margin: float) -> np.ndarray:
+    """Per row (row 0: the start) whether any distance is below ``margin`` and below its start."""
+    return ((distances < margin) & (distances < distances[0] - 1e-12)).any(axis=1)
 
 
 def robot_plan(plan: HighLevelPlan, scene: Scene) -> HighLevelPlan:
@@ -117,30 +134,68 @@ def robot_plan(plan: HighLevelPlan, scene: Scene) -> HighLevelPlan:
     space = TaskSpace(scene)
     placed = dict(space.rects)  # the objects' footprints as the pushes so far leave them
     keypoints: list[PlanKeypoint] = []
+    left_out: str | None = None  # the obstacle whose push (move and release) is left out
     for k in plan.keypoints:
         if k.action not in ("move", "release") or k.element not in space.rects:
+            keypoints += _way_to(keypoints, k, scene, placed)
             keypoints.append(k)
+            continue
+        if k.action == "release" and k.element == left_out:
+            left_out = None
             continue
         rect = space.rects[k.element]
         direction = _robot_direction(space, scene, k.element, k.direction, footprints=placed)
         unit = _unit(direction)
+        # Towards the relocated place, short of the edge and the others.
+        wanted = _wanted(space, k.element, direction)
+        travel = push_travel(space, scene, k.element, unit, wanted, footprints=placed)
+        if k.action == "move" and travel < MIN_PUSH_TRAVEL:
+            left_out = k.element
+            continue
         # Distance from the centre to the face opposite the push, along the push direction.
         clearance = abs(unit[0]) * FORWARD_CLEARANCE + abs(unit[1]) * SIDEWAYS_CLEARANCE
         reach = abs(unit[0]) * rect.depth / 2.0 + abs(unit[1]) * rect.width / 2.0 + clearance
         centre = np.array(rect.center)
-        if k.action == "release":  # towards the relocated place, short of the edge and the others
-            travel = push_travel(space, scene, k.element, unit, _wanted(space, k.element, direction),
-                                 footprints=placed)
+        if k.action == "release":
             shift = travel * unit
             centre = centre + shift
             placed[k.element] = Rect(rect.x_min + shift[0], rect.y_min + shift[1], rect.x_max + shift[0],
                                      rect.y_max + shift[1])
         point = centre - reach * unit
         push = replace(k, position=(float(point[0]), float(point[1])), direction=direction)
-        if k.action == "move" and keypoints:
-            keypoints += transit(keypoints[-1], push, transit_height(scene), placed.values())
+        if k.action == "move":
+            keypoints += _way_to(keypoints, push, scene, placed)
         keypoints.append(push)
     return replace(plan, keypoints=tuple(keypoints))
+
+
+def _way_to(keypoints: list[PlanKeypoint], k: PlanKeypoint, scene: Scene, placed: Mapping[str, Rect]
+            ) -> list[PlanKeypoint]:
+    """The transit waypoints on the way from the last of ``keypoints`` to ``k``, a push start or a
+    waypoint the hand passes: over the objects to a push start, or where the straight way would
+    pass over an object (the target aside), if the arm can come down at ``k`` (the target aside
+    when ``k`` is the target)."""
+    if not keypoints:
+        return []
+    target = scene.target.name
+    others = [r for name, r in placed.items() if name != target]
+    if k.action != "move" and not crosses(keypoints[-1].position, k.position, others):
+        return []
+    under = others if k.action == "target" else list(placed.values())
+    return transit(keypoints[-1], k, transit_height(scene), under)
+
+
+def crosses(a: tuple[float, float], b: tuple[float, float], rects) -> bool:
+    """Whether the straight tcp path from ``a`` to ``b`` passes within ``PATH_CLEARANCE`` of any of
+    ``rects`` (sampled every ``TRAVEL_STEP``)."""
+    boxes = np.array([[r.x_min, r.y_min, r.x_max, r.y_max] for r in rects]).reshape(-1, 4)
+    if boxes.size == 0:
+        return False
+    count = max(int(np.ceil(np.hypot(b[0] - a[0], b[1] - a[1]) / TRAVEL_STEP)), 1) + 1
+    points = np.linspace(a, b, count)[:, None, :]
+    inside = ((points[..., 0] > boxes[:, 0] - PATH_CLEARANCE) & (points[..., 0] < boxes[:, 2] + PATH_CLEARANCE)
+              & (points[..., 1] > boxes[:, 1] - PATH_CLEARANCE) & (points[..., 1] < boxes[:, 3] + PATH_CLEARANCE))
+    return bool(inside.any())
 
 
 def transit_height(scene: Scene) -> float:

@@ -28,11 +28,9 @@ def test_push_transfer_puts_the_tcp_behind_the_obstacle():
     assert [k.action for k in robot.keypoints if k.action != "transit"] == [k.action for k in human.keypoints]
     lifted = max(o.size[2] for o in scene.objects) + 0.07
     transits = [i for i, k in enumerate(robot.keypoints) if k.action == "transit"]
-    # The second push's start is free to come down on, the first one's is not (an object under the arm).
-    assert [robot.keypoints[i + 1].action for i in transits[1::2]] == ["move"] and len(transits) == 2
-    for i in transits[1::2]:  # lifted above the previous waypoint, then above the push start
-        before, up, over, push = robot.keypoints[i - 2:i + 2]
-        assert (up.position, over.position) == (before.position, push.position)
+    for i in transits[1::2]:  # lifted above the previous waypoint, then above the next one
+        before, up, over, after = robot.keypoints[i - 2:i + 2]
+        assert (up.position, over.position) == (before.position, after.position)
         assert up.height == over.height == pytest.approx(lifted)
     for k in robot.keypoints:
         if k.action == "move":
@@ -336,7 +334,38 @@ def test_a_way_that_would_pass_over_an_object_goes_over_it():
     assert (up.action, over.action, gap.action) == ("transit", "transit", "gap")
     assert (up.position, over.position) == (release.position, gap.position)
     assert up.height == over.height == pytest.approx(transit_height(scene))
-    # The gap to the next push start passes behind obstacle_8, clear of everything: no lift.
-    following = keypoints[i + 4]
-    assert following.action == "move" and not crosses(gap.position, following.position,
-                                                      [r for n, r in space.rects.items() if n != scene.target.name])
+
+
+def test_a_push_that_would_leave_the_obstacle_in_the_way_goes_another_way():
+    from hlp_drake.planner.transfer import WAY_CLEARANCE, chosen_push, crosses, robot_push
+
+    # gen1 seed 19: the person moves FailOnTouchObstacleLong-1 forwards, over the table; pushed
+    # forwards it would end up across the way to the target (and shove the target off the table).
+    scene = generate_scene("gen1", 19)
+    space = TaskSpace(scene)
+    human = plan(scene, default_models())
+    i = next(i for i, k in enumerate(human.keypoints) if k.action == "move")
+    move, rest = human.keypoints[i], human.keypoints[i + 1:]
+    assert (move.element, move.direction) == ("FailOnTouchObstacleLong-1", "FF")
+    ways = [k.position for k in rest if k.action in ("gap", "target")]
+
+    def in_the_way(push):
+        points = [push.end, *ways]
+        return any(crosses(a, b, [push.footprint], clearance=WAY_CLEARANCE) for a, b in zip(points, points[1:]))
+
+    forwards = robot_push(space, scene, move.element, "FF", space.rects)
+    assert forwards.travel > 0.0 and in_the_way(forwards)
+    push = chosen_push(space, scene, move, rest, space.rects)
+    assert push.direction in ("LL", "RR") and not in_the_way(push) and push.travel >= 0.01
+    # Of the sideways pushes that clear the way, the one that moves the obstacle furthest.
+    sideways = [robot_push(space, scene, move.element, d, space.rects) for d in ("LL", "RR")]
+    assert push.travel == max(p.travel for p in sideways if not in_the_way(p) and p.travel >= 0.01)
+    robot = robot_plan(human, scene)
+    assert [(k.action, k.direction) for k in robot.keypoints if k.action in ("move", "release")] == [
+        ("move", push.direction), ("release", push.direction)]
+    # Pushes already clear of the way keep the person's direction (gen1 seed 3: right, then left).
+    scene = generate_scene("gen1", 3)
+    human = plan(scene, default_models())
+    robot = robot_plan(human, scene)
+    assert [k.direction for k in robot.keypoints if k.action == "move"] == [
+        k.direction for k in human.keypoints if k.action == "move"] == ["RR", "LL"]

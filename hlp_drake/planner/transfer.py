@@ -22,8 +22,9 @@ waypoint and above the next one, where the arm comes down, if nothing lies under
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import replace
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+from itertools import pairwise
 
 import numpy as np
 
@@ -57,6 +58,9 @@ ARM_SHADOW_LENGTH = 0.35
 ARM_SHADOW_HALF_WIDTH = 0.06
 # A way between waypoints whose tcp path passes this close to an object's footprint goes over it.
 PATH_CLEARANCE = 0.02
+# A push must not leave the obstacle this close to the tcp's way on through the gaps to the target:
+# the open gripper's half-width.
+WAY_CLEARANCE = 0.055
 
 
 def _robot_direction(space: TaskSpace, scene: Scene, name: str, direction: str,
@@ -126,46 +130,82 @@ def _nearing(distances: np.ndarray, margin: float) -> np.ndarray:
     return ((distances < margin) & (distances < distances[0] - 1e-12)).any(axis=1)
 
 
+@dataclass(frozen=True)
+class RobotPush:
+    """One push of the robot plan: its direction, how far it moves the obstacle, the tcp's start
+    and end points and the obstacle's footprint after it."""
+
+    direction: str
+    travel: float
+    start: tuple[float, float]
+    end: tuple[float, float]
+    footprint: Rect
+
+
+def robot_push(space: TaskSpace, scene: Scene, name: str, direction: str, placed: Mapping[str, Rect]) -> RobotPush:
+    """The push of obstacle ``name`` towards ``direction``: towards its relocated place, short of
+    the edge and the other objects (at ``placed``), from just behind its face opposite the push."""
+    rect = space.rects[name]
+    unit = _unit(direction)
+    travel = push_travel(space, scene, name, unit, _wanted(space, name, direction), footprints=placed)
+    # Distance from the centre to the face opposite the push, along the push direction.
+    clearance = abs(unit[0]) * FORWARD_CLEARANCE + abs(unit[1]) * SIDEWAYS_CLEARANCE
+    reach = abs(unit[0]) * rect.depth / 2.0 + abs(unit[1]) * rect.width / 2.0 + clearance
+    start = np.array(rect.center) - reach * unit
+    dx, dy = travel * unit
+    return RobotPush(direction, travel, (float(start[0]), float(start[1])),
+                     (float(start[0] + dx), float(start[1] + dy)),
+                     Rect(rect.x_min + dx, rect.y_min + dy, rect.x_max + dx, rect.y_max + dy))
+
+
+def chosen_push(space: TaskSpace, scene: Scene, move: PlanKeypoint, rest: Sequence[PlanKeypoint],
+                placed: Mapping[str, Rect]) -> RobotPush:
+    """The robot's push for the person's ``move``: towards the person's direction (a backward move
+    made sideways), unless that leaves the obstacle within ``WAY_CLEARANCE`` of the way on through
+    the gaps to the target (``rest``: the plan's later keypoints); then the push among LL, RR and
+    FF that leaves the way clear and moves the obstacle furthest, if any does."""
+    first = robot_push(space, scene, move.element, _robot_direction(space, scene, move.element, move.direction,
+                                                                     footprints=placed), placed)
+    ways = [k.position for k in rest if k.action in ("gap", "target")]
+
+    def clear(push: RobotPush) -> bool:
+        points = [push.end, *ways]
+        return push.travel >= MIN_PUSH_TRAVEL and not any(
+            crosses(a, b, [push.footprint], clearance=WAY_CLEARANCE) for a, b in pairwise(points))
+
+    if not ways or clear(first):
+        return first
+    others = [robot_push(space, scene, move.element, d, placed) for d in ("LL", "RR", "FF") if d != first.direction]
+    return max((push for push in others if clear(push)), key=lambda push: push.travel, default=first)
+
+
 def robot_plan(plan: HighLevelPlan, scene: Scene) -> HighLevelPlan:
-    """The plan with each move/release pair turned into the push's start and end points, each push
-    start reached over the objects where the arm can come down there (see ``transit``)."""
+    """The plan with each move/release pair turned into the push's start and end points (see
+    ``chosen_push``), pushes with no room left out, and the ways that would pass over objects
+    going over them where the arm can come down (see ``transit``)."""
     if not plan.ok:
         return plan
     space = TaskSpace(scene)
     placed = dict(space.rects)  # the objects' footprints as the pushes so far leave them
     keypoints: list[PlanKeypoint] = []
-    left_out: str | None = None  # the obstacle whose push (move and release) is left out
-    for k in plan.keypoints:
+    pushes: dict[str, RobotPush] = {}
+    for i, k in enumerate(plan.keypoints):
         if k.action not in ("move", "release") or k.element not in space.rects:
             keypoints += _way_to(keypoints, k, scene, placed)
             keypoints.append(k)
             continue
-        if k.action == "release" and k.element == left_out:
-            left_out = None
+        if k.action == "move" or k.element not in pushes:
+            pushes[k.element] = chosen_push(space, scene, k, plan.keypoints[i + 1:], placed)
+        push = pushes[k.element]
+        if push.travel < MIN_PUSH_TRAVEL:
             continue
-        rect = space.rects[k.element]
-        direction = _robot_direction(space, scene, k.element, k.direction, footprints=placed)
-        unit = _unit(direction)
-        # Towards the relocated place, short of the edge and the others.
-        wanted = _wanted(space, k.element, direction)
-        travel = push_travel(space, scene, k.element, unit, wanted, footprints=placed)
-        if k.action == "move" and travel < MIN_PUSH_TRAVEL:
-            left_out = k.element
-            continue
-        # Distance from the centre to the face opposite the push, along the push direction.
-        clearance = abs(unit[0]) * FORWARD_CLEARANCE + abs(unit[1]) * SIDEWAYS_CLEARANCE
-        reach = abs(unit[0]) * rect.depth / 2.0 + abs(unit[1]) * rect.width / 2.0 + clearance
-        centre = np.array(rect.center)
-        if k.action == "release":
-            shift = travel * unit
-            centre = centre + shift
-            placed[k.element] = Rect(rect.x_min + shift[0], rect.y_min + shift[1], rect.x_max + shift[0],
-                                     rect.y_max + shift[1])
-        point = centre - reach * unit
-        push = replace(k, position=(float(point[0]), float(point[1])), direction=direction)
         if k.action == "move":
-            keypoints += _way_to(keypoints, push, scene, placed)
-        keypoints.append(push)
+            start = replace(k, position=push.start, direction=push.direction)
+            keypoints += _way_to(keypoints, start, scene, placed)
+            keypoints.append(start)
+        else:
+            placed[k.element] = push.footprint
+            keypoints.append(replace(k, position=push.end, direction=push.direction))
     return replace(plan, keypoints=tuple(keypoints))
 
 
@@ -185,16 +225,16 @@ def _way_to(keypoints: list[PlanKeypoint], k: PlanKeypoint, scene: Scene, placed
     return transit(keypoints[-1], k, transit_height(scene), under)
 
 
-def crosses(a: tuple[float, float], b: tuple[float, float], rects) -> bool:
-    """Whether the straight tcp path from ``a`` to ``b`` passes within ``PATH_CLEARANCE`` of any of
+def crosses(a: tuple[float, float], b: tuple[float, float], rects, *, clearance: float = PATH_CLEARANCE) -> bool:
+    """Whether the straight tcp path from ``a`` to ``b`` passes within ``clearance`` of any of
     ``rects`` (sampled every ``TRAVEL_STEP``)."""
     boxes = np.array([[r.x_min, r.y_min, r.x_max, r.y_max] for r in rects]).reshape(-1, 4)
     if boxes.size == 0:
         return False
     count = max(int(np.ceil(np.hypot(b[0] - a[0], b[1] - a[1]) / TRAVEL_STEP)), 1) + 1
     points = np.linspace(a, b, count)[:, None, :]
-    inside = ((points[..., 0] > boxes[:, 0] - PATH_CLEARANCE) & (points[..., 0] < boxes[:, 2] + PATH_CLEARANCE)
-              & (points[..., 1] > boxes[:, 1] - PATH_CLEARANCE) & (points[..., 1] < boxes[:, 3] + PATH_CLEARANCE))
+    inside = ((points[..., 0] > boxes[:, 0] - clearance) & (points[..., 0] < boxes[:, 2] + clearance)
+              & (points[..., 1] > boxes[:, 1] - clearance) & (points[..., 1] < boxes[:, 3] + clearance))
     return bool(inside.any())
 
 

@@ -369,3 +369,26 @@ def test_a_push_that_would_leave_the_obstacle_in_the_way_goes_another_way():
     robot = robot_plan(human, scene)
     assert [k.direction for k in robot.keypoints if k.action == "move"] == [
         k.direction for k in human.keypoints if k.action == "move"] == ["RR", "LL"]
+
+
+def test_the_gripper_slides_onto_the_target_along_its_approach_axis():
+    from hlp_drake.planner.transfer import APPROACH_GAP, GRIPPER_AHEAD, approach
+    from hlp_drake.taskspace import Rect
+
+    target = Rect(0.70, -0.03, 0.76, 0.03)
+    # Coming in 35 degrees off +x: a waypoint APPROACH_GAP behind the target's back face, in line.
+    (point,) = approach((0.50, -0.14), target, {"t": target}, "t")
+    assert point.action == "approach" and point.element == "t"
+    assert point.position == pytest.approx((0.70 - APPROACH_GAP, 0.0))
+    assert point.position[0] + GRIPPER_AHEAD < target.x_min  # the fingertips stop short of it
+    # Already in line (within 15 degrees): none; an object where the gripper would be: none.
+    assert approach((0.40, 0.05), target, {"t": target}, "t") == []
+    blocker = Rect(0.60, 0.04, 0.66, 0.10)
+    assert approach((0.50, -0.14), target, {"t": target, "b": blocker}, "t") == []
+    # In a plan: gen1 seed 18 comes to the target from a gap 9 cm to its side.
+    scene = generate_scene("gen1", 18)
+    keypoints = robot_plan(plan(scene, default_models()), scene).keypoints
+    before, last = keypoints[-2:]
+    space = TaskSpace(scene)
+    assert (before.action, last.action) == ("approach", "target")
+    assert before.position == pytest.approx((space.rects[scene.target.name].x_min - APPROACH_GAP, scene.target.y))

@@ -18,7 +18,7 @@ class PlanKeypoint:
         action: "start"; "gap" (pass through a gap); "move" (reach an obstacle and push/carry it);
             "release" (where the moved obstacle is left); "target" (reach the target). A robot's
             plan (``planner.transfer.robot_plan``) adds "transit": a waypoint lifted clear of the
-            objects on the way to a push.
+            objects, and "approach": the waypoint the gripper slides onto the target from.
         position: (x, y) of the hand, m.
         row: the row the keypoint belongs to (None for start and target).
         element: the obstacle's name for "move"/"release", the gap's index (from the left, as text)

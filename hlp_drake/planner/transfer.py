@@ -17,7 +17,9 @@ way to each push start, and any other way whose tcp path would pass over an obje
 ``PATH_CLEARANCE`` of its footprint, the objects where the pushes so far left them), goes over the
 objects: two "transit" waypoints ``TRANSIT_CLEARANCE`` over the tallest object, above the previous
 waypoint and above the next one, where the arm comes down, if nothing lies under the arm there
-(else the waypoint is reached directly, at push height).
+(else the waypoint is reached directly, at push height). The gripper's approach axis is +x; coming
+onto the target from the side would sweep it along, so the way ends with an "approach" waypoint
+``APPROACH_GAP`` behind the target, from where the gripper slides straight on.
 """
 
 from __future__ import annotations
@@ -33,9 +35,10 @@ from hlp_drake.planner.relocation import relocated
 from hlp_drake.scene.model import Scene
 from hlp_drake.taskspace import DIRECTION_VECTORS, Rect, TaskSpace
 
-# Gap between the obstacle's face and the tcp at the push start: the fingertips reach ~1 cm ahead
-# of the tcp, the open fingers' outer sides ~5.5 cm beside it; plus 2 cm of free approach.
-FORWARD_CLEARANCE = 0.03
+# Gap between the obstacle's face and the tcp at the push start: the fingertips reach 2 cm ahead
+# of the tcp, the open fingers' outer sides ~5.5 cm beside it; plus 2-3 cm of free approach (the
+# arm comes down there from a transit waypoint, its approach axis up to 20 degrees off level).
+FORWARD_CLEARANCE = 0.05
 SIDEWAYS_CLEARANCE = 0.075
 BACKWARD = ("BB", "BL", "BR")
 # Half-width of the corridor along the start-target line that a backward move should clear: the open
@@ -58,6 +61,14 @@ ARM_SHADOW_LENGTH = 0.35
 ARM_SHADOW_HALF_WIDTH = 0.06
 # A way between waypoints whose tcp path passes this close to an object's footprint goes over it.
 PATH_CLEARANCE = 0.02
+# The gripper slides onto the target straight along its approach axis (+x), from a waypoint this
+# far behind the target's back face (the fingertips 2 cm ahead of the tcp, then 3 cm of free space),
+# where the way there would otherwise come in more than ``APPROACH_ANGLE`` off +x.
+APPROACH_GAP = 0.05
+APPROACH_ANGLE = np.radians(15.0)
+# The gripper's footprint at that waypoint (tcp-relative: the palm 5 cm behind it, the open fingers
+# 5.5 cm to either side, the fingertips 2 cm ahead) must be clear of the other objects.
+GRIPPER_BEHIND, GRIPPER_HALF_WIDTH, GRIPPER_AHEAD = 0.05, 0.055, 0.02
 # A push must not leave the obstacle this close to the tcp's way on through the gaps to the target:
 # the open gripper's half-width.
 WAY_CLEARANCE = 0.055
@@ -191,6 +202,10 @@ def robot_plan(plan: HighLevelPlan, scene: Scene) -> HighLevelPlan:
     pushes: dict[str, RobotPush] = {}
     for i, k in enumerate(plan.keypoints):
         if k.action not in ("move", "release") or k.element not in space.rects:
+            if k.action == "target" and keypoints:
+                for point in approach(keypoints[-1].position, placed[scene.target.name], placed, scene.target.name):
+                    keypoints += _way_to(keypoints, point, scene, placed)
+                    keypoints.append(point)
             keypoints += _way_to(keypoints, k, scene, placed)
             keypoints.append(k)
             continue
@@ -207,6 +222,22 @@ def robot_plan(plan: HighLevelPlan, scene: Scene) -> HighLevelPlan:
             placed[k.element] = push.footprint
             keypoints.append(replace(k, position=push.end, direction=push.direction))
     return replace(plan, keypoints=tuple(keypoints))
+
+
+def approach(previous: tuple[float, float], target: Rect, placed: Mapping[str, Rect], name: str
+             ) -> list[PlanKeypoint]:
+    """The waypoint ``APPROACH_GAP`` behind the ``target`` footprint from which the gripper slides
+    straight onto it, if the way from ``previous`` would come in more than ``APPROACH_ANGLE`` off
+    the approach axis and the gripper fits there, clear of the other objects (``placed``, the
+    target ``name`` aside); else none."""
+    x, y = target.x_min - APPROACH_GAP, (target.y_min + target.y_max) / 2.0
+    dx, dy = target.center[0] - previous[0], target.center[1] - previous[1]
+    if dx > 0.0 and abs(np.arctan2(dy, dx)) <= APPROACH_ANGLE:
+        return []
+    gripper = Rect(x - GRIPPER_BEHIND, y - GRIPPER_HALF_WIDTH, x + GRIPPER_AHEAD, y + GRIPPER_HALF_WIDTH)
+    if any(gripper.overlap(r) > 0.0 for other, r in placed.items() if other != name):
+        return []
+    return [PlanKeypoint("approach", (float(x), float(y)), element=name)]
 
 
 def _way_to(keypoints: list[PlanKeypoint], k: PlanKeypoint, scene: Scene, placed: Mapping[str, Rect]

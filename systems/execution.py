@@ -22,7 +22,7 @@ from hlp_drake.systems.grasp import grasp_knots
 from hlp_drake.systems.keypoint_ik import Keyframes
 from hlp_drake.systems.planning import make_planning_diagram
 from hlp_drake.systems.robot import TCP_FRAME
-from hlp_drake.systems.rollout import pregrasp_check, reach_problem
+from hlp_drake.systems.rollout import pregrasp_check, reach_problem, simulation_failure
 from hlp_drake.systems.rollout_pool import RolloutPool
 from hlp_drake.systems.scene_models import fallen_objects, object_body, object_planar_poses
 from hlp_drake.systems.sto import StoResult
@@ -168,9 +168,10 @@ def _execute(result: ExecutionResult, sequence: ControlSequence, config: WorldCo
             result.failure_reason = f"in execution: {problem}"
         if problem is None:
             result.grasp_held = _grasp(simulator, source, sequence, config, plant, plant_context, scene)
-    except RuntimeError as error:
+    except (RuntimeError, SystemExit) as error:
+        failure = simulation_failure(error)
         if result.failure_reason is None:
-            result.failure_reason = f"simulation failed: {str(error).splitlines()[0]}"
+            result.failure_reason = f"simulation failed: {failure}"
     finally:
         result.simulated_s = float(simulator.get_context().get_time())
         if meshcat is not None:

@@ -126,6 +126,15 @@ def pregrasp_check(tcp: np.ndarray, target_position: np.ndarray, scene: Scene, *
     return inside, distance
 
 
+def simulation_failure(error: BaseException) -> str:
+    """The first line of a Drake simulation failure: a ``RuntimeError``, or one of Drake's internal
+    checks failing (pydrake raises those as ``SystemExit("Failure at ...")``, e.g. non-finite
+    positions after a blow-up). Any other ``SystemExit`` is raised again."""
+    if isinstance(error, SystemExit) and not str(error).startswith("Failure at"):
+        raise error
+    return str(error).splitlines()[0]
+
+
 def reach_problem(fallen, inside: bool, distance: float) -> str | None:
     """Why a reach failed the success test (None if it passed)."""
     if fallen:
@@ -329,8 +338,8 @@ class RolloutWorld:
         """Simulate up to time ``t``; why the solver failed (None if it did not)."""
         try:
             self._simulator.AdvanceTo(float(t))
-        except RuntimeError as error:
-            return f"the solver failed at t = {self._context.get_time():.2f} s: {str(error).splitlines()[0]}"
+        except (RuntimeError, SystemExit) as error:
+            return f"the solver failed at t = {self._context.get_time():.2f} s: {simulation_failure(error)}"
         return None
 
     def time(self) -> float:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 
 import numpy as np
 import pytest
@@ -164,6 +165,32 @@ def test_impossible_object_speed_counts_as_a_blow_up(scene, trajectories):
     config.sto.max_object_speed = 1e-4  # any push now exceeds it
     outcome = RolloutWorld(scene, config).rollout(ControlSequence.from_trajectory(trajectories["sto"], 0.5))
     assert not outcome.success and outcome.cost == BLOWN_UP_COST and "over the table" in outcome.failure_reason
+
+
+def test_a_drake_internal_check_failing_mid_rollout_is_a_failure_and_the_world_goes_on(scene, trajectories):
+    # Non-finite state (as after a blow-up) makes Drake's SetPositions check fail inside AdvanceTo;
+    # pydrake raises that as SystemExit. The rollout reports it; the world is reusable after it.
+    world = RolloutWorld(scene, WorldConfig())
+    sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 0.5)
+    world.begin(sequence)
+    state = world._context.get_mutable_discrete_state_vector()
+    x = state.get_value().copy()
+    x[-1] = np.nan
+    state.SetFromVector(x)
+    problem = world.advance_to(0.1)
+    assert re.fullmatch(r"the solver failed at t = 0\.0\d s: Failure at .*AllFinite.*", problem)
+    clean = RolloutWorld(scene, WorldConfig()).rollout(sequence)
+    again = world.rollout(sequence)
+    assert (again.cost, again.success, again.fallen) == (clean.cost, clean.success, clean.fallen)
+
+
+def test_only_drake_failures_count_as_simulation_failures():
+    from hlp_drake.systems.rollout import simulation_failure
+
+    assert simulation_failure(RuntimeError("SAP failed\nmore")) == "SAP failed"
+    assert simulation_failure(SystemExit("Failure at x.h:1 in f(): condition 'c' failed.")).startswith("Failure at")
+    with pytest.raises(SystemExit):
+        simulation_failure(SystemExit(2))
 
 
 def test_two_workers_give_the_same_outcomes_as_one(scene, trajectories):

@@ -334,3 +334,27 @@ def test_rows_finishing_in_any_order_are_written_sorted(tmp_path):
     rows = read_results(tmp_path / "results.csv")
     random.Random(0).shuffle(rows)
     assert results_csv(rows) == text and results_csv(reversed(rows)) == text
+
+
+def test_a_drake_check_failing_in_a_job_is_that_jobs_crash_and_a_real_exit_is_not(monkeypatch):
+    import hlp_drake.systems.execution as execution
+    from hlp_drake.experiments.runner import run_job
+    from hlp_drake.systems.world_config import WorldConfig, dump_world_config
+
+    job = Job("gen1", 0, 6, "gen1-0", "hlp", dump_world_config(WorldConfig()))
+
+    def failing_check(*args, **kwargs):
+        raise SystemExit("Failure at plant.h:1 in SetPositions(): condition 'AllFinite(q)' failed.")
+
+    monkeypatch.setattr(execution, "plan_and_execute", failing_check)
+    row = run_job(job)
+    assert row["success"] is False and row["rollouts"] == 0
+    assert row["failure_reason"] == ("crashed: SystemExit: Failure at plant.h:1 in SetPositions(): "
+                                     "condition 'AllFinite(q)' failed.")
+
+    def exiting(*args, **kwargs):
+        raise SystemExit(3)
+
+    monkeypatch.setattr(execution, "plan_and_execute", exiting)
+    with pytest.raises(SystemExit):
+        run_job(job)

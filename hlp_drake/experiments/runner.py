@@ -86,19 +86,23 @@ def make_row(job: Job, *, success: bool, failure_reason: str | None, plan_s: flo
 def run_job(job: Job) -> Row:
     """Plan and execute ``job``'s scene in the Drake world.
 
-    An exception is recorded as this planner's failure on this scene ("crashed: ..."), its times as
-    NaN (left out of the means), rather than ending the run. The bundled decision models are loaded
+    An exception (or one of Drake's internal checks failing, which pydrake raises as ``SystemExit``)
+    is recorded as this planner's failure on this scene ("crashed: ..."), its times as NaN (left
+    out of the means), rather than ending the run. The bundled decision models are loaded
     before the timed call, so a worker's first scene is not charged for loading them.
     """
     from hlp_drake.learners.bundled import default_models
     from hlp_drake.systems.execution import plan_and_execute
+    from hlp_drake.systems.rollout import simulation_failure
     from hlp_drake.systems.world_config import load_world_config
 
     config = load_world_config(overrides=job.config_yaml)
     try:
         result = plan_and_execute(job.make_scene(), planner=job.planner, models=default_models(),
                                   config=config)
-    except Exception as error:  # noqa: BLE001 - a crash is this planner's failure here, not the run's end
+    except (Exception, SystemExit) as error:  # noqa: BLE001 - a crash is this planner's failure here
+        if isinstance(error, SystemExit):
+            simulation_failure(error)  # raises it again unless it is Drake's
         reason = " ".join(f"crashed: {type(error).__name__}: {error}".split())[:300]
         nan = float("nan")
         return make_row(job, success=False, failure_reason=reason, plan_s=nan, ik_s=nan, optimise_s=nan,

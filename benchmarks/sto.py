@@ -39,7 +39,7 @@ from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.execution import plan_and_execute
 from hlp_drake.systems.planning import make_planning_diagram
 from hlp_drake.systems.rollout import RolloutOutcome, RolloutWorld, SceneRollouts
-from hlp_drake.systems.rollout_pool import RolloutPool
+from hlp_drake.systems.rollout_pool import RolloutPool, forget_worlds
 from hlp_drake.systems.sto import sample_base_noise
 from hlp_drake.systems.world_config import WorldConfig
 
@@ -227,9 +227,12 @@ def model_agreement(triples: list[tuple], steps: tuple[float, ...]) -> dict:
 def comparison(config: WorldConfig, seeds: int, out: Path) -> dict:
     scenes = [load_scene(DEFAULT_SCENE)] + [generate_scene("gen1", seed) for seed in range(seeds)]
     rows = []
-    with RolloutPool(config.sto.workers) as pool:
-        for scene in tqdm(scenes, desc="HLP vs straight line", unit="scene"):
-            for planner in ("hlp", "sto"):
+    for scene in tqdm(scenes, desc="HLP vs straight line", unit="scene"):
+        for planner in ("hlp", "sto"):
+            # Fresh workers and no worlds kept in this process: neither planner reuses the rollout
+            # worlds the other one built on this scene (the pool's start-up is not in optimise_s).
+            forget_worlds()
+            with RolloutPool(config.sto.workers) as pool:
                 result = plan_and_execute(scene, planner=planner, config=config, pool=pool)
                 rows.append({"scene": scene.name, "planner": planner, "success": result.success,
                              "failure_reason": result.failure_reason or "", "iterations": result.iterations,

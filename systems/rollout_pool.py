@@ -39,6 +39,12 @@ def _world(scene: Scene, config_yaml: str, config: WorldConfig | None = None):
     return _worlds[key]
 
 
+def forget_worlds() -> None:
+    """Drop this process's pre-built rollout worlds (so the next optimisation builds its own, as a
+    first run would: comparisons must not hand one planner the worlds another one built)."""
+    _worlds.clear()
+
+
 def _rollout_task(scene: Scene, config_yaml: str, times, knots):
     return _world(scene, config_yaml).rollout(ControlSequence(times, knots))
 

@@ -343,7 +343,12 @@ def test_a_drake_check_failing_in_a_job_is_that_jobs_crash_and_a_real_exit_is_no
 
     job = Job("gen1", 0, 6, "gen1-0", "hlp", dump_world_config(WorldConfig()))
 
+    from hlp_drake.systems import rollout_pool
+
+    rollout_pool._worlds["left by an earlier job"] = object()
+
     def failing_check(*args, **kwargs):
+        assert not rollout_pool._worlds  # each job starts without another job's rollout worlds
         raise SystemExit("Failure at plant.h:1 in SetPositions(): condition 'AllFinite(q)' failed.")
 
     monkeypatch.setattr(execution, "plan_and_execute", failing_check)

@@ -327,3 +327,13 @@ def test_an_unreachable_target_fails_with_a_reason_and_no_rollouts(scene):
     result = plan_and_execute(dataclasses.replace(scene, target=far), planner="sto", config=config)
     assert not result.success and result.failure_reason.startswith("IK failed") and "Target" in result.failure_reason
     assert result.rollouts == 0 and result.grasp_held is None
+
+
+def test_forgetting_the_worlds_makes_the_next_run_build_its_own(scene):
+    from hlp_drake.systems.rollout_pool import forget_worlds
+
+    pool = RolloutPool(1)
+    kept = pool.world(scene, WorldConfig())
+    assert pool.world(scene, WorldConfig()) is kept
+    forget_worlds()
+    assert pool.world(scene, WorldConfig()) is not kept

@@ -89,14 +89,18 @@ def run_job(job: Job) -> Row:
     An exception (or one of Drake's internal checks failing, which pydrake raises as ``SystemExit``)
     is recorded as this planner's failure on this scene ("crashed: ..."), its times as NaN (left
     out of the means), rather than ending the run. The bundled decision models are loaded
-    before the timed call, so a worker's first scene is not charged for loading them.
+    before the timed call, so a worker's first scene is not charged for loading them, and
+    every job starts without rollout worlds that an earlier job (maybe the other planner on the
+    same scene) built in this process.
     """
     from hlp_drake.learners.bundled import default_models
     from hlp_drake.systems.execution import plan_and_execute
     from hlp_drake.systems.rollout import simulation_failure
+    from hlp_drake.systems.rollout_pool import forget_worlds
     from hlp_drake.systems.world_config import load_world_config
 
     config = load_world_config(overrides=job.config_yaml)
+    forget_worlds()
     try:
         result = plan_and_execute(job.make_scene(), planner=job.planner, models=default_models(),
                                   config=config)

@@ -10,6 +10,8 @@ person lifts the obstacle back over the table; pushed sideways into the corridor
 way), the side the obstacle lies on when both leave the same. A push that cannot move the obstacle
 ``MIN_PUSH_TRAVEL`` before it nears the table's edge or another object is left out: pressing it
 into its neighbours would only shove them along (or off the table).
+A person can put an obstacle down anywhere; a push that would leave it in the way on through the
+gaps to the target goes another way (``chosen_push``).
 
 A person lifts their hand over the table on the way to an obstacle; a robot arm moving sideways at
 push height would sweep its forearm through everything between the base and the gripper. So the

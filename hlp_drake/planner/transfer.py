@@ -35,7 +35,7 @@ import numpy as np
 from hlp_drake.planner.plan import HighLevelPlan, PlanKeypoint
 from hlp_drake.planner.relocation import relocated
 from hlp_drake.scene.model import Scene
-from hlp_drake.taskspace import DIRECTION_VECTORS, Rect, TaskSpace
+from hlp_drake.taskspace import DIRECTION_VECTORS, Rect, TaskSpace, rect_array
 
 # Gap between the obstacle's face and the tcp at the push start: the fingertips reach 2 cm ahead
 # of the tcp, the open fingers' outer sides ~5.5 cm beside it; plus 2-3 cm of free approach (the
@@ -122,12 +122,12 @@ def push_travel(space: TaskSpace, scene: Scene, name: str, unit: np.ndarray, wan
     steps = np.arange(TRAVEL_STEP, wanted + 1e-9, TRAVEL_STEP)
     if steps.size == 0:
         return 0.0
-    start = np.array([rect.x_min, rect.y_min, rect.x_max, rect.y_max])
+    start = rect_array([rect])[0]
     boxes = np.vstack([start, start + np.outer(steps, [unit[0], unit[1], unit[0], unit[1]])])
     x_min, y_min, x_max, y_max = scene.table.bounds
     edges = np.column_stack([boxes[:, 0] - x_min, boxes[:, 1] - y_min, x_max - boxes[:, 2], y_max - boxes[:, 3]])
     blocked = _nearing(edges, EDGE_MARGIN)
-    others = np.array([[r.x_min, r.y_min, r.x_max, r.y_max] for other, r in footprints.items() if other != name])
+    others = rect_array([r for other, r in footprints.items() if other != name])
     if others.size:  # the gap to each other object along the axis that separates them most
         gaps = np.max([others[None, :, 0] - boxes[:, None, 2], boxes[:, None, 0] - others[None, :, 2],
                        others[None, :, 1] - boxes[:, None, 3], boxes[:, None, 1] - others[None, :, 3]], axis=0)
@@ -261,7 +261,7 @@ def _way_to(keypoints: list[PlanKeypoint], k: PlanKeypoint, scene: Scene, placed
 def crosses(a: tuple[float, float], b: tuple[float, float], rects, *, clearance: float = PATH_CLEARANCE) -> bool:
     """Whether the straight tcp path from ``a`` to ``b`` passes within ``clearance`` of any of
     ``rects`` (sampled every ``TRAVEL_STEP``)."""
-    boxes = np.array([[r.x_min, r.y_min, r.x_max, r.y_max] for r in rects]).reshape(-1, 4)
+    boxes = rect_array(list(rects))
     if boxes.size == 0:
         return False
     count = max(int(np.ceil(np.hypot(b[0] - a[0], b[1] - a[1]) / TRAVEL_STEP)), 1) + 1

@@ -13,6 +13,7 @@ from collections.abc import Sequence
 import numpy as np
 from shapely.geometry import Polygon
 
+from hlp_drake.taskspace.model import rect_array
 from hlp_drake.taskspace.rect import Rect
 
 SAMPLED_LINES = 11  # area_scan_resolution 10 -> 11 lines
@@ -150,10 +151,6 @@ def band_coverage_sampled(p0: np.ndarray, p1: np.ndarray, offsets: np.ndarray, s
     return area / ((r[:, 2] - r[:, 0]) * (r[:, 3] - r[:, 1]))[None, :]
 
 
-def _rects(occluders: Sequence[Rect]) -> np.ndarray:
-    return np.array([(o.x_min, o.y_min, o.x_max, o.y_max) for o in occluders], float).reshape(-1, 4)
-
-
 def band_collision(p0: Sequence[float], p1: Sequence[float], occluders: Sequence[Rect], *,
                    half_width: float, offset: Sequence[float] | None = None) -> float:
     """Exact mean covered fraction of ``occluders`` by the band of ``half_width`` around p0->p1.
@@ -164,7 +161,7 @@ def band_collision(p0: Sequence[float], p1: Sequence[float], occluders: Sequence
     if not occluders:
         return 0.0
     u = normal_of(p0, p1) if offset is None else offset
-    return float(band_coverage(p0, p1, u, half_width, half_width, _rects(occluders)).mean())
+    return float(band_coverage(p0, p1, u, half_width, half_width, rect_array(occluders)).mean())
 
 
 def band_collision_sampled(p0: Sequence[float], p1: Sequence[float], occluders: Sequence[Rect], *,
@@ -172,4 +169,4 @@ def band_collision_sampled(p0: Sequence[float], p1: Sequence[float], occluders: 
     """The original code's sampled estimate (reference 4.6); all occluders count in the mean."""
     if not occluders:
         return 0.0
-    return float(band_coverage_sampled(p0, p1, offset, s_minus, s_plus, _rects(occluders)).mean())
+    return float(band_coverage_sampled(p0, p1, offset, s_minus, s_plus, rect_array(occluders)).mean())

@@ -239,20 +239,13 @@ class TaskSpace:
         """The eight direction blocks around object ``name``."""
         return direction_blocks(self.rects[name], self.alpha)
 
-    def occluders(self, *, target: bool = False, walls: tuple[str, ...] = WALLS,
-                  exclude: tuple[str, ...] = ()) -> list[Rect]:
-        """Obstacle rectangles (and the target's, and the named walls), minus ``exclude``."""
-        names = [n for n in self.obstacle_names if n not in exclude]
-        if target:
-            names.append(self.scene.target.name)
-        return [self.rects[n] for n in names] + [self.walls[w] for w in walls]
-
     def occluder_bounds(self, *, target: bool = False, walls: tuple[str, ...] = WALLS) -> np.ndarray:
-        """``occluders`` (nothing excluded) as an (m, 4) array."""
+        """(m, 4) bounds of the obstacles (and of the target, and of the named walls)."""
         extra = ([self.target] if target else []) + [self.walls[w] for w in walls]
         return np.vstack([self.obstacle_bounds, rect_array(extra)])
 
-    def free_space(self, name: str, occluders: list[Rect] | None = None) -> np.ndarray:
-        """Free fraction of each direction block of ``name`` (order ``DIRECTIONS``)."""
+    def free_space(self, name: str) -> np.ndarray:
+        """Free fraction of each direction block of ``name`` (order ``DIRECTIONS``), the obstacles and
+        the four walls occluding."""
         blocks = block_array(rect_array([self.rects[name]]), self.alpha)[0]
-        return free_fractions(blocks, rect_array(self.occluders() if occluders is None else occluders))
+        return free_fractions(blocks, self.occluder_bounds())

@@ -31,6 +31,7 @@ import time
 from collections import OrderedDict
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 from hlp_drake.systems.control_sequence import ControlSequence
@@ -45,6 +46,7 @@ from hlp_drake.systems.world import (
 )
 from hlp_drake.systems.world_config import WorldConfig
 from pydrake.geometry import CollisionFilterDeclaration, GeometrySet, Role
+from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
@@ -256,7 +258,6 @@ class RolloutWorld:
         self._watched = robot_bodies + self._objects
         self._watched_radii = np.array([self._body_radius(inspector, b) for b in self._watched])
         self._sweep_context = None
-        self.start_collisions = self._start_collisions(world)
 
     def _body_radius(self, inspector, body) -> float:
         """Radius about the body's origin of a sphere holding its collision geometry, m."""
@@ -267,13 +268,14 @@ class RolloutWorld:
             radius = max(radius, float(np.linalg.norm(centre) + np.linalg.norm(box.half_width())))
         return radius
 
-    def _start_collisions(self, world) -> tuple[str, ...]:
-        """Names of the bodies the robot penetrates in the initial state."""
-        query = world.GetOutputPort("query_object").Eval(world.GetMyContextFromRoot(self._context))
-        inspector = query.inspector()
+    @cached_property
+    def start_collisions(self) -> tuple[str, ...]:
+        """Names of the bodies the robot penetrates in the initial state (computed on first use: of
+        a scene's worlds only the full one is asked)."""
+        query = self._world.GetOutputPort("query_object").Eval(self._world.GetMyContextFromRoot(self._initial))
         hits = set()
         for pair in query.ComputePointPairPenetration():
-            a, b = (self.plant.GetBodyFromFrameId(inspector.GetFrameId(g)) for g in (pair.id_A, pair.id_B))
+            a, b = (self.plant.get_body(BodyIndex(self._geometry_body[g])) for g in (pair.id_A, pair.id_B))
             a_robot, b_robot = int(a.index()) in self._robot_bodies, int(b.index()) in self._robot_bodies
             if a_robot != b_robot:
                 hits.add((b if a_robot else a).name())

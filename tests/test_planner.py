@@ -52,3 +52,42 @@ def test_bad_scenes_give_a_reason_not_an_exception(models):
     assert one.ok and len({k.row for k in one.keypoints if k.row}) == 1
     mismatch = plan(scene, models, PlannerConfig(mode="faithful"))
     assert not mismatch.ok and "fixed mode" in mismatch.reason
+
+
+def test_rows_the_classifiers_know_nothing_about_keep_what_lies_nearest_the_reach(models):
+    """Gen II scenes lie outside the demonstrations: Cg and Co score (almost) every candidate with
+    their intercept. Such a row keeps the gap and the obstacle nearest the start-target line, not
+    the first in order, so the plan moves the one obstacle the straight reach would hit."""
+    from hlp_drake.planner.candidates import informed, line_offsets
+
+    scene = generate_scene("gen2", 0, 5)
+    space = TaskSpace(scene)
+    result = plan(scene, models)
+    gap_scores = np.array(list(result.details["gap_scores"].values()))
+    object_scores = np.array(list(result.details["object_scores"].values()))
+    config = PlannerConfig()
+    assert not informed(gap_scores, models.gap.intercept_, config.min_evidence).any()
+    assert not informed(object_scores, models.object.intercept_, config.min_evidence).any()
+    start, target = np.asarray(scene.start), np.asarray(space.target.center)
+    offsets = dict(zip(space.obstacle_names, line_offsets(space.obstacle_centres, start, target)))
+    for row, names in result.details["candidates"].items():
+        kept = [n for n in names if n in offsets]
+        in_row = [n for n, r in zip(space.obstacle_names, space.obstacle_rows.tolist()) if str(r) == row]
+        assert kept == [min(in_row, key=offsets.get)]
+    moved = [k.element for k in result.keypoints if k.action == "move"]
+    assert moved == ["obstacle_5"]  # the only obstacle within 10 cm of the line
+    assert offsets["obstacle_5"] < 0.1 and sorted(offsets.values())[1] > 0.2
+
+
+def test_candidates_with_evidence_still_follow_the_classifiers():
+    from hlp_drake.planner.candidates import _accepted, enumerate_paths
+
+    offsets = [0.3, 0.0, 0.1]
+    assert _accepted([-0.5, -0.5, -0.5], [False] * 3, offsets, 2) == [1]  # no evidence: nearest the line
+    assert _accepted([-0.2, -0.5, -0.5], [True, False, False], offsets, 2) == [0]  # the best-scored
+    assert _accepted([0.4, -0.5, 0.2], [True, False, True], offsets, 1) == [0]  # the accepted ones, capped
+    block = np.array([[-0.5, -0.5], [-0.5, -0.5]])
+    two_best = enumerate_paths([2, 2], [block], 10)
+    assert len(two_best) == 3  # the original's rule: the two best pairs, and node 1 along its best
+    every = enumerate_paths([2, 2], [block], 10, [np.zeros((2, 2), bool)])
+    assert sorted(nodes for nodes, _ in every) == [(0, 0), (0, 1), (1, 0), (1, 1)]

@@ -9,7 +9,7 @@ import numpy as np
 from hlp_drake.features import table_diagonal
 from hlp_drake.learners.models import DecisionModels
 from hlp_drake.planner.blas import single_blas_thread
-from hlp_drake.planner.candidates import classify, enumerate_paths, row_candidates, segment_scores
+from hlp_drake.planner.candidates import classify, enumerate_paths, informed, row_candidates, segment_scores
 from hlp_drake.planner.config import PlannerConfig
 from hlp_drake.planner.plan import HighLevelPlan, PlanCandidate, PlanKeypoint
 from hlp_drake.planner.rollout import PrefixTree, arm_configurations, expected_collisions, path_keypoints
@@ -67,9 +67,10 @@ def _plan(space: TaskSpace, models: DecisionModels, config: PlannerConfig, q0: n
                        if np.isfinite(s)},
         "object_scores": {n: s for n, s in zip(names, object_scores.tolist()) if np.isfinite(s)},
     }
-    candidates = row_candidates(space, gap_scores, object_scores, config)
-    scored = enumerate_paths([len(c) for c in candidates], segment_scores(space, models, candidates, config),
-                             config.max_paths)
+    candidates = row_candidates(space, models, gap_scores, object_scores, config)
+    blocks = segment_scores(space, models, candidates, config)
+    evidence = [informed(block, models.segment.intercept_, config.min_evidence) for block in blocks]
+    scored = enumerate_paths([len(c) for c in candidates], blocks, config.max_paths, evidence)
 
     # 4-5. Keypoints per path (moved obstacles' directions by Cd), arm configurations by Ra and
     # the arm's expected collision.

@@ -177,6 +177,12 @@ class TaskSpace:
         return rect_array([self.rects[n] for n in self.obstacle_names])
 
     @cached_property
+    def obstacle_centres(self) -> np.ndarray:
+        """(n_obstacles, 2) centres of the obstacles, in scene order."""
+        b = self.obstacle_bounds
+        return np.column_stack([(b[:, 0] + b[:, 2]) / 2.0, (b[:, 1] + b[:, 3]) / 2.0])
+
+    @cached_property
     def obstacle_index(self) -> dict[str, int]:
         """Each obstacle's position in scene order."""
         return {n: i for i, n in enumerate(self.obstacle_names)}

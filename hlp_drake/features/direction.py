@@ -8,7 +8,15 @@ import numpy as np
 
 from hlp_drake.features.plane import corner_origin
 from hlp_drake.segmentation.modes import Mode, is_faithful
-from hlp_drake.taskspace import DIRECTIONS, TaskSpace, block_array, direction_of, free_fractions, rect_array
+from hlp_drake.taskspace import (
+    DIRECTIONS,
+    TaskSpace,
+    block_array,
+    direction_of,
+    free_fractions,
+    rect_array,
+    rect_centres,
+)
 
 DIRECTION_FEATURES = (*(f"free_{d}" for d in DIRECTIONS), "hand_to_object", "object_to_target")
 UNDEFINED_DIRECTION = -1  # class index of a zero displacement (the original's empty label)
@@ -63,7 +71,7 @@ class DirectionTable:
         if self.faithful:
             self.origins, target_origin = corner_origin(rects), corner_origin(target[0])
         else:
-            self.origins = np.column_stack([(rects[:, 0] + rects[:, 2]) / 2.0, (rects[:, 1] + rects[:, 3]) / 2.0])
+            self.origins = rect_centres(rects)
             target_origin = np.array(space.target.center)
         self.to_target = np.array([direction_index(direction_of(*(target_origin - o), faithful=self.faithful))
                                    for o in self.origins], dtype=int).reshape(-1)

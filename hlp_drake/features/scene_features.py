@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from hlp_drake.features.plane import GAP_DEPTH, paper_angle, table_diagonal
-from hlp_drake.taskspace import TaskSpace, block_array, free_fractions
+from hlp_drake.taskspace import TaskSpace, block_array, free_fractions, rect_centres
 
 GAP_FEATURES = ("dist_start", "dist_target", "size", "angle_from_start", "angle_from_target")
 OBJECT_FEATURES = (*GAP_FEATURES, "free_space", "target_overlap")
@@ -35,7 +35,7 @@ def gap_features(space: TaskSpace, index: np.ndarray | None = None) -> np.ndarra
     if len(bounds) == 0:
         return np.zeros((0, len(GAP_FEATURES)))
     diagonal = table_diagonal(space.scene.table)
-    centres = np.column_stack([(bounds[:, 0] + bounds[:, 2]) / 2.0, (bounds[:, 1] + bounds[:, 3]) / 2.0])
+    centres = rect_centres(bounds)
     widths = bounds[:, 3] - bounds[:, 1]
     rel = _relative(centres, np.asarray(space.scene.start), np.asarray(space.target.center), diagonal)
     size = np.hypot(widths, GAP_DEPTH) / diagonal
@@ -54,7 +54,7 @@ def object_features(space: TaskSpace, index: np.ndarray | None = None) -> np.nda
     if len(rects) == 0:
         return np.zeros((0, len(OBJECT_FEATURES)))
     diagonal = table_diagonal(space.scene.table)
-    centres = np.column_stack([(rects[:, 0] + rects[:, 2]) / 2, (rects[:, 1] + rects[:, 3]) / 2])
+    centres = rect_centres(rects)
     target = space.target
     rel = _relative(centres, np.asarray(space.scene.start), np.asarray(target.center), diagonal)
     size = np.hypot(rects[:, 2] - rects[:, 0], rects[:, 3] - rects[:, 1]) / diagonal

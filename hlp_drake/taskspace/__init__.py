@@ -12,6 +12,7 @@ from hlp_drake.taskspace.model import (
     free_fractions,
     overlap_areas,
     rect_array,
+    rect_centres,
 )
 from hlp_drake.taskspace.rect import Rect
 
@@ -34,4 +35,5 @@ __all__ = [
     "normal_of",
     "overlap_areas",
     "rect_array",
+    "rect_centres",
 ]

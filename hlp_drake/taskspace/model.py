@@ -80,8 +80,12 @@ class GapTable:
     @property
     def centers(self) -> np.ndarray:
         """(n, 2) centres, as ``Rect.center``."""
-        b = self.bounds
-        return np.column_stack([(b[:, 0] + b[:, 2]) / 2.0, (b[:, 1] + b[:, 3]) / 2.0])
+        return rect_centres(self.bounds)
+
+
+def rect_centres(bounds: np.ndarray) -> np.ndarray:
+    """(n, 2) centres of an (n, 4) rectangle array, as ``Rect.center``."""
+    return np.column_stack([(bounds[:, 0] + bounds[:, 2]) / 2.0, (bounds[:, 1] + bounds[:, 3]) / 2.0])
 
 
 def rect_array(rects: list[Rect] | tuple[Rect, ...]) -> np.ndarray:
@@ -179,8 +183,7 @@ class TaskSpace:
     @cached_property
     def obstacle_centres(self) -> np.ndarray:
         """(n_obstacles, 2) centres of the obstacles, in scene order."""
-        b = self.obstacle_bounds
-        return np.column_stack([(b[:, 0] + b[:, 2]) / 2.0, (b[:, 1] + b[:, 3]) / 2.0])
+        return rect_centres(self.obstacle_bounds)
 
     @cached_property
     def obstacle_index(self) -> dict[str, int]:

@@ -29,7 +29,7 @@ scene's objects welded at their scene poses, with one private context. Constrain
 
 The cost keeps each keyframe near the previous one. A keypoint is solved from up to ``ik.attempts``
 seeds (the previous keyframe; it with the base moved along with the tcp; the start posture moved
-to the keypoint) and checked by forward kinematics; a keypoint that fails is reported in
+to the keypoint; a continuation along the tcp's straight line) and checked by forward kinematics; a keypoint that fails is reported in
 ``Keyframes`` and skipped by the trajectory (the next keypoint is seeded from the last success).
 """
 
@@ -72,6 +72,8 @@ POSTURE_WEIGHT = 0.05
 """Weight of the pull of the arm's joints towards their start posture, against 1 for the step."""
 FK_CHECK_FACTOR = 2.0
 """A solution whose tcp is farther than this times ``ik.position_tolerance`` from its target fails."""
+CONTINUATION_STEPS = 4
+"""Steps of the continuation seed along the straight tcp line to a keypoint (``_continued``)."""
 
 
 @dataclass(frozen=True)
@@ -298,6 +300,22 @@ class KeypointIk(LeafSystem):
         shifted[self._index[BASE_JOINTS[1]]] += shift[1]
         return np.clip(shifted, self._lower, self._upper)
 
+    def _continued(self, previous: np.ndarray, target: np.ndarray) -> np.ndarray | None:
+        """The posture reached by solving ``CONTINUATION_STEPS - 1`` evenly spaced points of the
+        straight tcp line from ``previous`` towards ``target`` (without the clearance constraint),
+        each from the last; None if one fails. A far keypoint may need the arm to unfold while the
+        base stops at its bounds, which SNOPT does not find in one solve from a folded seed (a
+        straight line from a Generalization II start)."""
+        q, start = previous.copy(), self.tcp_position(previous)
+        for fraction in np.linspace(0.0, 1.0, CONTINUATION_STEPS + 1)[1:-1]:
+            prog, variables = self._program(start + fraction * (target - start), q, clearance=False)
+            result = Solve(prog, q, self._options)
+            solution = result.GetSolution(variables)
+            if not (result.is_success() or prog.CheckSatisfied(prog.GetAllConstraints(), solution, 1e-6)):
+                return None
+            q = solution
+        return q
+
     def _program(self, target: np.ndarray, previous: np.ndarray, *, clearance: bool) -> tuple:
         """The IK program of one keypoint: (program, decision variables)."""
         ik_config = self._config.ik
@@ -336,7 +354,8 @@ class KeypointIk(LeafSystem):
 
         Seeds, in order, up to ``ik.attempts``: the previous keyframe; the solution of the same
         program without the clearance constraint (from the previous keyframe); the previous
-        keyframe with the base moved along with the tcp; the start posture moved likewise.
+        keyframe with the base moved along with the tcp; the start posture moved likewise; the
+        end of a continuation along the straight tcp line (``_continued``).
         """
         target = self._target(keypoint)
         start_distance = np.hypot(*np.subtract(keypoint.position, self._scene.start))
@@ -354,6 +373,9 @@ class KeypointIk(LeafSystem):
                 yield result.GetSolution(loose_q)
             yield self._shifted(previous, target)
             yield self._shifted(self._start, target)
+            continued = self._continued(previous, target)
+            if continued is not None:
+                yield continued
 
         attempts = 0
         for seed in seeds():

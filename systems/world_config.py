@@ -139,7 +139,8 @@ class IkConfig:
         start_reach: horizontal distance from the base's centre to the tcp at the start, m.
         start_base_clearance: smallest gap between the base's front and the table edge at the start, m.
         max_iterations: SNOPT major-iteration limit per solve.
-        attempts: solves per keypoint (the previous keyframe, then seeds with the base shifted).
+        attempts: solves per keypoint (the previous keyframe, then seeds with the base shifted, then
+            a continuation along the tcp's straight line).
     """
 
     height: float = 0.06
@@ -153,7 +154,7 @@ class IkConfig:
     start_reach: float = 1.10
     start_base_clearance: float = 0.05
     max_iterations: int = 500
-    attempts: int = 4
+    attempts: int = 5
 
 
 @dataclass

@@ -197,6 +197,22 @@ def test_ik_reaches_the_target_of_generated_and_vr_scenes(kind, seed):
         assert_reaches(system.solve(plan), plan, height)
 
 
+def test_a_far_target_straight_from_a_gen2_start_is_reached_by_continuation():
+    """gen2 seed 17: the target 0.83 m deep, 0.19 m to the side of the start. From the start's folded
+    arm the base stops at its bound and SNOPT ends at its iteration limit from every other seed;
+    solving points along the straight tcp line first reaches it."""
+    from dataclasses import replace
+
+    scene = generate_scene("gen2", 17, 5)
+    target = PlanKeypoint("target", scene.target.position, element=scene.target.name)
+    direct = HighLevelPlan(scene=scene.name, keypoints=(PlanKeypoint("start", scene.start), target))
+    height = scene.table.height + CONFIG.ik.height
+    assert_reaches(KeypointIk(scene, CONFIG).solve(direct), direct, height)
+    without = replace(CONFIG, ik=replace(CONFIG.ik, attempts=4))  # the seeds before the continuation
+    failed = KeypointIk(scene, without).solve(direct)
+    assert not failed.ok and "IK failed after 4 attempt(s)" in failed.failures[0]
+
+
 @pytest.mark.parametrize("height", [0.70, 0.80])
 def test_tcp_reaches_0_95_m_past_the_front_edge_and_the_edge_itself(height):
     """The riser puts the arm's mount at about table height: the horizontal gripper reaches 0.95 m deep

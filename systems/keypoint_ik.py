@@ -355,7 +355,8 @@ class KeypointIk(LeafSystem):
         Seeds, in order, up to ``ik.attempts``: the previous keyframe; the solution of the same
         program without the clearance constraint (from the previous keyframe); the previous
         keyframe with the base moved along with the tcp; the start posture moved likewise; the
-        end of a continuation along the straight tcp line (``_continued``).
+        end of a continuation along the straight tcp line (``_continued``), from which the keypoint
+        is solved with the cost pulling towards that posture instead of the previous keyframe.
         """
         target = self._target(keypoint)
         start_distance = np.hypot(*np.subtract(keypoint.position, self._scene.start))
@@ -365,28 +366,28 @@ class KeypointIk(LeafSystem):
         prog, q = self._program(target, previous, clearance=True)
         best, reasons = previous.copy(), []
 
-        def seeds():
-            yield previous.copy()
+        def seeds():  # (seed, program, its variables)
+            yield previous.copy(), prog, q
             loose, loose_q = self._program(target, previous, clearance=False)
             result = Solve(loose, previous, self._options)
             if result.is_success():
-                yield result.GetSolution(loose_q)
-            yield self._shifted(previous, target)
-            yield self._shifted(self._start, target)
+                yield result.GetSolution(loose_q), prog, q
+            yield self._shifted(previous, target), prog, q
+            yield self._shifted(self._start, target), prog, q
             continued = self._continued(previous, target)
-            if continued is not None:
-                yield continued
+            if continued is not None:  # its last step: the cost pulls towards the last posture on the way
+                yield continued, *self._program(target, continued, clearance=True)
 
         attempts = 0
-        for seed in seeds():
+        for seed, program, variables in seeds():
             if attempts == self._config.ik.attempts:
                 break
             attempts += 1
-            result = Solve(prog, seed, self._options)
-            solution = result.GetSolution(q)
+            result = Solve(program, seed, self._options)
+            solution = result.GetSolution(variables)
             # SNOPT often stops at its iteration limit on a point that meets every constraint:
             # accept such an iterate when the constraints check out (the FK check follows).
-            feasible = result.is_success() or prog.CheckSatisfied(prog.GetAllConstraints(), solution, 1e-6)
+            feasible = result.is_success() or program.CheckSatisfied(program.GetAllConstraints(), solution, 1e-6)
             if not feasible:
                 best = solution
                 reasons.append(str(result.get_solution_result()).split(".")[-1])

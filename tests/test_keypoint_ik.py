@@ -197,13 +197,14 @@ def test_ik_reaches_the_target_of_generated_and_vr_scenes(kind, seed):
         assert_reaches(system.solve(plan), plan, height)
 
 
-def test_a_far_target_straight_from_a_gen2_start_is_reached_by_continuation():
-    """gen2 seed 17: the target 0.83 m deep, 0.19 m to the side of the start. From the start's folded
-    arm the base stops at its bound and SNOPT ends at its iteration limit from every other seed;
-    solving points along the straight tcp line first reaches it."""
+@pytest.mark.parametrize("kind, seed, objects", [("gen2", 17, 5), ("gen1", 41, None)])
+def test_a_far_target_straight_from_the_start_is_reached_by_continuation(kind, seed, objects):
+    """Targets 0.83 m (gen2 seed 17, 0.19 m to the side) and 0.86 m (gen1 seed 41) deep: from the
+    start's folded arm the base stops at its bound and SNOPT ends at its iteration limit from every
+    other seed; solving points along the straight tcp line first reaches them."""
     from dataclasses import replace
 
-    scene = generate_scene("gen2", 17, 5)
+    scene = generate_scene(kind, seed, objects)
     target = PlanKeypoint("target", scene.target.position, element=scene.target.name)
     direct = HighLevelPlan(scene=scene.name, keypoints=(PlanKeypoint("start", scene.start), target))
     height = scene.table.height + CONFIG.ik.height

@@ -22,10 +22,10 @@ class PlannerConfig:
             original).
         arm_band: half-width of the band swept by an arm link, m.
         min_evidence: a Cg, Co or Cc score closer than this to the classifier's intercept carries no
-            evidence (the case lies outside the demonstrations' range): a row with no such gap
-            (obstacle) score keeps the one nearest the start-target line, and a pair of rows with
-            no such segment score keeps every segment between them (the arm's expected collision
-            decides).
+            evidence (the case lies outside the demonstrations' range): a row none of whose gap
+            (obstacle) scores carries evidence keeps the one nearest the start-target line, and a
+            pair of rows none of whose segment scores does keeps every segment between them (the
+            arm's expected collision decides).
         classify_per_row: per row, only the gaps and obstacles laterally nearest the start-target
             line (this many of each) are classified, so the work per row is bounded however
             crowded the row is (a VR row has 4 gaps and 3 obstacles: all are classified).

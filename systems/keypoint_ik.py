@@ -29,8 +29,9 @@ scene's objects welded at their scene poses, with one private context. Constrain
 
 The cost keeps each keyframe near the previous one. A keypoint is solved from up to ``ik.attempts``
 seeds (the previous keyframe; it with the base moved along with the tcp; the start posture moved
-to the keypoint; a continuation along the tcp's straight line) and checked by forward kinematics; a keypoint that fails is reported in
-``Keyframes`` and skipped by the trajectory (the next keypoint is seeded from the last success).
+to the keypoint; a continuation along the tcp's straight line) and checked by forward kinematics;
+a keypoint that fails is reported in ``Keyframes`` and skipped by the trajectory (the next keypoint
+is seeded from the last success).
 """
 
 from __future__ import annotations
@@ -308,13 +309,20 @@ class KeypointIk(LeafSystem):
         straight line from a Generalization II start)."""
         q, start = previous.copy(), self.tcp_position(previous)
         for fraction in np.linspace(0.0, 1.0, CONTINUATION_STEPS + 1)[1:-1]:
-            prog, variables = self._program(start + fraction * (target - start), q, clearance=False)
-            result = Solve(prog, q, self._options)
-            solution = result.GetSolution(variables)
-            if not (result.is_success() or prog.CheckSatisfied(prog.GetAllConstraints(), solution, 1e-6)):
+            point = start + fraction * (target - start)
+            _, q, feasible = self._solve(*self._program(point, q, clearance=False), q)
+            if not feasible:
                 return None
-            q = solution
         return q
+
+    def _solve(self, program, variables, seed: np.ndarray) -> tuple:
+        """(SNOPT's result, the solution, whether it meets every constraint) from ``seed``. SNOPT
+        often stops at its iteration limit on a point that meets every constraint: such an iterate
+        counts when the constraints check out."""
+        result = Solve(program, seed, self._options)
+        solution = result.GetSolution(variables)
+        return result, solution, result.is_success() or program.CheckSatisfied(
+            program.GetAllConstraints(), solution, 1e-6)
 
     def _program(self, target: np.ndarray, previous: np.ndarray, *, clearance: bool) -> tuple:
         """The IK program of one keypoint: (program, decision variables)."""
@@ -383,11 +391,7 @@ class KeypointIk(LeafSystem):
             if attempts == self._config.ik.attempts:
                 break
             attempts += 1
-            result = Solve(program, seed, self._options)
-            solution = result.GetSolution(variables)
-            # SNOPT often stops at its iteration limit on a point that meets every constraint:
-            # accept such an iterate when the constraints check out (the FK check follows).
-            feasible = result.is_success() or program.CheckSatisfied(program.GetAllConstraints(), solution, 1e-6)
+            result, solution, feasible = self._solve(program, variables, seed)  # the FK check follows
             if not feasible:
                 best = solution
                 reasons.append(str(result.get_solution_result()).split(".")[-1])

@@ -8,7 +8,8 @@ Output ports (both computed only when ``plan`` changes; cached otherwise):
         a message naming the keypoint when its IK failed.
     ``trajectory`` (abstract, ``PiecewisePolynomial``): a first-order hold of the robot's 11 positions
         from the start configuration through the successful keyframes (straight lines in joint space),
-        timed by ``WorldConfig.motion``.
+        timed by ``WorldConfig.motion``; the gripper closed among the obstacles if
+        ``motion.closed_among_obstacles``.
 
 The positions are in the robot model instance's order (``world.robot_position_names()``: base x, y,
 yaw, the six UR5 joints, left finger, right (mimic) finger), the same in the world diagram's plant,
@@ -54,6 +55,7 @@ from hlp_drake.systems.robot import (
     ARM_JOINTS,
     BASE_FOOTPRINT,
     BASE_JOINTS,
+    GRIPPER_CLOSED,
     GRIPPER_JOINTS,
     GRIPPER_MIMIC_JOINTS,
     TCP_FRAME,
@@ -75,6 +77,8 @@ FK_CHECK_FACTOR = 2.0
 """A solution whose tcp is farther than this times ``ik.position_tolerance`` from its target fails."""
 CONTINUATION_STEPS = 4
 """Steps of the continuation seed along the straight tcp line to a keypoint (``_continued``)."""
+GRASP_ACTIONS = ("approach", "target")
+"""Keypoint actions reached with the gripper open (``motion.closed_among_obstacles``)."""
 
 
 @dataclass(frozen=True)
@@ -198,8 +202,9 @@ class KeypointIk(LeafSystem):
         self._upper[self._index[BASE_JOINTS[1]]] = y_limit
         yaw = self._index[BASE_JOINTS[2]]
         self._lower[yaw], self._upper[yaw] = -ik.base_max_yaw, ik.base_max_yaw
-        for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS:  # keep the gripper as at the start (open)
-            self._lower[self._index[name]] = self._upper[self._index[name]] = self._start[self._index[name]]
+        self._gripper = [self._index[name] for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS]
+        for i in self._gripper:  # keep the gripper as at the start (open)
+            self._lower[i] = self._upper[i] = self._start[i]
         self._height = tcp_keypoint_height(scene, self._config)
         self._options = ik_solver_options(ik.max_iterations)
         self.num_solves = 0
@@ -414,12 +419,24 @@ class KeypointIk(LeafSystem):
         keyframes: Keyframes = self._keyframes_port.Eval(context)
         output.set_value(self.trajectory(keyframes))
 
+    def _with_gripper(self, q: np.ndarray, opening: float) -> np.ndarray:
+        q = np.array(q, dtype=float)
+        q[self._gripper] = opening
+        return q
+
     def trajectory(self, keyframes: Keyframes) -> PiecewisePolynomial:
         """The first-order hold from the start through ``keyframes``' successful keyframes."""
         motion = self._config.motion
         knots, lifted = [self._start], [False]
         for q, ok, keypoint in zip(keyframes.positions, keyframes.success, keyframes.keypoints):
-            if ok and np.max(np.abs(q - knots[-1])) > 1e-9:
+            if not ok:
+                continue
+            if motion.closed_among_obstacles and keypoint.action not in ("start", *GRASP_ACTIONS):
+                q = self._with_gripper(q, GRIPPER_CLOSED)
+            elif keypoint.action == "target" and np.any(knots[-1][self._gripper] != q[self._gripper]):
+                knots.append(self._with_gripper(knots[-1], q[self._gripper][0]))  # open before sliding on
+                lifted.append(lifted[-1])
+            if np.max(np.abs(q - knots[-1])) > 1e-9:
                 knots.append(q)
                 lifted.append(keypoint.height is not None)  # lifted clear of the objects
         if len(knots) == 1:

@@ -164,12 +164,19 @@ class MotionConfig:
     A segment lasts the longest of: its tcp path length over ``tcp_speed`` (``transit_speed`` on the
     way to or from a waypoint lifted clear of the objects), each joint's travel over
     ``joint_speed_fraction`` of its velocity limit, and ``min_segment_duration``.
+
+    With ``closed_among_obstacles`` the gripper closes on the way to the first keyframe and stays
+    closed through the pushes, gaps and transits, opening on the way to the "approach" keyframe
+    (in place before sliding onto the target if there is none): open fingers straddle a small
+    obstacle and carry it along into the target. Keyframes are solved open either way (the tcp
+    does not depend on the fingers).
     """
 
     tcp_speed: float = 0.1
     transit_speed: float = 0.25
     joint_speed_fraction: float = 0.5
     min_segment_duration: float = 0.25
+    closed_among_obstacles: bool = True
 
 
 @dataclass

@@ -12,7 +12,7 @@ from hlp_drake.planner.plan import HighLevelPlan, PlanKeypoint
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene, SceneObject, Table
 from hlp_drake.systems.keypoint_ik import Keyframes, KeypointIk
-from hlp_drake.systems.robot import BASE_FOOTPRINT, TCP_FRAME
+from hlp_drake.systems.robot import BASE_FOOTPRINT, GRIPPER_CLOSED, GRIPPER_OPEN, TCP_FRAME
 from hlp_drake.systems.world import make_world_diagram, start_configuration, world_plant
 from hlp_drake.systems.world_config import WorldConfig
 from hlp_drake.taskspace import TaskSpace
@@ -107,8 +107,8 @@ def test_trajectory_starts_at_the_start_and_passes_through_the_keyframes(system,
     np.testing.assert_allclose(keyframes.positions[0], start, atol=1e-12)  # the "start" keypoint
     breaks = trajectory.get_segment_times()
     assert len(breaks) == len(keyframes.positions)  # start + the two gaps; no duplicated knot
-    for t, q in zip(breaks, keyframes.positions):
-        np.testing.assert_allclose(trajectory.value(t).ravel(), q, atol=1e-9)
+    for t, q in zip(breaks, keyframes.positions):  # the gripper aside (closed at the gaps)
+        np.testing.assert_allclose(trajectory.value(t).ravel()[:9], q[:9], atol=1e-9)
     # Timed by the tcp speed: no segment is shorter than its tcp path over tcp_speed.
     for i in range(1, len(breaks)):
         path = np.linalg.norm(keyframes.tcp_positions[i] - keyframes.tcp_positions[i - 1])
@@ -119,8 +119,56 @@ def test_trajectory_starts_at_the_start_and_passes_through_the_keyframes(system,
     # A first-order hold: straight lines in joint space between keyframes.
     middle = 0.5 * (breaks[0] + breaks[1])
     np.testing.assert_allclose(
-        trajectory.value(middle).ravel(), 0.5 * (keyframes.positions[0] + keyframes.positions[1]), atol=1e-9
+        trajectory.value(middle).ravel(),
+        0.5 * (trajectory.value(breaks[0]) + trajectory.value(breaks[1])).ravel(), atol=1e-9,
     )
+
+
+def fingers(trajectory: PiecewisePolynomial, t: float) -> np.ndarray:
+    return trajectory.value(t).ravel()[9:]
+
+
+def test_gripper_closes_among_the_obstacles_and_opens_before_the_target(system, scene):
+    """Closed from the first gap on (closing on the way there), open again in place at the last gap
+    before sliding onto the target (the plan has no approach keypoint); open throughout when
+    ``motion.closed_among_obstacles`` is off."""
+    plan = through_gaps(scene, to_target=True)
+    keyframes, trajectory = evaluate(system, plan)
+    assert keyframes.ok, keyframes.failures
+    breaks = trajectory.get_segment_times()
+    assert len(breaks) == len(plan.keypoints) + 1  # the opening in place is a knot of its own
+    np.testing.assert_allclose(fingers(trajectory, 0.0), [GRIPPER_OPEN] * 2)
+    assert 0.0 < fingers(trajectory, 0.5 * breaks[1])[0] < GRIPPER_OPEN  # closing on the way
+    for t in breaks[1:3]:
+        np.testing.assert_allclose(fingers(trajectory, t), [GRIPPER_CLOSED] * 2)
+    np.testing.assert_allclose(trajectory.value(breaks[3])[:9], trajectory.value(breaks[2])[:9])  # in place
+    for t in breaks[3:]:
+        np.testing.assert_allclose(fingers(trajectory, t), [GRIPPER_OPEN] * 2)
+    # The fingers' speed limit times the pace: no faster than the trajectory allows for any joint.
+    assert breaks[3] - breaks[2] >= GRIPPER_OPEN / (CONFIG.motion.joint_speed_fraction * 0.075) - 1e-9
+
+    config = WorldConfig()
+    config.motion.closed_among_obstacles = False
+    _, open_all = evaluate(KeypointIk(scene, config), plan)
+    assert len(open_all.get_segment_times()) == len(plan.keypoints)
+    for t in open_all.get_segment_times():
+        np.testing.assert_allclose(fingers(open_all, t), [GRIPPER_OPEN] * 2)
+
+
+def test_gripper_opens_on_the_way_to_an_approach_keypoint(system, scene):
+    gaps = through_gaps(scene, to_target=False)
+    x, y = scene.target.position
+    approach = PlanKeypoint("approach", (x - 0.08, y), element=scene.target.name)
+    target = PlanKeypoint("target", scene.target.position, element=scene.target.name)
+    plan = HighLevelPlan(scene=scene.name, keypoints=(*gaps.keypoints, approach, target))
+    keyframes, trajectory = evaluate(system, plan)
+    assert keyframes.ok, keyframes.failures
+    breaks = trajectory.get_segment_times()
+    assert len(breaks) == len(plan.keypoints)  # no knot added
+    np.testing.assert_allclose(fingers(trajectory, breaks[2]), [GRIPPER_CLOSED] * 2)
+    assert 0.0 < fingers(trajectory, 0.5 * (breaks[2] + breaks[3]))[0] < GRIPPER_OPEN
+    for t in breaks[3:]:
+        np.testing.assert_allclose(fingers(trajectory, t), [GRIPPER_OPEN] * 2)
 
 
 def test_unreachable_waypoint_is_reported_for_that_keypoint(system, scene):
@@ -134,9 +182,9 @@ def test_unreachable_waypoint_is_reported_for_that_keypoint(system, scene):
     assert "keypoint 3" in keyframes.messages[3] and "target" in keyframes.messages[3]
     assert "IK failed" in keyframes.messages[3]
     assert keyframes.failures == [keyframes.messages[3]]
-    # The trajectory skips the failed keyframe and ends at the last good one.
+    # The trajectory skips the failed keyframe and ends at the last good one (the gripper closed).
     np.testing.assert_allclose(
-        trajectory.value(trajectory.end_time()).ravel(), keyframes.positions[2], atol=1e-9
+        trajectory.value(trajectory.end_time()).ravel()[:9], keyframes.positions[2][:9], atol=1e-9
     )
 
 

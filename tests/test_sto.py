@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from pydrake.trajectories import PiecewisePolynomial
 
+from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import load_scene
 from hlp_drake.scene.model import SceneObject
 from hlp_drake.systems.control_sequence import ControlSequence
@@ -151,6 +152,29 @@ def test_rollouts_are_repeatable_and_the_hlp_initialisation_reaches_the_default_
     assert first.success, first.failure_reason
     assert first.cost == second.cost and first.terms == second.terms  # contexts are reset, not rebuilt
     assert first.simulated_s == pytest.approx(sequence.duration + world.config.sto.settle_s)
+
+
+def initial_outcome(scene, config: WorldConfig):
+    """The HLP initial trajectory's rollout on the reduced worlds, as the optimiser's first one."""
+    diagram = make_planning_diagram(scene, planner="hlp", config=config)
+    context = diagram.CreateDefaultContext()
+    diagram.GetInputPort("scene").FixValue(context, scene)
+    sequence = ControlSequence.from_trajectory(diagram.GetOutputPort("trajectory").Eval(context),
+                                               config.sto.step_duration)
+    return SceneRollouts(scene, config).rollout(sequence)
+
+
+def test_a_gripper_closed_among_the_obstacles_does_not_carry_one_into_the_target():
+    """Gen I seed 15: on the way to the first push start the open fingers straddle a small obstacle
+    (FailOnTouchObstacleShort) and carry it through both rows into the target, which falls off
+    the table; closed there, the same plan passes at its first rollout."""
+    scene = generate_scene("gen1", 15)
+    closed = initial_outcome(scene, WorldConfig())
+    assert closed.success, closed.failure_reason
+    config = WorldConfig()
+    config.motion.closed_among_obstacles = False
+    opened = initial_outcome(scene, config)
+    assert not opened.success and opened.fallen == ("Target",), opened.failure_reason
 
 
 def test_holding_still_fails_with_the_goal_cost(world, scene):

@@ -11,7 +11,9 @@ from hlp_drake.planner.transfer import robot_plan
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.hlp_planner_system import HlpPlannerSystem
+from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.keypoint_ik import KeypointIk
+from hlp_drake.systems.rollout import RolloutOutcome, SceneRollouts
 from hlp_drake.systems.rollout_pool import RolloutPool
 from hlp_drake.systems.sto import StochasticTrajectoryOptimiser
 from hlp_drake.systems.world_config import WorldConfig
@@ -105,3 +107,19 @@ def make_planning_diagram(scene: Scene, *, planner: str = "hlp", models: Decisio
     diagram = builder.Build()
     diagram.set_name(f"{planner}_planning")
     return diagram
+
+
+def first_rollout(scene: Scene, *, planner: str = "hlp", models: DecisionModels | None = None,
+                  config: WorldConfig | None = None) -> RolloutOutcome | None:
+    """The rollout of ``planner``'s initial trajectory on ``scene``, as the optimiser's first one
+    (``SceneRollouts``: the reduced model if ``config.sto.reduced_model``, at the rollout time step);
+    None if the plan or its IK produced no trajectory."""
+    config = WorldConfig() if config is None else config
+    diagram = make_planning_diagram(scene, planner=planner, models=models, config=config)
+    context = diagram.CreateDefaultContext()
+    diagram.GetInputPort("scene").FixValue(context, scene)
+    if not diagram.GetOutputPort("keyframes").Eval(context).ok:
+        return None
+    trajectory = diagram.GetOutputPort("trajectory").Eval(context)
+    sequence = ControlSequence.from_trajectory(trajectory, config.sto.step_duration)
+    return SceneRollouts(scene, config).rollout(sequence)

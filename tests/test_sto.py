@@ -14,7 +14,7 @@ from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import load_scene
 from hlp_drake.scene.model import SceneObject
 from hlp_drake.systems.control_sequence import ControlSequence
-from hlp_drake.systems.planning import make_planning_diagram
+from hlp_drake.systems.planning import first_rollout, make_planning_diagram
 from hlp_drake.systems.rollout import BLOWN_UP_COST, RolloutSamples, RolloutWorld, SceneRollouts, rollout_cost
 from hlp_drake.systems.rollout_pool import RolloutPool
 from hlp_drake.systems.sto import StochasticTrajectoryOptimiser, mppi_weights, optimise, sample_base_noise
@@ -154,26 +154,16 @@ def test_rollouts_are_repeatable_and_the_hlp_initialisation_reaches_the_default_
     assert first.simulated_s == pytest.approx(sequence.duration + world.config.sto.settle_s)
 
 
-def initial_outcome(scene, config: WorldConfig):
-    """The HLP initial trajectory's rollout on the reduced worlds, as the optimiser's first one."""
-    diagram = make_planning_diagram(scene, planner="hlp", config=config)
-    context = diagram.CreateDefaultContext()
-    diagram.GetInputPort("scene").FixValue(context, scene)
-    sequence = ControlSequence.from_trajectory(diagram.GetOutputPort("trajectory").Eval(context),
-                                               config.sto.step_duration)
-    return SceneRollouts(scene, config).rollout(sequence)
-
-
 def test_a_gripper_closed_among_the_obstacles_does_not_carry_one_into_the_target():
     """Gen I seed 15: on the way to the first push start the open fingers straddle a small obstacle
     (FailOnTouchObstacleShort) and carry it through both rows into the target, which falls off
     the table; closed there, the same plan passes at its first rollout."""
     scene = generate_scene("gen1", 15)
-    closed = initial_outcome(scene, WorldConfig())
+    closed = first_rollout(scene, config=WorldConfig())
     assert closed.success, closed.failure_reason
     config = WorldConfig()
     config.motion.closed_among_obstacles = False
-    opened = initial_outcome(scene, config)
+    opened = first_rollout(scene, config=config)
     assert not opened.success and opened.fallen == ("Target",), opened.failure_reason
 
 

@@ -23,6 +23,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from hlp_drake.atomic import write_text_atomic
+from hlp_drake.errors import HlpError
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.systems.world_config import dump_world_config, load_world_config
 
@@ -51,7 +52,10 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--json", type=Path, help="write the rows and counts here")
     args = parser.parse_args()
-    config_yaml = dump_world_config(load_world_config(args.config))
+    try:
+        config_yaml = dump_world_config(load_world_config(args.config))
+    except HlpError as error:
+        parser.error(str(error))
     counts = args.objects if args.kind == "gen2" else [None]
     jobs = [(args.kind, args.seed + i, n, args.planner, config_yaml) for n in counts for i in range(args.scenes)]
     started = time.perf_counter()

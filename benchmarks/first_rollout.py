@@ -38,7 +38,7 @@ def first_pass(kind: str, seed: int, objects: int | None, planner: str, config_y
                             config=load_world_config(overrides=config_yaml))
     return {"scene": scene.name, "seed": seed, "objects": len(scene.obstacles),
             "passed": bool(outcome is not None and outcome.success),
-            "reason": "IK failed" if outcome is None else outcome.failure_reason}
+            "reason": "no trajectory" if outcome is None else outcome.failure_reason}
 
 
 def main() -> None:
@@ -57,10 +57,12 @@ def main() -> None:
     except HlpError as error:
         parser.error(str(error))
     counts = args.objects if args.kind == "gen2" else [None]
-    jobs = [(args.kind, args.seed + i, n, args.planner, config_yaml) for n in counts for i in range(args.scenes)]
+    jobs = [(args.kind, args.seed + i, n, args.planner, config_yaml)
+            for n in counts for i in range(args.scenes)]
     started = time.perf_counter()
     with ProcessPoolExecutor(args.workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-        rows = list(tqdm(pool.map(first_pass, *zip(*jobs)), total=len(jobs), desc="first rollouts", unit="scene"))
+        outcomes = pool.map(first_pass, *zip(*jobs))
+        rows = list(tqdm(outcomes, total=len(jobs), desc="first rollouts", unit="scene"))
     summary = {}
     for n in counts:
         group = [r for r in rows if n is None or r["objects"] == n]

@@ -37,7 +37,7 @@ from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import load_scene
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.execution import plan_and_execute
-from hlp_drake.systems.planning import make_planning_diagram
+from hlp_drake.systems.planning import initial_sequence
 from hlp_drake.systems.rollout import RolloutOutcome, RolloutWorld, SceneRollouts
 from hlp_drake.systems.rollout_pool import RolloutPool, forget_worlds
 from hlp_drake.systems.sto import sample_base_noise
@@ -45,17 +45,6 @@ from hlp_drake.systems.world_config import WorldConfig
 
 DEFAULT_SCENE = Path(__file__).resolve().parents[1] / "hlp_drake" / "scenes" / "default.yaml"
 HORIZON = 3.0
-
-
-def initial_sequence(scene, planner: str, config: WorldConfig) -> ControlSequence | None:
-    """The planner's initial (IK) sequence on ``scene``; None if it has no trajectory at all."""
-    diagram = make_planning_diagram(scene, planner=planner, config=config)
-    context = diagram.CreateDefaultContext()
-    diagram.GetInputPort("scene").FixValue(context, scene)
-    trajectory = diagram.GetOutputPort("trajectory").Eval(context)
-    if trajectory.get_number_of_segments() == 0:
-        return None
-    return ControlSequence.from_trajectory(trajectory, config.sto.step_duration)
 
 
 def truncated(sequence: ControlSequence, horizon: float) -> ControlSequence:
@@ -76,7 +65,7 @@ def throughput_sequences(count: int) -> tuple:
     scene = generate_scene("gen2", 0, 9)
     config = WorldConfig()
     config.sto.settle_s = 0.0
-    base = truncated(initial_sequence(scene, "sto", config), HORIZON)
+    base = truncated(initial_sequence(scene, planner="sto", config=config), HORIZON)
     return scene, config, noisy(base, config, count, seed=1)
 
 
@@ -134,14 +123,15 @@ def validation_sequences(count: int, scenes: int) -> list[tuple]:
     default = load_scene(DEFAULT_SCENE)
     triples = []
     for planner in ("hlp", "sto"):
-        for i, sequence in enumerate(noisy(initial_sequence(default, planner, WorldConfig()), WorldConfig(), count, seed=2)):
+        initial = initial_sequence(default, planner=planner, config=WorldConfig())
+        for i, sequence in enumerate(noisy(initial, WorldConfig(), count, seed=2)):
             triples.append((default, f"default/{planner}/noisy{i}", sequence, True))
     scene, _, sequences = throughput_sequences(2 * count)
     triples += [(scene, f"throughput/noisy{i}", s, False) for i, s in enumerate(sequences)]
     for kind, seed in [(kind, seed) for seed in range(scenes) for kind in ("gen1", "gen2")]:
         scene = generate_scene(kind, seed, 9 if kind == "gen2" else None)
         for planner in ("hlp", "sto"):
-            sequence = initial_sequence(scene, planner, WorldConfig())
+            sequence = initial_sequence(scene, planner=planner, config=WorldConfig())
             if sequence is None:
                 print(f"{kind} seed {seed}, {planner}: no initial trajectory, left out")
                 continue

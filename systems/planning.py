@@ -109,17 +109,26 @@ def make_planning_diagram(scene: Scene, *, planner: str = "hlp", models: Decisio
     return diagram
 
 
-def first_rollout(scene: Scene, *, planner: str = "hlp", models: DecisionModels | None = None,
-                  config: WorldConfig | None = None) -> RolloutOutcome | None:
-    """The rollout of ``planner``'s initial trajectory on ``scene``, as the optimiser's first one
-    (``SceneRollouts``: the reduced model if ``config.sto.reduced_model``, at the rollout time step);
-    None if the plan or its IK produced no trajectory."""
+def initial_sequence(scene: Scene, *, planner: str = "hlp", models: DecisionModels | None = None,
+                     config: WorldConfig | None = None) -> ControlSequence | None:
+    """``planner``'s initial (IK) control sequence on ``scene``, the optimiser's starting point;
+    None if there is no trajectory at all (a keypoint whose IK failed is skipped, as the trajectory
+    does)."""
     config = WorldConfig() if config is None else config
     diagram = make_planning_diagram(scene, planner=planner, models=models, config=config)
     context = diagram.CreateDefaultContext()
     diagram.GetInputPort("scene").FixValue(context, scene)
-    if not diagram.GetOutputPort("keyframes").Eval(context).ok:
-        return None
     trajectory = diagram.GetOutputPort("trajectory").Eval(context)
-    sequence = ControlSequence.from_trajectory(trajectory, config.sto.step_duration)
-    return SceneRollouts(scene, config).rollout(sequence)
+    if trajectory.get_number_of_segments() == 0:
+        return None
+    return ControlSequence.from_trajectory(trajectory, config.sto.step_duration)
+
+
+def first_rollout(scene: Scene, *, planner: str = "hlp", models: DecisionModels | None = None,
+                  config: WorldConfig | None = None) -> RolloutOutcome | None:
+    """The rollout of ``initial_sequence`` on ``scene``, as the optimiser's first one
+    (``SceneRollouts``: the reduced model if ``config.sto.reduced_model``, at the rollout time step);
+    None if there is no initial sequence."""
+    config = WorldConfig() if config is None else config
+    sequence = initial_sequence(scene, planner=planner, models=models, config=config)
+    return None if sequence is None else SceneRollouts(scene, config).rollout(sequence)

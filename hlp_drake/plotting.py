@@ -8,10 +8,10 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
+import matplotlib.pyplot as plt
+from matplotlib.figure import Figure
 
-from hlp_drake.atomic import atomic_path  # noqa: E402
+from hlp_drake.atomic import atomic_path
 
 
 def save_png(figure: Figure, path: str | os.PathLike[str], *, dpi: int = 150) -> None:

@@ -36,8 +36,8 @@ def summary(result) -> str:
     lines = [
         f"scene {result.scene.name}: {len(result.scene.obstacles)} obstacles, planner {result.planner}",
         f"plan: {steps}",
-        f"timings: plan {t['plan_s']:.3f} s, IK {t['ik_s']:.2f} s, {optimiser}, execute {t['execute_s']:.1f} s "
-        f"({result.simulated_s:.1f} s simulated), total {t['total_s']:.1f} s",
+        (f"timings: plan {t['plan_s']:.3f} s, IK {t['ik_s']:.2f} s, {optimiser}, execute {t['execute_s']:.1f} s "
+         f"({result.simulated_s:.1f} s simulated), total {t['total_s']:.1f} s"),
         f"objects moved: {', '.join(result.objects_moved) or 'none'}; dropped: {', '.join(result.objects_dropped) or 'none'}",
         "success" if result.success else f"failure: {result.failure_reason}",
         f"grasp: {grasp}",

@@ -17,7 +17,14 @@ from hlp_drake.atomic import write_text_atomic
 from hlp_drake.cli import run_cli
 from hlp_drake.dataset.dataset import Dataset
 from hlp_drake.errors import HlpError
-from hlp_drake.segmentation import DEFAULT_MODE, MODES, Rejected, SegmentationResult, segment_dataset, segment_trial
+from hlp_drake.segmentation import (
+    DEFAULT_MODE,
+    MODES,
+    Rejected,
+    SegmentationResult,
+    segment_dataset,
+    segment_trial,
+)
 from hlp_drake.segmentation.plot import save_segmentation_png
 
 CSV_COLUMNS = ("subject", "trial", "row", "decision", "element", "direction", "keypoints", "handedness")

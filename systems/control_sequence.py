@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from itertools import pairwise
 
 import numpy as np
 from pydrake.trajectories import PiecewisePolynomial
@@ -62,7 +63,7 @@ class ControlSequence:
         most ``max_step`` s; the sequence starts at time 0."""
         breaks = np.array(trajectory.get_segment_times(), dtype=float)
         times = [breaks[0]]
-        for a, b in zip(breaks[:-1], breaks[1:]):
+        for a, b in pairwise(breaks):
             pieces = max(1, math.ceil((b - a) / max_step - 1e-9))
             times.extend(a + (b - a) * np.arange(1, pieces + 1) / pieces)
         times = np.array(times)

@@ -26,7 +26,12 @@ from hlp_drake.systems.rollout import pregrasp_check, reach_problem, simulation_
 from hlp_drake.systems.rollout_pool import RolloutPool
 from hlp_drake.systems.scene_models import fallen_objects, object_body, object_planar_poses
 from hlp_drake.systems.sto import StoResult
-from hlp_drake.systems.world import add_position_trajectory, make_world_diagram, tcp_keypoint_height, world_plant
+from hlp_drake.systems.world import (
+    add_position_trajectory,
+    make_world_diagram,
+    tcp_keypoint_height,
+    world_plant,
+)
 from hlp_drake.systems.world_config import WorldConfig
 
 SETTLE_S = 1.0  # simulated time after the trajectory ends, before objects are checked

@@ -10,8 +10,8 @@ from hlp_drake.planner import HighLevelPlan, PlanKeypoint
 from hlp_drake.planner.transfer import robot_plan
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene
-from hlp_drake.systems.hlp_planner_system import HlpPlannerSystem
 from hlp_drake.systems.control_sequence import ControlSequence
+from hlp_drake.systems.hlp_planner_system import HlpPlannerSystem
 from hlp_drake.systems.keypoint_ik import KeypointIk
 from hlp_drake.systems.rollout import RolloutOutcome, SceneRollouts
 from hlp_drake.systems.rollout_pool import RolloutPool

@@ -34,6 +34,12 @@ from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
+from pydrake.geometry import CollisionFilterDeclaration, GeometrySet, Role
+from pydrake.multibody.tree import BodyIndex
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+
+from hlp_drake.scene.model import Scene
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.robot import TCP_FRAME
 from hlp_drake.systems.scene_models import TABLE_NAME, object_body, off_table_mask, over_table_mask
@@ -45,12 +51,6 @@ from hlp_drake.systems.world import (
     world_plant,
 )
 from hlp_drake.systems.world_config import WorldConfig
-from pydrake.geometry import CollisionFilterDeclaration, GeometrySet, Role
-from pydrake.multibody.tree import BodyIndex
-from pydrake.systems.analysis import Simulator
-from pydrake.systems.framework import DiagramBuilder
-
-from hlp_drake.scene.model import Scene
 
 BLOWN_UP_COST = 1.0e9
 """Cost of a rollout whose simulation failed or blew up (ranked below every sane one)."""

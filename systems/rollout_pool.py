@@ -13,6 +13,7 @@ import multiprocessing
 import time
 from collections import OrderedDict
 from concurrent.futures import ProcessPoolExecutor
+from typing import Self
 
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.control_sequence import ControlSequence
@@ -93,7 +94,7 @@ class RolloutPool:
             self._executor.shutdown(cancel_futures=True)
             self._executor = None
 
-    def __enter__(self) -> RolloutPool:
+    def __enter__(self) -> Self:
         return self
 
     def __exit__(self, *exc) -> None:

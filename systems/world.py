@@ -53,7 +53,7 @@ from pydrake.multibody.plant import (
     MultibodyPlant,
 )
 from pydrake.multibody.tree import JointActuatorIndex, ModelInstanceIndex, PdControllerGains
-from pydrake.solvers import SnoptSolver, SolverOptions, Solve
+from pydrake.solvers import SnoptSolver, Solve, SolverOptions
 from pydrake.systems.controllers import InverseDynamics
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import MatrixGain, TrajectorySource

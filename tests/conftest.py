@@ -76,6 +76,7 @@ def run_module(module: str, *args: str, cwd: Path | None = None, env: dict | Non
         [sys.executable, "-m", module, *args],
         capture_output=True,
         text=True,
+        check=False,
         cwd=cwd,
         env={**os.environ, **(env or {})},
         timeout=600,

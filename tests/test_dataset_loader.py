@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from conftest import run_module
+from synthetic_dataset import hand_positions, write_archive, write_dataset
+
 from hlp_drake.dataset import Dataset
 from hlp_drake.errors import DatasetError
-from synthetic_dataset import hand_positions, write_archive, write_dataset
 
 
 @pytest.fixture

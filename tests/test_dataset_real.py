@@ -6,8 +6,8 @@ import json
 
 import numpy as np
 import pytest
-
 from conftest import run_module
+
 from hlp_drake.dataset import PRACTICE, STRUCTURED
 from hlp_drake.scene import find_rows
 

@@ -337,8 +337,8 @@ def test_rows_finishing_in_any_order_are_written_sorted(tmp_path):
 
 
 def test_a_drake_check_failing_in_a_job_is_that_jobs_crash_and_a_real_exit_is_not(monkeypatch):
-    import hlp_drake.systems.execution as execution
     from hlp_drake.experiments.runner import run_job
+    from hlp_drake.systems import execution
     from hlp_drake.systems.world_config import WorldConfig, dump_world_config
 
     job = Job("gen1", 0, 6, "gen1-0", "hlp", dump_world_config(WorldConfig()))

@@ -36,7 +36,7 @@ def test_nothing_can_use_the_remote_drake_models_package():
 def readme_block(heading: str) -> str:
     text = (REPO / "README.md").read_text()
     section = text.split(heading, 1)[1]
-    return re.search(r"```(?:bash|sh)?\n(.+?)\n```", section, re.S).group(1).strip()
+    return re.search(r"```(?:bash|sh)?\n(.+?)\n```", section, re.DOTALL).group(1).strip()
 
 
 def test_ci_runs_the_readme_test_command():

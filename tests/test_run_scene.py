@@ -5,12 +5,13 @@ from __future__ import annotations
 import json
 import os
 from dataclasses import replace
+from itertools import pairwise
 
 import numpy as np
 import pytest
 import yaml
-
 from conftest import run_module
+
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.planner import plan
 from hlp_drake.planner.transfer import robot_plan
@@ -351,7 +352,7 @@ def test_a_push_that_would_leave_the_obstacle_in_the_way_goes_another_way():
 
     def in_the_way(push):
         points = [push.end, *ways]
-        return any(crosses(a, b, [push.footprint], clearance=WAY_CLEARANCE) for a, b in zip(points, points[1:]))
+        return any(crosses(a, b, [push.footprint], clearance=WAY_CLEARANCE) for a, b in pairwise(points))
 
     forwards = robot_push(space, scene, move.element, "FF", space.rects)
     assert forwards.travel > 0.0 and in_the_way(forwards)

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import pytest
-
 from conftest import run_module
+
 from hlp_drake.scene import generate_scene, load_scene
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"

@@ -96,7 +96,7 @@ def test_faithful_training_sets_have_the_reference_sizes(faithful):
     assert data.segment.X.shape == (85848, 4) and data.segment.y.sum() == 1752
     assert data.arm.X.shape == (7731, 5) and data.arm.y.shape == (7731, 2)
     assert np.all(np.isfinite(data.segment.X))
-    assert set(data.gap.subjects) == set(faithful.demonstrations[i].subject for i in range(len(faithful.demonstrations)))
+    assert set(data.gap.subjects) == {faithful.demonstrations[i].subject for i in range(len(faithful.demonstrations))}
 
 
 def test_bad_tracks_are_rejected_with_a_reason(dataset):

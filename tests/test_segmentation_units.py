@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from hlp_drake.dataset.records import Interaction
+from hlp_drake.errors import HlpError
 from hlp_drake.segmentation import arm_angles, check_mode, link_lengths, medial_direction
 from hlp_drake.segmentation.motion import first_moved_per_row, motion_period
-from hlp_drake.errors import HlpError
 
 
 def _track(steps: list[tuple[float, float]]) -> np.ndarray:

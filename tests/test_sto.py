@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from pydrake.trajectories import PiecewisePolynomial
 
+from hlp_drake.run_scene import DEFAULT_SCENE
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import load_scene
 from hlp_drake.scene.model import SceneObject
@@ -20,7 +21,6 @@ from hlp_drake.systems.rollout_pool import RolloutPool
 from hlp_drake.systems.sto import StochasticTrajectoryOptimiser, mppi_weights, optimise, sample_base_noise
 from hlp_drake.systems.world import tcp_keypoint_height
 from hlp_drake.systems.world_config import WorldConfig
-from hlp_drake.run_scene import DEFAULT_SCENE
 
 
 @pytest.fixture(scope="module")
@@ -127,7 +127,7 @@ def synthetic_samples(scene, *, tcp_end, moved=None, force=0.0, blew_up=None):
 def test_cost_rewards_reaching_and_charges_falls_forces_and_blow_ups(scene):
     config = WorldConfig()
     height = tcp_keypoint_height(scene, config)
-    kwargs = dict(tcp_height=height, effort=0.0, step_duration=0.5)
+    kwargs = {"tcp_height": height, "effort": 0.0, "step_duration": 0.5}
     target = (scene.target.x, scene.target.y)
     reached = rollout_cost(synthetic_samples(scene, tcp_end=target), scene, config.sto, **kwargs)
     assert reached.success and reached.failure_reason is None and reached.cost < 1.0

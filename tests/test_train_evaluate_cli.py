@@ -6,8 +6,8 @@ import csv
 import json
 
 import pytest
-
 from conftest import run_module
+
 from hlp_drake.learners import DecisionModels
 
 pytestmark = pytest.mark.dataset

@@ -112,7 +112,7 @@ def _split_free_space(
     if grid is None:
         shares = rng.dirichlet(np.ones(parts)) * spare
     else:
-        units = int(math.floor(spare / grid + 1e-9))
+        units = math.floor(spare / grid + 1e-9)
         cuts = np.sort(rng.choice(units + parts - 1, size=parts - 1, replace=False))
         counts = np.diff(np.concatenate(([-1], cuts, [units + parts - 1]))) - 1
         shares = counts * grid
@@ -336,7 +336,7 @@ def generate_unstructured(seed: int, objects: int = 6) -> Scene:
 
         def draw() -> SceneObject:
             width = VR_OBSTACLE_WIDTHS[size_name]
-            y_steps = int(math.floor((half - width / 2.0) / cm))
+            y_steps = math.floor((half - width / 2.0) / cm)
             return SceneObject(
                 name=f"{VR_OBSTACLE_PREFIX}{size_name}" + ("" if index < 3 else f"-{index // 3}"),
                 shape="box",

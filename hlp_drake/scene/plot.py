@@ -6,7 +6,8 @@ import math
 import os
 
 from matplotlib.axes import Axes
-from matplotlib.patches import Circle, Polygon as PolygonPatch, Rectangle
+from matplotlib.patches import Circle, Rectangle
+from matplotlib.patches import Polygon as PolygonPatch
 
 from hlp_drake.plotting import new_figure, save_png
 from hlp_drake.scene.geometry import footprint

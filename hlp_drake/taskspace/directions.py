@@ -35,7 +35,7 @@ def direction_of(dx: float, dy: float, *, faithful: bool = False) -> str | None:
         return None
     if faithful:
         return _BY_SIGNS[(_sign(dx), _sign(dy))]
-    sector = int(math.floor(math.atan2(dy, dx) / (math.pi / 4.0) + 0.5)) % 8
+    sector = math.floor(math.atan2(dy, dx) / (math.pi / 4.0) + 0.5) % 8
     return _SECTORS[sector]
 
 

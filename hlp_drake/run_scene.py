@@ -30,8 +30,10 @@ def summary(result) -> str:
         k.action + (f" {k.element}" if k.action in ("gap", "move") else "") + (f" {k.direction}" if k.action == "move" else "")
         for k in plan.keypoints) or "(none)"
     t = result.timings
-    optimiser = (f"optimise {t['optimise_s']:.1f} s ({result.iterations} iterations, {result.rollouts} rollouts)"
-                 if result.rollouts else "not optimised")
+    start = (result.optimisation or {}).get("start", 0)
+    alternative = f", from the planner's alternative {start}" if start else ""
+    optimiser = (f"optimise {t['optimise_s']:.1f} s ({result.iterations} iterations, {result.rollouts} rollouts"
+                 f"{alternative})" if result.rollouts else "not optimised")
     grasp = {None: "not attempted", True: "held", False: "did not hold"}[result.grasp_held]
     lines = [
         f"scene {result.scene.name}: {len(result.scene.obstacles)} obstacles, planner {result.planner}",

@@ -1,7 +1,8 @@
 """``KeypointIk``: a high-level plan's keypoints -> robot keyframes (IK) -> a joint-space trajectory.
 
-Input port:
+Input ports:
     ``plan`` (abstract, ``HighLevelPlan``): the plan for the scene the system was built for.
+    ``alternatives`` (abstract, tuple of ``HighLevelPlan``; optional): other plans for the scene.
 
 Output ports (both computed only when ``plan`` changes; cached otherwise):
     ``keyframes`` (abstract, ``Keyframes``): per keypoint the robot's 11 positions, a success flag and
@@ -10,6 +11,9 @@ Output ports (both computed only when ``plan`` changes; cached otherwise):
         from the start configuration through the successful keyframes (straight lines in joint space),
         timed by ``WorldConfig.motion``; the gripper closed among the obstacles if
         ``motion.closed_among_obstacles``.
+    ``alternative_trajectories`` (abstract, tuple of ``PiecewisePolynomial``): the same for each of
+        ``alternatives`` whose every keypoint's IK succeeds, in order; computed only when evaluated
+        (cached per input value).
 
 The positions are in the robot model instance's order (``world.robot_position_names()``: base x, y,
 yaw, the six UR5 joints, left finger, right (mimic) finger), the same in the world diagram's plant,
@@ -226,6 +230,14 @@ class KeypointIk(LeafSystem):
             calc=self._calc_trajectory,
             prerequisites_of_calc=plan_ticket,
         )
+        self._alternatives_port = self.DeclareAbstractInputPort(
+            name="alternatives", model_value=AbstractValue.Make(()))
+        self._alternative_trajectories_port = self.DeclareAbstractOutputPort(
+            name="alternative_trajectories",
+            alloc=lambda: AbstractValue.Make(()),
+            calc=self._calc_alternative_trajectories,
+            prerequisites_of_calc={self.input_port_ticket(self._alternatives_port.get_index())},
+        )
 
     # --- Accessors ------------------------------------------------------------------------------
 
@@ -250,6 +262,12 @@ class KeypointIk(LeafSystem):
 
     def get_trajectory_output_port(self):
         return self._trajectory_port
+
+    def get_alternatives_input_port(self):
+        return self._alternatives_port
+
+    def get_alternative_trajectories_output_port(self):
+        return self._alternative_trajectories_port
 
     def tcp_position(self, q: np.ndarray) -> np.ndarray:
         """World position of the tcp at robot positions ``q`` (uses the private context)."""
@@ -418,6 +436,11 @@ class KeypointIk(LeafSystem):
     def _calc_trajectory(self, context, output) -> None:
         keyframes: Keyframes = self._keyframes_port.Eval(context)
         output.set_value(self.trajectory(keyframes))
+
+    def _calc_alternative_trajectories(self, context, output) -> None:
+        plans = self._alternatives_port.Eval(context) if self._alternatives_port.HasValue(context) else ()
+        solved = (self.solve(plan) for plan in plans)
+        output.set_value(tuple(self.trajectory(keyframes) for keyframes in solved if keyframes.ok))
 
     def _with_gripper(self, q: np.ndarray, opening: float) -> np.ndarray:
         q = np.array(q, dtype=float)

@@ -7,7 +7,7 @@ from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
 
 from hlp_drake.learners.models import DecisionModels
 from hlp_drake.planner import HighLevelPlan, PlanKeypoint
-from hlp_drake.planner.transfer import robot_plan
+from hlp_drake.planner.transfer import robot_alternatives, robot_plan
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.control_sequence import ControlSequence
@@ -53,10 +53,13 @@ class StraightLinePlanSystem(LeafSystem):
 class RobotPlanTransfer(LeafSystem):
     """Turns a human-like plan into the pushing robot's waypoints (``hlp_drake.planner.transfer``).
 
-    Input port ``plan`` and output port ``robot_plan`` (both abstract HighLevelPlan).
+    Input port ``plan`` (abstract HighLevelPlan). Output ports ``robot_plan`` (abstract
+    HighLevelPlan) and ``robot_alternatives`` (abstract tuple of HighLevelPlan: the robot plans of
+    at most ``alternatives`` of the plan's other candidates, ``robot_alternatives``; computed only
+    when evaluated).
     """
 
-    def __init__(self, scene: Scene) -> None:
+    def __init__(self, scene: Scene, *, alternatives: int = 0) -> None:
         super().__init__()
         self._scene = scene
         self._plan_port = self.DeclareAbstractInputPort(name="plan", model_value=AbstractValue.Make(HighLevelPlan("", ())))
@@ -64,12 +67,20 @@ class RobotPlanTransfer(LeafSystem):
             name="robot_plan", alloc=lambda: AbstractValue.Make(HighLevelPlan("", ())),
             calc=lambda context, output: output.set_value(robot_plan(self._plan_port.Eval(context), self._scene)),
             prerequisites_of_calc={self.all_input_ports_ticket()})
+        self._alternatives_port = self.DeclareAbstractOutputPort(
+            name="robot_alternatives", alloc=lambda: AbstractValue.Make(()),
+            calc=lambda context, output: output.set_value(
+                robot_alternatives(self._plan_port.Eval(context), self._scene, alternatives)),
+            prerequisites_of_calc={self.all_input_ports_ticket()})
 
     def get_plan_input_port(self):
         return self._plan_port
 
     def get_robot_plan_output_port(self):
         return self._out_port
+
+    def get_robot_alternatives_output_port(self):
+        return self._alternatives_port
 
 
 def make_planning_diagram(scene: Scene, *, planner: str = "hlp", models: DecisionModels | None = None,
@@ -79,10 +90,14 @@ def make_planning_diagram(scene: Scene, *, planner: str = "hlp", models: Decisio
     Outputs ``plan`` (the planner's), ``robot_plan`` (its pushing-robot waypoints), ``keyframes``,
     ``trajectory`` (the initial joint trajectory through the keyframes), ``optimised_trajectory``
     and ``optimisation`` (the optimiser's ``StoResult``). Evaluating the last two runs the optimiser.
+    The transfer's ``robot_alternatives`` (the plan's next candidates, ``config.sto.alternatives``
+    of them) go through KeypointIk's ``alternatives`` to the optimiser, which evaluates them only
+    when the initial trajectory's rollout fails.
 
     Args:
         planner: "hlp" (the human-like planner) or "sto" (the straight line of the baseline); the
-            only difference is the planner block: the optimiser and its settings are the same.
+            only difference is the planner block: the optimiser and its settings are the same (the
+            straight line has no alternatives).
         pool: the optimiser's rollout workers (an in-process pool by default).
     """
     if planner not in PLANNERS:
@@ -91,12 +106,16 @@ def make_planning_diagram(scene: Scene, *, planner: str = "hlp", models: Decisio
     block = HlpPlannerSystem(models=models) if planner == "hlp" else StraightLinePlanSystem()
     block.set_name(f"{planner}_planner")
     builder.AddSystem(block)
-    transfer = builder.AddNamedSystem("robot_plan_transfer", RobotPlanTransfer(scene))
+    config = WorldConfig() if config is None else config
+    transfer = builder.AddNamedSystem("robot_plan_transfer",
+                                      RobotPlanTransfer(scene, alternatives=config.sto.alternatives))
     ik = builder.AddNamedSystem("keypoint_ik", KeypointIk(scene, config))
     builder.Connect(block.get_plan_output_port(), transfer.get_plan_input_port())
     optimiser = builder.AddNamedSystem("optimiser", StochasticTrajectoryOptimiser(scene, config, pool=pool))
     builder.Connect(transfer.get_robot_plan_output_port(), ik.get_plan_input_port())
     builder.Connect(ik.get_trajectory_output_port(), optimiser.get_initial_trajectory_input_port())
+    builder.Connect(transfer.get_robot_alternatives_output_port(), ik.get_alternatives_input_port())
+    builder.Connect(ik.get_alternative_trajectories_output_port(), optimiser.get_alternatives_input_port())
     builder.ExportInput(block.get_scene_input_port(), "scene")
     builder.ExportOutput(block.get_plan_output_port(), "plan")
     builder.ExportOutput(transfer.get_robot_plan_output_port(), "robot_plan")

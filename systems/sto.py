@@ -7,18 +7,24 @@ of the holonomic base; the update keeps the cheapest copy ("greedy") or the cost
 the noise, w_k = exp(-h (c_k - c_min) / (c_max - c_min)) ("mppi", rolled out once more); a candidate
 replaces the current sequence only if its cost is lower (monotone acceptance). It stops at the first
 successful rollout (target in the pre-grasp region, nothing fell), at ``max_iterations``, or when
-the next iteration would end past ``time_budget_s``.
+the next iteration would end past ``time_budget_s``. Beyond the paper: when the initial sequence's
+rollout fails and the planner has alternatives (the HLP's next candidate plans), they are rolled
+out once each before the first iteration; a successful one ends the optimisation (the best-ranked
+first), else the cheapest of them all becomes the current sequence.
 
-``StochasticTrajectoryOptimiser`` wraps it as a LeafSystem: input ``initial_trajectory`` (abstract
-PiecewisePolynomial of the robot's 11 positions, e.g. ``KeypointIk``'s ``trajectory``), outputs
-``trajectory`` (the optimised one) and ``result`` (``StoResult``), computed once per input value.
-The HLP-initialised and the straight-line-initialised runs use this same block and configuration;
-only the initial trajectory differs.
+``StochasticTrajectoryOptimiser`` wraps it as a LeafSystem: inputs ``initial_trajectory`` (abstract
+PiecewisePolynomial of the robot's 11 positions, e.g. ``KeypointIk``'s ``trajectory``) and, optional,
+``alternative_trajectories`` (abstract tuple of them, best first, e.g. ``KeypointIk``'s; evaluated
+only when needed, at most ``sto.alternatives`` used), outputs ``trajectory`` (the optimised one) and
+``result`` (``StoResult``), computed once per input value. The HLP-initialised and the
+straight-line-initialised runs use this same block and configuration; only the initial trajectory
+(and the alternatives: the straight line has none) differs.
 """
 
 from __future__ import annotations
 
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -46,8 +52,10 @@ class StoResult:
         iterations: iterations run (0: the initial sequence already succeeded, or none was run).
         rollouts: rollouts simulated, the initial one included.
         optimise_s: wall-clock time of the optimisation, s.
-        costs: the current cost after the initial rollout and after every iteration.
+        costs: the current cost after the initial rollout, after the alternatives' rollouts (if
+            any) and after every iteration.
         initial_cost: the initial sequence's cost.
+        start: which sequence the result grew from: 0 the initial one, i >= 1 the i-th alternative.
     """
 
     sequence: ControlSequence
@@ -59,11 +67,12 @@ class StoResult:
     optimise_s: float = 0.0
     costs: list[float] = field(default_factory=list)
     initial_cost: float | None = None
+    start: int = 0
 
     def to_dict(self) -> dict:
         return {
             "success": self.success, "failure_reason": self.failure_reason, "iterations": self.iterations,
-            "rollouts": self.rollouts, "optimise_s": self.optimise_s, "initial_cost": self.initial_cost,
+            "rollouts": self.rollouts, "optimise_s": self.optimise_s, "initial_cost": self.initial_cost, "start": self.start,
             "final_cost": self.outcome.cost if self.outcome is not None else None,
             "cost_terms": dict(self.outcome.terms) if self.outcome is not None else {},
             "costs": list(self.costs),
@@ -94,11 +103,14 @@ def mppi_weights(costs: np.ndarray, temperature: float) -> np.ndarray:
 
 
 def optimise(scene: Scene, initial: ControlSequence, config: WorldConfig | None = None, *,
-             pool: RolloutPool | None = None, progress=None) -> StoResult:
+             pool: RolloutPool | None = None, progress=None,
+             alternatives: Callable[[], Sequence[ControlSequence]] | None = None) -> StoResult:
     """Improve ``initial`` on ``scene`` (see the module's docstring); never raises for a bad scene.
 
     Args:
         pool: the rollout workers; a temporary in-process pool by default.
+        alternatives: returns the planner's other initial sequences, best first; called only if
+            the initial rollout fails and ``sto.alternatives`` > 0 (the first that many are used).
         progress: optional callable ``progress(iteration, cost)`` called after every iteration.
     """
     config = WorldConfig() if config is None else config
@@ -116,6 +128,18 @@ def optimise(scene: Scene, initial: ControlSequence, config: WorldConfig | None 
         (outcome,) = pool.rollouts(scene, config, [best])
         result = StoResult(best, outcome, outcome.success, outcome.failure_reason, rollouts=1,
                            costs=[outcome.cost], initial_cost=outcome.cost)
+        if not result.success and alternatives is not None and sto.alternatives > 0:
+            others = list(alternatives())[: sto.alternatives]
+            if others:
+                outcomes = pool.rollouts(scene, config, others)
+                result.rollouts += len(others)
+                passed = [i for i, o in enumerate(outcomes) if o.success]
+                i = passed[0] if passed else int(np.argmin([o.cost for o in outcomes]))
+                if passed or outcomes[i].cost < outcome.cost:
+                    best, outcome, result.start = others[i], outcomes[i], i + 1
+                    result.sequence, result.outcome = best, outcome
+                    result.success, result.failure_reason = outcome.success, outcome.failure_reason
+                result.costs.append(outcome.cost)
         last_iteration_s = 0.0
         while not result.success and result.iterations < sto.max_iterations:
             elapsed = time.perf_counter() - started
@@ -172,7 +196,10 @@ class StochasticTrajectoryOptimiser(LeafSystem):
         self.num_optimisations = 0
         self._input = self.DeclareAbstractInputPort(
             name="initial_trajectory", model_value=AbstractValue.Make(PiecewisePolynomial()))
-        ticket = {self.input_port_ticket(self._input.get_index())}
+        self._alternatives = self.DeclareAbstractInputPort(name="alternative_trajectories",
+                                                           model_value=AbstractValue.Make(()))
+        ticket = {self.input_port_ticket(self._input.get_index()),
+                  self.input_port_ticket(self._alternatives.get_index())}
         self._result = self.DeclareAbstractOutputPort(
             name="result", alloc=lambda: AbstractValue.Make(_EMPTY_RESULT), calc=self._calc_result,
             prerequisites_of_calc=ticket)
@@ -183,6 +210,9 @@ class StochasticTrajectoryOptimiser(LeafSystem):
 
     def get_initial_trajectory_input_port(self):
         return self._input
+
+    def get_alternatives_input_port(self):
+        return self._alternatives
 
     def get_trajectory_output_port(self):
         return self._trajectory
@@ -198,8 +228,15 @@ class StochasticTrajectoryOptimiser(LeafSystem):
         if self._pool is None:
             self._pool = RolloutPool(1)
         self.num_optimisations += 1
-        initial = ControlSequence.from_trajectory(trajectory, self._config.sto.step_duration)
-        output.set_value(optimise(self._scene, initial, self._config, pool=self._pool))
+        step = self._config.sto.step_duration
+        initial = ControlSequence.from_trajectory(trajectory, step)
+
+        def alternatives() -> list[ControlSequence]:
+            if not self._alternatives.HasValue(context):
+                return []
+            return [ControlSequence.from_trajectory(t, step) for t in self._alternatives.Eval(context)]
+
+        output.set_value(optimise(self._scene, initial, self._config, pool=self._pool, alternatives=alternatives))
 
 
 _EMPTY_RESULT = StoResult(ControlSequence(np.array([0.0, 1.0]), np.zeros((2, 11))), None, False,

@@ -94,6 +94,9 @@ class StoConfig:
         max_sink: an object's centre more than this below the table top while over it means it
             tunnelled into the table, m.
         cost: the cost weights.
+        alternatives: when the initial sequence's rollout fails, roll out the planner's next this
+            many distinct candidate plans once (the HLP's, by expected arm collision; the straight
+            line has none) and go on from the best of them all (0: never).
     """
 
     samples: int = 8
@@ -115,6 +118,7 @@ class StoConfig:
     max_object_speed: float = 5.0
     max_sink: float = 0.03
     cost: StoCost = field(default_factory=StoCost)
+    alternatives: int = 3
 
 
 @dataclass

@@ -272,6 +272,8 @@ def config_problems(config: WorldConfig) -> list[str]:
     for name in ("samples", "max_iterations", "workers"):
         if int(getattr(sto, name)) < 1:
             problems.append(f"sto.{name} must be >= 1, got {getattr(sto, name)}")
+    if int(sto.alternatives) < 0:
+        problems.append(f"sto.alternatives must be >= 0, got {sto.alternatives}")
     for name in ("time_budget_s", "step_duration", "mppi_temperature", "rollout_time_step",
                  "sample_period", "max_object_speed", "max_sink"):
         positive(f"sto.{name}", getattr(sto, name))

@@ -59,10 +59,14 @@ def solved(system, scene):
 
 
 def test_ports(system):
-    assert [system.get_input_port(i).get_name() for i in range(system.num_input_ports())] == ["plan"]
+    assert [system.get_input_port(i).get_name() for i in range(system.num_input_ports())] == [
+        "plan",
+        "alternatives",
+    ]
     assert [system.get_output_port(i).get_name() for i in range(system.num_output_ports())] == [
         "keyframes",
         "trajectory",
+        "alternative_trajectories",
     ]
 
 
@@ -202,6 +206,26 @@ def test_outputs_are_cached_until_the_plan_changes(scene):
     port.FixValue(context, shorter)
     assert len(system.GetOutputPort("keyframes").Eval(context).positions) == 2
     assert system.num_solves == 2
+
+
+def test_alternative_trajectories_are_solved_only_when_asked_for_and_like_the_plan(scene):
+    system = KeypointIk(scene, CONFIG)
+    context = system.CreateDefaultContext()
+    main, other = through_gaps(scene, to_target=True), through_gaps(scene, to_target=False)
+    system.GetInputPort("plan").FixValue(context, main)
+    system.GetInputPort("alternatives").FixValue(
+        context, (other, HighLevelPlan(scene=scene.name, keypoints=(), reason="no plan"), main))
+    trajectory = system.GetOutputPort("trajectory").Eval(context)
+    assert system.num_solves == 1  # the alternatives are not solved for the plan's trajectory
+    alternatives = system.GetOutputPort("alternative_trajectories").Eval(context)
+    assert system.num_solves == 4 and len(alternatives) == 2  # the plan-less one has no trajectory
+    system.GetOutputPort("alternative_trajectories").Eval(context)
+    assert system.num_solves == 4  # cached
+    _, expected = evaluate(system, other)
+    for got, want in ((alternatives[0], expected), (alternatives[1], trajectory)):
+        np.testing.assert_allclose(got.get_segment_times(), want.get_segment_times())
+        np.testing.assert_allclose(got.vector_values(got.get_segment_times()),
+                                   want.vector_values(want.get_segment_times()), atol=1e-9)
 
 
 def test_no_plan_and_wrong_scene_are_problems_not_successes(system, scene):

@@ -14,7 +14,7 @@ from conftest import run_module
 
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.planner import plan
-from hlp_drake.planner.transfer import robot_plan
+from hlp_drake.planner.transfer import robot_alternatives, robot_plan
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import scene_to_dict
 from hlp_drake.systems.planning import make_planning_diagram
@@ -42,6 +42,23 @@ def test_push_transfer_puts_the_tcp_behind_the_obstacle():
             offset = np.subtract(k.position, rect.center)
             assert offset @ unit < 0
             assert not rect.contains(np.array([k.position]))[0]
+
+
+def test_robot_alternatives_are_the_next_distinct_candidates_in_rank_order():
+    scene = generate_scene("gen2", 39, 9)
+    human = plan(scene, default_models())
+    chosen = robot_plan(human, scene)
+    candidates = [robot_plan(replace(human, keypoints=c.keypoints), scene).keypoints for c in human.alternatives]
+    alternatives = robot_alternatives(human, scene, 3)
+    assert len(alternatives) == 3 and all(a.ok for a in alternatives)
+    found = [a.keypoints for a in alternatives]
+    assert len({chosen.keypoints, *found}) == 4  # distinct from the chosen plan and from each other
+    ranks = [candidates.index(k) for k in found]
+    assert ranks == sorted(ranks)  # best first, the first of equal robot plans
+    assert all(k in (chosen.keypoints, *found) for k in candidates[:ranks[-1]])  # none skipped
+    assert robot_alternatives(human, scene, 1) == alternatives[:1]
+    assert robot_alternatives(human, scene, 0) == ()
+    assert robot_alternatives(replace(human, keypoints=(), reason="no plan"), scene, 3) == ()
 
 
 def test_planning_diagram_swaps_the_planner_block():

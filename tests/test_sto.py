@@ -167,6 +167,29 @@ def test_a_gripper_closed_among_the_obstacles_does_not_carry_one_into_the_target
     assert not opened.success and opened.fallen == ("Target",), opened.failure_reason
 
 
+def test_where_the_hlps_plan_fails_at_its_first_rollout_its_next_candidates_are_tried():
+    """Gen II seed 39, 9 objects: the chosen plan's way to a push start runs through the pushed
+    obstacle and knocks another off the table; of the next three distinct candidate plans, the
+    second passes at its first rollout. The straight line has no candidates to try."""
+    scene = generate_scene("gen2", 39, 9)
+    config = WorldConfig()
+    config.sto.max_iterations, config.sto.samples = 1, 2
+    results = {}
+    for planner in ("hlp", "sto"):
+        diagram = make_planning_diagram(scene, planner=planner, config=config)
+        context = diagram.CreateDefaultContext()
+        diagram.GetInputPort("scene").FixValue(context, scene)
+        transfer = diagram.GetSubsystemByName("robot_plan_transfer")
+        alternatives = transfer.GetOutputPort("robot_alternatives").Eval(
+            transfer.GetMyContextFromRoot(context))
+        results[planner] = (len(alternatives), diagram.GetOutputPort("optimisation").Eval(context))
+    count, hlp = results["hlp"]
+    assert count == 3
+    assert hlp.success and hlp.start == 2 and hlp.iterations == 0 and hlp.rollouts == 1 + 3
+    assert "fell off the table" in first_rollout(scene, config=config).failure_reason
+    assert results["sto"][0] == 0 and results["sto"][1].start == 0
+
+
 def test_holding_still_fails_with_the_goal_cost(world, scene):
     start = world.start_positions
     outcome = world.rollout(ControlSequence(np.array([0.0, 1.0]), np.vstack([start, start])))
@@ -303,6 +326,33 @@ def test_optimiser_respects_its_time_budget(scene, trajectories):
     assert "time budget" in result.failure_reason
 
 
+def test_a_failed_initial_rollout_goes_on_from_the_planners_first_passing_alternative(scene, trajectories):
+    config = WorldConfig()
+    config.sto.max_iterations, config.sto.samples = 1, 1
+    stuck = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)  # fails: too short
+    reaching = ControlSequence.from_trajectory(trajectories["hlp"], 0.5)  # passes
+    calls = []
+
+    def alternatives():
+        calls.append(1)
+        return [stuck, reaching, reaching]
+
+    with RolloutPool(1) as pool:
+        passed = optimise(scene, reaching, config, pool=pool, alternatives=alternatives)
+        assert passed.success and passed.start == 0 and passed.rollouts == 1 and not calls  # not needed
+        result = optimise(scene, stuck, config, pool=pool, alternatives=alternatives)
+        assert calls == [1]
+        assert result.success and result.iterations == 0 and result.start == 2  # the first that passes
+        assert result.rollouts == 1 + 3 and result.sequence is not stuck
+        assert result.to_dict()["start"] == 2 and result.costs[-1] < result.costs[0]
+        config.sto.alternatives = 1  # only the first alternative: it fails too, and costs no less
+        capped = optimise(scene, stuck, config, pool=pool, alternatives=alternatives)
+        assert not capped.success and capped.start == 0 and capped.rollouts == 1 + 1 + 1
+        config.sto.alternatives = 0
+        never = optimise(scene, stuck, config, pool=pool, alternatives=lambda: pytest.fail("called"))
+        assert never.rollouts == 1 + 1
+
+
 def test_a_start_in_collision_fails_without_rollouts(scene, trajectories):
     blocker = SceneObject(name="Blocker", shape="box", x=float(scene.start[0]) + 0.03, y=float(scene.start[1]),
                           size=(0.04, 0.16, 0.12))  # wider than the open fingers
@@ -330,6 +380,9 @@ def test_optimiser_block_ports_and_cache(scene, trajectories):
     assert result.success and result.iterations == 0  # the HLP initialisation already succeeds here
     assert isinstance(trajectory, PiecewisePolynomial)
     assert trajectory.end_time() == pytest.approx(trajectories["hlp"].end_time())
+    block.GetInputPort("alternative_trajectories").FixValue(context, (trajectories["hlp"],))
+    again = block.GetOutputPort("result").Eval(context)  # a new input value: optimised again
+    assert block.num_optimisations == 2 and again.success and again.start == 0
 
 
 def test_an_unreachable_target_fails_with_a_reason_and_no_rollouts(scene):

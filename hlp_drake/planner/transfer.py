@@ -226,6 +226,25 @@ def robot_plan(plan: HighLevelPlan, scene: Scene) -> HighLevelPlan:
     return replace(plan, keypoints=tuple(keypoints))
 
 
+def robot_alternatives(plan: HighLevelPlan, scene: Scene, limit: int) -> tuple[HighLevelPlan, ...]:
+    """The robot plans (``robot_plan``) of ``plan``'s alternative candidates, best first: at most
+    ``limit``, each different from the chosen plan's and from the earlier ones (two candidates
+    can differ only where the transfer makes them the same, e.g. in a push it leaves out)."""
+    if not plan.ok or limit <= 0:
+        return ()
+    seen = {robot_plan(plan, scene).keypoints}
+    found: list[HighLevelPlan] = []
+    for candidate in plan.alternatives:
+        robot = robot_plan(replace(plan, keypoints=candidate.keypoints, expected_collision=candidate.expected_collision,
+                                   alternatives=()), scene)
+        if robot.ok and robot.keypoints not in seen:
+            seen.add(robot.keypoints)
+            found.append(robot)
+            if len(found) == limit:
+                break
+    return tuple(found)
+
+
 def approach(previous: tuple[float, float], target: Rect, placed: Mapping[str, Rect], name: str
              ) -> list[PlanKeypoint]:
     """The waypoint ``APPROACH_GAP`` behind the ``target`` footprint from which the gripper slides

@@ -32,8 +32,8 @@ def summary(result) -> str:
     t = result.timings
     start = (result.optimisation or {}).get("start", 0)
     alternative = f", from the planner's alternative {start}" if start else ""
-    optimiser = (f"optimise {t['optimise_s']:.1f} s ({result.iterations} iterations, {result.rollouts} rollouts"
-                 f"{alternative})" if result.rollouts else "not optimised")
+    optimiser = (f"optimise {t['optimise_s']:.1f} s ({result.iterations} iterations, "
+                 f"{result.rollouts} rollouts{alternative})" if result.rollouts else "not optimised")
     grasp = {None: "not attempted", True: "held", False: "did not hold"}[result.grasp_held]
     lines = [
         f"scene {result.scene.name}: {len(result.scene.obstacles)} obstacles, planner {result.planner}",

@@ -72,7 +72,8 @@ class StoResult:
     def to_dict(self) -> dict:
         return {
             "success": self.success, "failure_reason": self.failure_reason, "iterations": self.iterations,
-            "rollouts": self.rollouts, "optimise_s": self.optimise_s, "initial_cost": self.initial_cost, "start": self.start,
+            "rollouts": self.rollouts, "optimise_s": self.optimise_s, "initial_cost": self.initial_cost,
+            "start": self.start,
             "final_cost": self.outcome.cost if self.outcome is not None else None,
             "cost_terms": dict(self.outcome.terms) if self.outcome is not None else {},
             "costs": list(self.costs),
@@ -236,7 +237,8 @@ class StochasticTrajectoryOptimiser(LeafSystem):
                 return []
             return [ControlSequence.from_trajectory(t, step) for t in self._alternatives.Eval(context)]
 
-        output.set_value(optimise(self._scene, initial, self._config, pool=self._pool, alternatives=alternatives))
+        output.set_value(optimise(self._scene, initial, self._config, pool=self._pool,
+                                  alternatives=alternatives))
 
 
 _EMPTY_RESULT = StoResult(ControlSequence(np.array([0.0, 1.0]), np.zeros((2, 11))), None, False,

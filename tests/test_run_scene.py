@@ -48,7 +48,8 @@ def test_robot_alternatives_are_the_next_distinct_candidates_in_rank_order():
     scene = generate_scene("gen2", 39, 9)
     human = plan(scene, default_models())
     chosen = robot_plan(human, scene)
-    candidates = [robot_plan(replace(human, keypoints=c.keypoints), scene).keypoints for c in human.alternatives]
+    candidates = [robot_plan(replace(human, keypoints=c.keypoints), scene).keypoints
+                  for c in human.alternatives]
     alternatives = robot_alternatives(human, scene, 3)
     assert len(alternatives) == 3 and all(a.ok for a in alternatives)
     found = [a.keypoints for a in alternatives]

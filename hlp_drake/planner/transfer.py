@@ -235,8 +235,8 @@ def robot_alternatives(plan: HighLevelPlan, scene: Scene, limit: int) -> tuple[H
     seen = {robot_plan(plan, scene).keypoints}
     found: list[HighLevelPlan] = []
     for candidate in plan.alternatives:
-        robot = robot_plan(replace(plan, keypoints=candidate.keypoints, expected_collision=candidate.expected_collision,
-                                   alternatives=()), scene)
+        robot = robot_plan(replace(plan, keypoints=candidate.keypoints,
+                                   expected_collision=candidate.expected_collision, alternatives=()), scene)
         if robot.ok and robot.keypoints not in seen:
             seen.add(robot.keypoints)
             found.append(robot)

@@ -25,7 +25,7 @@ from hlp_drake.planner.blas import single_blas_thread
 from hlp_drake.planner.candidates import nearest_per_row
 from hlp_drake.planner.human_arm import sweep_collision
 from hlp_drake.planner.plan import PlanKeypoint
-from hlp_drake.planner.relocation import relocated, relocated_array
+from hlp_drake.taskspace.relocation import relocated, relocated_array
 from hlp_drake.planner.rollout import PrefixTree
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.geometry import footprint, overlapping_bounds

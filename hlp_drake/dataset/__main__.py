@@ -21,10 +21,11 @@ def summarise(dataset: Dataset) -> dict[str, Any]:
         records = dataset.select(category=category)
         categories[category] = {"trials": len(records), "successes": sum(r.success for r in records)}
     return {
-        "source": str(dataset.source.path),
+        "source": dataset.source.describe_parts(),
         "subjects": len(dataset.subjects),
         "categories": categories,
         "problems": dataset.problems,
+        "notes": dataset.notes,
     }
 
 
@@ -38,6 +39,8 @@ def format_summary(summary: dict[str, Any]) -> str:
         lines.append(f"{name:<14}{counts['trials']:>8}{counts['successes']:>11}{rate:>8}")
     if summary["problems"]:
         lines.append(f"{len(summary['problems'])} unreadable or invalid files (their trials are left out)")
+    if summary["notes"]:
+        lines.append(f"{len(summary['notes'])} corrections (see the notes above)")
     return "\n".join(lines)
 
 
@@ -52,6 +55,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     result = summarise(dataset)
     for problem in result["problems"]:
         print(f"warning: {problem['path']}: {problem['reason']}", file=sys.stderr)
+    for note in result["notes"]:
+        print(f"note: {note['path']}: {note['reason']}", file=sys.stderr)
     print(format_summary(result))
     if args.json:
         write_text_atomic(args.json, json.dumps(result, indent=2) + "\n")

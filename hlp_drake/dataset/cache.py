@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 from tqdm import tqdm
 
-from hlp_drake.dataset.convert import scene_from_layouts
+from hlp_drake.dataset.convert import scene_from_layouts, stale_start
 from hlp_drake.dataset.parse import (
     optional_float,
     parse_interactions,
@@ -32,7 +32,7 @@ from hlp_drake.dataset.records import TRACKERS, category_of, trial_key
 from hlp_drake.dataset.source import PARTICIPANTS_FILE, Source
 from hlp_drake.errors import HlpError
 
-CACHE_VERSION = 1
+CACHE_VERSION = 2
 CACHE_ENV_VAR = "HLP_CACHE"
 _TRIAL_FILE = re.compile(r"^(sub_\d+)/T(\d{3})/(scene|movement)/(.+)$")
 _MOVEMENT = re.compile(r"^(.+)_movement_T\d{3}\.csv$")
@@ -54,6 +54,8 @@ class _Collector:
     def __init__(self, source: Source) -> None:
         self.source = source
         self.problems: list[dict[str, str]] = []
+        self.notes: list[dict[str, str]] = []
+        self.where: dict[str, str] = {}
         self.participants: dict[str, dict[str, str]] | None = None
         self.results: dict[str, list[dict[str, str]]] = {}
         self.trial_files: dict[tuple[str, int], dict[str, Any]] = defaultdict(dict)
@@ -61,10 +63,19 @@ class _Collector:
         self.blocks: list[np.ndarray] = []
         self.rows = 0
 
-    def problem(self, relative: str, reason: str) -> None:
-        self.problems.append({"path": self.source.describe(relative), "reason": reason})
+    def describe(self, relative: str) -> str:
+        """Where a user finds ``relative``: in the part it was read from (else the first part)."""
+        return self.where.get(relative) or self.source.parts[0].describe(relative)
 
-    def add(self, relative: str, content: bytes | OSError) -> None:
+    def problem(self, relative: str, reason: str) -> None:
+        self.problems.append({"path": self.describe(relative), "reason": reason})
+
+    def note(self, relative: str, reason: str) -> None:
+        """A correction made to a trial that is kept (e.g. a stale start point)."""
+        self.notes.append({"path": self.describe(relative), "reason": reason})
+
+    def add(self, relative: str, where: str, content: bytes | OSError) -> None:
+        self.where[relative] = where
         match = _TRIAL_FILE.match(relative)
         if isinstance(content, OSError):
             self.problem(relative, f"cannot read: {content}")
@@ -167,10 +178,16 @@ def _trial_entry(
             collector.problem(path, "missing: trial skipped")
         return None
     try:
-        scene_from_layouts(files["scene_layout"], files["objects_layout"], folder)
+        start_x = optional_float(row.get("start_pos_x"))
+        scene = scene_from_layouts(files["scene_layout"], files["objects_layout"], folder, start_x=start_x)
     except (ValueError, HlpError) as error:
         collector.problem(f"{folder}/scene/grid_objects_layout_T{number:03d}.csv", f"invalid scene: {error}")
         return None
+    stale = stale_start(files["scene_layout"], start_x)
+    if stale is not None:
+        collector.note(f"{folder}/scene/scene_layout_T{number:03d}.csv",
+                       f"StartPoint x {stale:.4f} is stale: {subject}/{RESULTS_FILE} start_pos_x {start_x:.4f} "
+                       f"used (start at world y {scene.start[1]:+.4f} m)")
     return {
         "subject": subject,
         "trial": number,
@@ -179,6 +196,7 @@ def _trial_entry(
         "handedness": handedness,
         "trial_name": (row.get("trial_name") or "").strip(),
         "times": times,
+        "start_x": start_x,
         "scene_layout": files["scene_layout"],
         "objects_layout": files["objects_layout"],
         "tracks": files["tracks"],
@@ -191,16 +209,17 @@ def build_cache(source: Source, directory: Path, *, progress: bool = True) -> No
     collector = _Collector(source)
     with tqdm(desc="reading VR dataset (first load, cached afterwards)", unit="B", unit_scale=True,
               disable=not progress, file=sys.stderr, mininterval=1.0) as bar:
-        for relative, content in source.files(bar):
-            collector.add(relative, content)
+        for relative, where, content in source.files(bar):
+            collector.add(relative, where, content)
     trials = _assemble(collector)
     tracks = np.concatenate(collector.blocks) if collector.blocks else np.empty((0, 7))
     index = {
         "version": CACHE_VERSION,
-        "source": str(source.path),
+        "source": source.describe_parts(),
         "rows": int(tracks.shape[0]),
         "trials": trials,
         "problems": collector.problems,
+        "notes": collector.notes,
     }
     directory.parent.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=f".{directory.name}.", dir=directory.parent))

@@ -11,21 +11,45 @@ from hlp_drake.scene.validation import validate_scene
 
 TARGET = "Target"
 ORIGIN_DECIMALS = 4  # the table pose is recorded with float32 noise (depth 0.6000001): snap to 0.1 mm
+START_TOLERANCE = 1e-3  # m: a scene file's start x further than this from trial_results' is stale
+
+
+def _layout_rows(scene_layout: list[list]) -> dict[str, list]:
+    rows = {row[0]: row[1:] for row in scene_layout}
+    for name in ("TableTop", "StartPoint"):
+        if name not in rows:
+            raise ValueError(f"no {name} row")
+    return rows
+
+
+def stale_start(scene_layout: list[list], start_x: float | None) -> float | None:
+    """The scene file's StartPoint x (Unity) if ``trial_results.csv``'s ``start_pos_x`` differs
+    from it by more than ``START_TOLERANCE`` (in every T100 the scene file keeps 0), else None."""
+    recorded = _layout_rows(scene_layout)["StartPoint"][0]
+    if start_x is None or abs(start_x - recorded) <= START_TOLERANCE:
+        return None
+    return recorded
 
 
 class TableFrame:
-    """Where the table sits in Unity, which fixes the world frame of a trial."""
+    """Where the table sits in Unity, which fixes the world frame of a trial.
 
-    def __init__(self, scene_layout: list[list]) -> None:
-        rows = {row[0]: row[1:] for row in scene_layout}
-        for name in ("TableTop", "StartPoint"):
-            if name not in rows:
-                raise ValueError(f"no {name} row")
+    Args:
+        scene_layout: the parsed scene layout file.
+        start_x: ``trial_results.csv``'s ``start_pos_x`` (Unity x) where known: the start's
+            lateral position, which the hand track confirms; the scene file's can be stale.
+    """
+
+    def __init__(self, scene_layout: list[list], start_x: float | None = None) -> None:
+        rows = _layout_rows(scene_layout)
         x, y, z, width, height, depth = rows["TableTop"]
         self.center_x = round(x, ORIGIN_DECIMALS)
         self.front_z = round(z - depth / 2.0, ORIGIN_DECIMALS)
         self.table = Table(length=depth, width=width, height=y + height / 2.0)
-        start = self.to_world(np.array(rows["StartPoint"][:3]))
+        unity = np.array(rows["StartPoint"][:3], dtype=float)
+        if start_x is not None:
+            unity[0] = start_x
+        start = self.to_world(unity)
         self.start = (float(start[0]), float(start[1]))
 
     def to_world(self, points: np.ndarray) -> np.ndarray:
@@ -42,13 +66,15 @@ class TableFrame:
         )
 
 
-def scene_from_layouts(scene_layout: list[list], objects_layout: list[list], name: str) -> Scene:
-    """Build and validate the Scene of a trial from its two layout files (rows as parsed).
+def scene_from_layouts(scene_layout: list[list], objects_layout: list[list], name: str, *,
+                       start_x: float | None = None) -> Scene:
+    """Build and validate the Scene of a trial from its two layout files (rows as parsed) and
+    ``trial_results.csv``'s start (``start_x``, Unity x; see ``TableFrame``).
 
     Raises:
         ValueError: a row is missing. SceneError: the layout is not a valid scene.
     """
-    frame = TableFrame(scene_layout)
+    frame = TableFrame(scene_layout, start_x)
     target = None
     obstacles = []
     for obj_name, x, y, z, width, height, depth in objects_layout:

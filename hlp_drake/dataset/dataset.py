@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 import sys
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -22,7 +22,8 @@ class Dataset:
     """The VR dataset: trial metadata at once, each trial's tracks and scene on request.
 
     Args:
-        path: the archive or the unpacked folder; None reads ``HLP_DATASET``.
+        path: the archive or the unpacked folder, or several laid over each other
+            (``resolve_source``); None reads ``HLP_DATASET``.
         cache_dir: where caches live (default ``$HLP_CACHE`` or ``~/.cache/hlp_drake``).
         progress: show a progress bar while the cache is built.
 
@@ -31,6 +32,8 @@ class Dataset:
         cache_status: "warm" (read from an existing cache) or "built" (parsed now).
         problems: unreadable, missing or invalid files as ``{"path", "reason"}``; their trials are
             left out of ``records`` and ``trials``.
+        notes: corrections made to kept trials, as ``{"path", "reason"}`` (e.g. a stale start
+            point in a scene file, replaced by ``trial_results.csv``'s).
 
     Raises:
         DatasetError: no dataset at ``path``, or the archive cannot be read.
@@ -38,7 +41,7 @@ class Dataset:
 
     def __init__(
         self,
-        path: str | os.PathLike[str] | None = None,
+        path: str | os.PathLike[str] | Sequence[str | os.PathLike[str]] | None = None,
         *,
         cache_dir: str | os.PathLike[str] | None = None,
         progress: bool = True,
@@ -63,6 +66,7 @@ class Dataset:
             trial_key(e["subject"], e["trial"]): e for e in index["trials"]
         }
         self.problems: list[dict[str, str]] = index["problems"]
+        self.notes: list[dict[str, str]] = index["notes"]
         self.records: list[TrialRecord] = [_record(e) for e in self._entries.values()]
 
     def __len__(self) -> int:
@@ -95,7 +99,7 @@ class Dataset:
     def scene(self, key: str) -> Scene:
         """The Scene of one trial, without loading its tracks."""
         entry = self._entry(key)
-        return scene_from_layouts(entry["scene_layout"], entry["objects_layout"], key)
+        return scene_from_layouts(entry["scene_layout"], entry["objects_layout"], key, start_x=entry["start_x"])
 
     def _entry(self, key: str) -> dict[str, Any]:
         entry = self._entries.get(key)
@@ -110,7 +114,7 @@ class Dataset:
             KeyError: no such trial (or it was left out as a problem).
         """
         entry = self._entry(key)
-        frame = TableFrame(entry["scene_layout"])
+        frame = TableFrame(entry["scene_layout"], entry["start_x"])
         tracks = {
             name: frame.track(TRACKERS.get(name, name), self._block(span))
             for name, span in entry["tracks"].items()

@@ -8,7 +8,7 @@ import numpy as np
 
 from hlp_drake.features.training import gap_labels, object_labels
 from hlp_drake.planner.plan import HighLevelPlan
-from hlp_drake.segmentation.demonstration import GAP, OBJECT, Demonstration
+from hlp_drake.segmentation.demonstration import GAP, NONE, OBJECT, Demonstration
 from hlp_drake.taskspace import TaskSpace
 
 
@@ -36,8 +36,17 @@ class TrialOutcome:
 
     @property
     def shlp(self) -> float:
-        """0.25 * sum over rows of I(D) * (I(D) + I(E)) for two rows; scaled by rows otherwise."""
-        scores = [int(r.decision_ok) * (int(r.decision_ok) + int(r.element_ok)) for r in self.rows]
+        """0.25 * sum over rows of I(D) * (I(D) + I(E)) for two rows; scaled by rows otherwise
+        (I(E) as the released code: the row's raw classifier labels)."""
+        return self._shlp([r.element_ok for r in self.rows])
+
+    @property
+    def shlp_plan(self) -> float:
+        """As ``shlp`` with I(E) = the plan used the person's element."""
+        return self._shlp([r.element_plan_ok for r in self.rows])
+
+    def _shlp(self, element_ok: list[bool]) -> float:
+        scores = [int(r.decision_ok) * (int(r.decision_ok) + int(e)) for r, e in zip(self.rows, element_ok)]
         return float(np.sum(scores)) / (2.0 * len(self.rows)) if self.rows else 0.0
 
 
@@ -61,6 +70,8 @@ def score_trial(demo: Demonstration, plan: HighLevelPlan, *, faithful: bool) -> 
     planned = planned_rows(plan)
     rows = []
     for decision in demo.decisions:
+        if decision.decision == NONE:  # a row the person never crossed: no element, not scored
+            continue
         hlp_decision, hlp_element = planned.get(decision.row, ("none", ""))
         if hlp_decision == GAP:
             mask = np.array([g.row == decision.row for g in gaps])

@@ -9,11 +9,14 @@ import numpy as np
 
 from hlp_drake.features.arm import ARM_FEATURES, arm_features
 from hlp_drake.features.direction import DIRECTION_FEATURES, direction_features, direction_index
+from hlp_drake.features.row_choice import HUMAN_HAND_WIDTH, ROW_CHOICE_FEATURES, row_candidates
 from hlp_drake.features.scene_features import GAP_FEATURES, OBJECT_FEATURES, gap_features, object_features
 from hlp_drake.features.segment import SEGMENT_FEATURES, segment_feature_matrix
-from hlp_drake.segmentation.demonstration import GAP, OBJECT, Demonstration
+from hlp_drake.segmentation.demonstration import GAP, NONE, OBJECT, Demonstration
 from hlp_drake.segmentation.modes import Mode, check_mode, is_faithful
-from hlp_drake.taskspace import Node, TaskSpace
+from hlp_drake.taskspace import DIRECTIONS, Node, TaskSpace
+from hlp_drake.taskspace.relocation import relocated_array
+from hlp_drake.taskspace.routes import FreeRoutes
 
 
 @dataclass
@@ -43,9 +46,12 @@ class LabelledSet:
         return self.rows(self.original)
 
 
+SETS = ("gap", "object", "direction", "segment", "arm", "people", "row")
+
+
 @dataclass
 class TrainingData:
-    """Gap (Xg), object (Xo), direction (Xd), segment (Xc) and arm (Xa) training sets."""
+    """Gap (Xg), object (Xo), direction (Xd), segment (Xc), arm (Xa) and row-choice (Xr) training sets."""
 
     mode: Mode
     gap: LabelledSet
@@ -54,11 +60,17 @@ class TrainingData:
     segment: LabelledSet
     arm: LabelledSet
     people: LabelledSet  # per demonstration: X = (upper arm, forearm) lengths, y = start (q1, q2)
+    row: LabelledSet  # per candidate of every scored row (fixed mode only)
 
     def subset(self, subjects: Iterable[str]) -> TrainingData:
         subjects = list(subjects)
-        return TrainingData(self.mode, *(getattr(self, n).subset(subjects) for n in
-                                         ("gap", "object", "direction", "segment", "arm", "people")))
+        return TrainingData(self.mode, *(getattr(self, n).subset(subjects) for n in SETS))
+
+    def where(self, keep) -> TrainingData:
+        """The rows of the trials (keys) ``keep(key)`` accepts."""
+        return TrainingData(self.mode, *(
+            getattr(self, n).rows(np.array([bool(keep(k)) for k in getattr(self, n).keys], dtype=bool).reshape(-1))
+            for n in SETS))
 
 
 class _Builder:
@@ -114,10 +126,11 @@ def _segment_labels(space: TaskSpace, demo: Demonstration, row: int, near: list[
 
 def gap_labels(demo: Demonstration, space: TaskSpace, *, faithful: bool) -> list[float]:
     """Per gap (rows in order, left to right): 1 for the gap the hand went through, 0 elsewhere and
-    in rows where an obstacle was moved. Faithful: the raw passage flags of gap rows."""
+    in rows where an obstacle was moved (or that the hand never crossed). Faithful: the raw
+    passage flags of gap rows."""
     labels: list[float] = []
     for decision, row_flags, gaps in zip(demo.decisions, demo.gap_flags, space.gaps):
-        if decision.decision == OBJECT:
+        if decision.decision != GAP:
             labels += [0.0] * len(gaps)
         elif faithful:
             labels += [float(f) for f in row_flags]
@@ -132,6 +145,40 @@ def object_labels(demo: Demonstration, space: TaskSpace) -> list[float]:
     return [float(n in moved) for n in space.obstacle_names]
 
 
+def row_choice_rows(demo: Demonstration, space: TaskSpace, *, hand_width: float = HUMAN_HAND_WIDTH,
+                    ) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Per row the person crossed: the row's candidates' Xr and 0/1 labels (1: the person's).
+
+    The hand goes from row to row as the planner's does: from the start to the passage point of
+    the person's gap, or to where the person's obstacle is released (the centre of its relocated
+    region in the person's direction), which then no longer stands in its row.
+    """
+    routes = FreeRoutes(space.obstacle_bounds, space.scene.table.bounds, hand_width)
+    hand, goal = np.asarray(demo.scene.start, float), np.asarray(space.target.center, float)
+    removed: set[int] = set()
+    rows = []
+    for decision in demo.decisions:
+        if decision.decision == NONE:
+            continue
+        candidates, = row_candidates(space, decision.row, hand, goal, hand_width=hand_width, routes=routes,
+                                     removed=[removed], mirror=demo.left_handed)
+        names = space.obstacle_names
+        chosen = [k for k in range(len(candidates)) if candidates.kinds[k] == decision.decision
+                  and candidates.element(k, names) == decision.element]
+        if len(chosen) != 1:
+            continue  # the person's obstacle was moved already (a second move in a row is not learnt)
+        k = chosen[0]
+        rows.append((candidates.X, (np.arange(len(candidates)) == k).astype(float)))
+        if decision.decision == OBJECT:
+            obstacle = int(candidates.obstacles[k])
+            region = relocated_array(space.obstacle_bounds[[obstacle]], space.alpha)[0, DIRECTIONS.index(decision.direction)]
+            hand = np.array([(region[0] + region[2]) / 2.0, (region[1] + region[3]) / 2.0])
+            removed.add(obstacle)
+        else:
+            hand = candidates.points[k]
+    return rows
+
+
 def training_data(demonstrations: Iterable[Demonstration], *, mode: Mode | None = None) -> TrainingData:
     """Build the five training sets from demonstrations segmented in ``mode``.
 
@@ -141,9 +188,10 @@ def training_data(demonstrations: Iterable[Demonstration], *, mode: Mode | None 
       only trials that moved at least one obstacle (``original`` rows);
     - direction: one row per moved obstacle (label: direction class index);
     - segment: every (node of row r, node of row r+1) pair (label: the pair the hand used);
-    - arm: consecutive keypoints (label: the next keypoint's (q1, q2)).
+    - arm: consecutive keypoints (label: the next keypoint's (q1, q2));
+    - row (fixed mode): every candidate of every row the person crossed (``row_choice_rows``).
     """
-    gap, obj = _Builder(GAP_FEATURES), _Builder(OBJECT_FEATURES)
+    gap, obj, row_set = _Builder(GAP_FEATURES), _Builder(OBJECT_FEATURES), _Builder(ROW_CHOICE_FEATURES)
     direction, segment, arm = _Builder(DIRECTION_FEATURES), _Builder(SEGMENT_FEATURES), _Builder(ARM_FEATURES)
     people = _Builder(("upper_arm", "forearm"))
     for demo in demonstrations:
@@ -153,6 +201,9 @@ def training_data(demonstrations: Iterable[Demonstration], *, mode: Mode | None 
         faithful = is_faithful(mode)
         space = TaskSpace(demo.scene)
         flags = demo.flags
+        if not faithful:
+            for X, y in row_choice_rows(demo, space):
+                row_set.add(demo.key, X, y)
         gap.add(demo.key, gap_features(space), gap_labels(demo, space, faithful=faithful), not all(flags))
         obj.add(demo.key, object_features(space), object_labels(demo, space), any(flags))
         for k, keypoint in enumerate(demo.keypoints):
@@ -163,6 +214,8 @@ def training_data(demonstrations: Iterable[Demonstration], *, mode: Mode | None 
                                           training=True, hand_to_object=keypoint.direction)
             direction.add(demo.key, features, [direction_index(decision.direction)])
         for row in range(1, len(space.rows)):
+            if NONE in (demo.decisions[row - 1].decision, demo.decisions[row].decision):
+                continue  # a row beside the target: no segment was chosen into or out of it
             near, far = space.nodes(row), space.nodes(row + 1)
             labels = _segment_labels(space, demo, row, near, far, faithful=faithful)
             features = segment_feature_matrix(space, near, far, mode=mode, training=True)
@@ -174,4 +227,4 @@ def training_data(demonstrations: Iterable[Demonstration], *, mode: Mode | None 
             displacement = np.asarray(after.displacement) / scale
             arm.add(demo.key, arm_features(before.arm, displacement, after.direction, mirror=mirror), [after.arm])
     return TrainingData(mode or "fixed", gap.build(), obj.build(), direction.build(), segment.build(), arm.build(),
-                        people.build())
+                        people.build(), row_set.build())

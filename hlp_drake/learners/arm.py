@@ -8,7 +8,7 @@ from sklearn.gaussian_process import GaussianProcessRegressor
 from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from hlp_drake.learners.encoding import expand_directions
+from hlp_drake.learners.encoding import N_DIRECTIONS, check_categorical, expand_directions
 from hlp_drake.learners.inputs import prediction_input
 from hlp_drake.learners.kernel import distance_weights, gaussian_kernel
 
@@ -16,53 +16,59 @@ CATEGORICAL = (4,)  # direction class index in Xa
 
 
 class ArmRegressor(RegressorMixin, BaseEstimator):
-    """One Gaussian process per output angle (constant * RBF + white noise, fitted mean).
+    """One Gaussian process per output (constant * RBF + white noise) on standardised inputs and
+    outputs; the ``categorical`` columns (direction class indices) enter one-hot. For Ra:
+    ``categorical=CATEGORICAL``.
 
     Args:
         max_samples: rows used for the fit (a random subset above it, as MATLAB's subset-of-data
             fit above 2000 rows); a GP's fit grows cubically with the rows.
+        categorical: class-index columns of X.
         random_state: seed of the subset.
 
     Inputs are standardised (the original did not; one shared length scale then weighs angles,
     displacements and one-hot classes alike). Saved as plain arrays; prediction is the GP mean.
     """
 
-    def __init__(self, max_samples: int = 1500, random_state: int = 0) -> None:
+    def __init__(self, max_samples: int = 1500, categorical: tuple[int, ...] = (), random_state: int = 0) -> None:
         self.max_samples = max_samples
+        self.categorical = categorical
         self.random_state = random_state
 
     def fit(self, X: np.ndarray, y: np.ndarray) -> ArmRegressor:
-        X, y = validate_data(self, X, y, multi_output=True)
-        y = y.reshape(len(y), -1)
+        X, y = validate_data(self, X, y, multi_output=True, y_numeric=True)
+        check_categorical(self.categorical, X.shape[1])
+        self.n_outputs_ = 1 if y.ndim == 1 else y.shape[1]
+        y = y.reshape(len(y), -1).astype(float)
         rng = np.random.default_rng(self.random_state)
         if len(X) > self.max_samples:
             index = rng.choice(len(X), self.max_samples, replace=False)
             X, y = X[index], y[index]
-        Z = expand_directions(X, CATEGORICAL)
+        Z = expand_directions(X, self.categorical)
         self.mean_ = Z.mean(axis=0)
         self.scale_ = np.where(Z.std(axis=0) > 0, Z.std(axis=0), 1.0)
-        Z = (Z - self.mean_) / self.scale_
-        self.train_ = Z
-        self.alpha_, self.length_scale_, self.amplitude_, self.y_mean_, self.y_std_ = [], [], [], [], []
+        self.train_ = (Z - self.mean_) / self.scale_
+        self.y_mean_ = y.mean(axis=0)
+        self.y_std_ = np.where(y.std(axis=0) > 0, y.std(axis=0), 1.0)
+        targets = (y - self.y_mean_) / self.y_std_
+        self.alpha_, self.length_scale_, self.amplitude_ = [], [], []
         for k in range(y.shape[1]):
             kernel = ConstantKernel(1.0) * RBF(length_scale=1.0) + WhiteKernel(0.1)
-            gp = GaussianProcessRegressor(kernel, normalize_y=True, random_state=self.random_state).fit(Z, y[:, k])
+            gp = GaussianProcessRegressor(kernel, random_state=self.random_state).fit(self.train_, targets[:, k])
             self.alpha_.append(gp.alpha_.ravel())
             self.length_scale_.append(gp.kernel_.k1.k2.length_scale)
             self.amplitude_.append(gp.kernel_.k1.k1.constant_value)
-            self.y_mean_.append(gp._y_train_mean)
-            self.y_std_.append(gp._y_train_std)
         self.alpha_ = np.array(self.alpha_)
         self.length_scale_ = np.array(self.length_scale_, dtype=float)
         self.amplitude_ = np.array(self.amplitude_, dtype=float)
-        self.y_mean_ = np.array(self.y_mean_, dtype=float).ravel()
-        self.y_std_ = np.array(self.y_std_, dtype=float).ravel()
         self._weights = distance_weights(self.train_)
         return self
 
     def predict(self, X: np.ndarray) -> np.ndarray:
-        """(n, outputs) predicted angles."""
-        return self._predict(self._standardised(prediction_input(self, X)))
+        """(n, outputs) predictions; (n,) for a model fitted on a 1-D target."""
+        X = prediction_input(self, X)
+        q = self._predict(self._standardised(X))
+        return q[:, 0] if self.n_outputs_ == 1 else q
 
     def rollout(self, start: np.ndarray, parent: list[int], moves: np.ndarray,
                 limits: tuple[float, float] = (-np.inf, np.inf)) -> np.ndarray:
@@ -91,7 +97,7 @@ class ArmRegressor(RegressorMixin, BaseEstimator):
         return q
 
     def _standardised(self, X: np.ndarray) -> np.ndarray:
-        return (expand_directions(X, CATEGORICAL) - self.mean_) / self.scale_
+        return (expand_directions(X, self.categorical) - self.mean_) / self.scale_
 
     def _predict(self, Z: np.ndarray) -> np.ndarray:
         kernels = gaussian_kernel(Z, self._weights, tuple(0.5 / self.length_scale_**2))
@@ -102,11 +108,12 @@ class ArmRegressor(RegressorMixin, BaseEstimator):
         check_is_fitted(self)
         return {"mean": self.mean_, "scale": self.scale_, "train": self.train_, "alpha": self.alpha_,
                 "length_scale": self.length_scale_, "amplitude": self.amplitude_, "y_mean": self.y_mean_,
-                "y_std": self.y_std_}
+                "y_std": self.y_std_, "outputs": np.array(self.n_outputs_)}
 
     def set_state(self, state: dict[str, np.ndarray]) -> ArmRegressor:
         for name in ("mean", "scale", "train", "alpha", "length_scale", "amplitude", "y_mean", "y_std"):
             setattr(self, f"{name}_", state[name])
+        self.n_outputs_ = int(state["outputs"])
         self._weights = distance_weights(self.train_)
-        self.n_features_in_ = 5
+        self.n_features_in_ = self.train_.shape[1] - (N_DIRECTIONS - 1) * len(self.categorical)
         return self

@@ -1,4 +1,5 @@
-"""One-hot encoding of the direction-class columns of Xd and Xa (index -1 = undefined -> all zeros)."""
+"""One-hot encoding of the direction-class columns of Xd and Xa (index -1 = undefined -> all zeros;
+any value outside 0-7 likewise)."""
 
 from __future__ import annotations
 
@@ -15,6 +16,13 @@ def expand_directions(X: np.ndarray, columns: tuple[int, ...]) -> np.ndarray:
     out[:, :len(keep)] = X[:, keep]
     for k, c in enumerate(columns):
         index = X[:, c].astype(int)
-        valid = np.flatnonzero(index >= 0)
+        valid = np.flatnonzero((index >= 0) & (index < N_DIRECTIONS))
         out[valid, len(keep) + N_DIRECTIONS * k + index[valid]] = 1.0
     return out
+
+
+def check_categorical(columns: tuple[int, ...], n_features: int) -> None:
+    """Raise a ValueError unless every categorical column index is one of the ``n_features``."""
+    outside = [c for c in columns if not 0 <= c < n_features]
+    if outside:
+        raise ValueError(f"categorical columns {outside} outside the {n_features} features")

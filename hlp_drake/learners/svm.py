@@ -5,10 +5,11 @@ from __future__ import annotations
 import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.svm import SVC
+from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from hlp_drake.learners.balance import oversample
-from hlp_drake.learners.inputs import prediction_input
+from hlp_drake.learners.inputs import binary_classes, prediction_input, sample_weights
 from hlp_drake.learners.kernel import distance_weights, gaussian_kernel
 
 
@@ -36,18 +37,25 @@ class RbfSvmClassifier(ClassifierMixin, BaseEstimator):
         self.balance = balance
         self.random_state = random_state
 
-    def fit(self, X: np.ndarray, y: np.ndarray) -> RbfSvmClassifier:
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.classifier_tags.multi_class = False
+        return tags
+
+    def fit(self, X: np.ndarray, y: np.ndarray, sample_weight: np.ndarray | None = None) -> RbfSvmClassifier:
         X, y = validate_data(self, X, y)
-        self.classes_ = np.unique(y)
-        if len(self.classes_) != 2:
-            raise ValueError(f"RbfSvmClassifier needs two classes, got {len(self.classes_)}")
+        check_classification_targets(y)
+        self.classes_ = binary_classes(self, y)
         rng = np.random.default_rng(self.random_state)
-        Xb, yb = oversample(X, y, rng, self.max_per_class) if self.balance else (X, y)
+        rows = oversample(np.arange(len(y)), y, rng, self.max_per_class)[0] if self.balance else np.arange(len(y))
+        Xb, yb = X[rows], y[rows]
         self.mean_ = Xb.mean(axis=0)
         self.scale_ = np.where(Xb.std(axis=0) > 0, Xb.std(axis=0), 1.0)
         self.gamma_ = 1.0 / self.kernel_scale**2
         svc = SVC(C=self.C, kernel="rbf", gamma=self.gamma_, cache_size=500)
-        svc.fit((Xb - self.mean_) / self.scale_, yb == self.classes_[1])
+        weight = sample_weights(sample_weight, len(y))
+        weight = None if weight is None else weight[rows]
+        svc.fit((Xb - self.mean_) / self.scale_, yb == self.classes_[1], sample_weight=weight)
         self.support_vectors_ = svc.support_vectors_
         self.dual_coef_ = svc.dual_coef_[0]
         self.intercept_ = float(svc.intercept_[0])
@@ -61,7 +69,8 @@ class RbfSvmClassifier(ClassifierMixin, BaseEstimator):
         return kernel @ self.dual_coef_ + self.intercept_
 
     def predict(self, X: np.ndarray) -> np.ndarray:
-        return self.classes_[(self.decision_function(X) > 0).astype(int)]
+        positive = self.decision_function(X) > 0
+        return self.classes_[positive.astype(int)]
 
     def get_state(self) -> dict[str, np.ndarray]:
         """The fitted arrays (for safe saving)."""

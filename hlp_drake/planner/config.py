@@ -27,8 +27,14 @@ class PlannerConfig:
             pair of rows none of whose segment scores does keeps every segment between them (the
             arm's expected collision decides).
         classify_per_row: per row, only the gaps and obstacles laterally nearest the start-target
-            line (this many of each) are classified, so the work per row is bounded however
-            crowded the row is (a VR row has 4 gaps and 3 obstacles: all are classified).
+            line (the row-by-row planner: the hand's line to the target) (this many of each) are
+            classified, so the work per row is bounded however crowded the row is (a VR row has 4
+            gaps and 3 obstacles: all are classified).
+        hand_width: the hand's (or gripper's) width the row-by-row planner measures in, m; None: the
+            VR study's 5 cm hand scaled with the table (as the arm's link lengths are).
+        beam: the row-by-row planner keeps this many partial plans from row to row.
+        min_share: ... and follows a row's candidate only where its share of the row's choice
+            probability is at least this (always the most likely one).
     """
 
     mode: Mode = "fixed"
@@ -39,3 +45,6 @@ class PlannerConfig:
     arm_band: float = 0.025
     classify_per_row: int = 6
     min_evidence: float = 0.05
+    hand_width: float | None = None
+    beam: int = 4
+    min_share: float = 0.05

@@ -1,4 +1,4 @@
-"""The human-like planner: Algorithm 1 of the paper over the task space of any scene (reference 6)."""
+"""The human-like planner: row by row (``row_plan``), or Algorithm 1 of the paper (reference 6)."""
 
 from __future__ import annotations
 
@@ -7,12 +7,14 @@ import time
 import numpy as np
 
 from hlp_drake.features import table_diagonal
+from hlp_drake.features.row_choice import HUMAN_HAND_WIDTH
 from hlp_drake.learners.models import DecisionModels
 from hlp_drake.planner.blas import single_blas_thread
 from hlp_drake.planner.candidates import classify, enumerate_paths, informed, row_candidates, segment_scores
 from hlp_drake.planner.config import PlannerConfig
 from hlp_drake.planner.plan import HighLevelPlan, PlanCandidate, PlanKeypoint
 from hlp_drake.planner.rollout import PrefixTree, arm_configurations, expected_collisions, path_keypoints
+from hlp_drake.planner.row_plan import plan_rows
 from hlp_drake.scene.generators import VR_TABLE
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.validation import scene_problems
@@ -29,6 +31,9 @@ def plan(scene: Scene, models: DecisionModels, config: PlannerConfig | None = No
          link_lengths: tuple[float, float] | None = None) -> HighLevelPlan:
     """Plan how a person would reach the target of ``scene``.
 
+    The models decide the planner: the row-by-row planner (``planner.row_plan``) for models of the
+    "rows" planner (the default presets), the paper's Algorithm 1 for the "paper" preset.
+
     Args:
         scene: the scene (any number of rows).
         models: fitted decision models (trained in ``config.mode``).
@@ -40,9 +45,9 @@ def plan(scene: Scene, models: DecisionModels, config: PlannerConfig | None = No
         The plan, or a plan with ``reason`` set (never an exception for a bad scene).
     """
     started = time.perf_counter()
-    config = config or PlannerConfig(mode=models.mode)
-    if config.mode != models.mode:
-        return _no_plan(scene, f"models were trained in {models.mode} mode, the planner runs in {config.mode}", started)
+    config = config or PlannerConfig(mode=models.mode_)
+    if config.mode != models.mode_:
+        return _no_plan(scene, f"models were trained in {models.mode_} mode, the planner runs in {config.mode}", started)
     problems = scene_problems(scene)
     if problems:
         return _no_plan(scene, "invalid scene: " + "; ".join(problems), started)
@@ -50,7 +55,11 @@ def plan(scene: Scene, models: DecisionModels, config: PlannerConfig | None = No
     links = link_lengths if link_lengths is not None else tuple(np.asarray(models.link_lengths_) * scale)
     q0 = np.asarray(start_arm if start_arm is not None else models.start_arm_, float)
     with single_blas_thread():
-        return _plan(TaskSpace(scene), models, config, q0, links, started)
+        space = TaskSpace(scene)
+        if models.planner == "rows":
+            width = config.hand_width if config.hand_width is not None else HUMAN_HAND_WIDTH * scale
+            return plan_rows(space, models, config, q0, links, width, started)
+        return _plan(space, models, config, q0, links, started)
 
 
 def _plan(space: TaskSpace, models: DecisionModels, config: PlannerConfig, q0: np.ndarray,

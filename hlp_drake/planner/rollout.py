@@ -18,9 +18,9 @@ from hlp_drake.features.segment import path_occluders
 from hlp_drake.learners.models import DecisionModels
 from hlp_drake.planner.human_arm import arm_joints, sweep_collision
 from hlp_drake.planner.plan import PlanKeypoint
-from hlp_drake.planner.relocation import relocated_array
 from hlp_drake.segmentation.modes import Mode
 from hlp_drake.taskspace import DIRECTIONS, Node, TaskSpace, direction_of
+from hlp_drake.taskspace.relocation import relocated_array
 
 
 def path_keypoints(space: TaskSpace, models: DecisionModels, candidates: list[list[Node]],

@@ -33,9 +33,9 @@ from itertools import pairwise
 import numpy as np
 
 from hlp_drake.planner.plan import HighLevelPlan, PlanKeypoint
-from hlp_drake.planner.relocation import relocated
 from hlp_drake.scene.model import Scene
 from hlp_drake.taskspace import DIRECTION_VECTORS, Rect, TaskSpace, rect_array
+from hlp_drake.taskspace.relocation import relocated
 
 # Gap between the obstacle's face and the tcp at the push start: the fingertips reach 2 cm ahead
 # of the tcp, the open fingers' outer sides ~5.5 cm beside it; plus 2-3 cm of free approach (the

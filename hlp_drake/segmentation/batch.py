@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 from tqdm import tqdm
 
 from hlp_drake.dataset.dataset import Dataset
-from hlp_drake.dataset.records import STRUCTURED, TrialRecord
+from hlp_drake.dataset.records import STRUCTURED, TrialRecord, category_of
 from hlp_drake.segmentation.demonstration import Demonstration, Rejection
 from hlp_drake.segmentation.modes import DEFAULT_MODE, Mode, check_mode
 from hlp_drake.segmentation.segment import Rejected, segment_trial
@@ -39,24 +39,28 @@ def _reason_kind(reason: str) -> str:
     return re.sub(r"\d+", "N", reason)
 
 
-def demonstration_records(dataset: Dataset, subjects: Iterable[str] | None = None) -> list[TrialRecord]:
-    """The trials the method learns from: successful structured trials (T010-T099)."""
-    return dataset.select(category=STRUCTURED, success=True, subjects=subjects)
+def demonstration_records(dataset: Dataset, subjects: Iterable[str] | None = None,
+                          categories: Iterable[str] = (STRUCTURED,)) -> list[TrialRecord]:
+    """The trials the method learns from: the successful trials of ``categories`` (default: the
+    structured trials T010-T099)."""
+    categories = tuple(categories)
+    return [r for r in dataset.select(success=True, subjects=subjects) if r.category in categories]
 
 
 def segment_dataset(dataset: Dataset, *, mode: Mode = DEFAULT_MODE, records: list[TrialRecord] | None = None,
-                    progress: bool = False) -> SegmentationResult:
-    """Segment ``records`` (default: all successful structured trials) of ``dataset``.
+                    categories: Iterable[str] = (STRUCTURED,), progress: bool = False) -> SegmentationResult:
+    """Segment ``records`` (default: all successful trials of ``categories``) of ``dataset``.
 
-    Trials the dataset loader already left out (unreadable or invalid files) are reported as
-    rejections too, with the loader's reason.
+    Trials of those categories the dataset loader already left out (unreadable or invalid files)
+    are reported as rejections too, with the loader's reason.
     """
     result = SegmentationResult(check_mode(mode))
     if records is None:
-        records = demonstration_records(dataset)
+        categories = tuple(categories)
+        records = demonstration_records(dataset, categories=categories)
         for problem in dataset.problems:
             match = _TRIAL_IN_PATH.search(problem["path"])
-            if match and 10 <= int(match.group(2)) <= 99:
+            if match and category_of(int(match.group(2))) in categories:
                 key = f"{match.group(1)}/T{match.group(2)}"
                 result.rejections.append(Rejection(key, f"unreadable data: {problem['reason']}"))
     for record in tqdm(records, desc=f"segmenting ({mode})", unit="trial", disable=not progress):

@@ -10,16 +10,17 @@ from hlp_drake.scene.model import Scene
 from hlp_drake.segmentation.arm import LinkLengths
 from hlp_drake.segmentation.modes import Mode
 
-GAP, OBJECT = "gap", "object"
+GAP, OBJECT, NONE = "gap", "object", "none"  # NONE: a row the hand never crossed
 
 
 @dataclass(frozen=True)
 class RowDecision:
-    """What the person did at a row: went through gap ``gap`` or moved ``obstacle`` towards ``direction``.
+    """What the person did at a row: went through gap ``gap`` or moved ``obstacle`` towards ``direction``
+    (or nothing: a row beside the target that the hand never crossed).
 
     Attributes:
         row: 1 = nearest the start.
-        decision: "gap" or "object".
+        decision: "gap", "object" or "none".
         gap: the gap's index in its row from 1, counted from the left (gap decisions only).
         obstacle: the moved obstacle's name (object decisions only).
         direction: the moved obstacle's direction class (FF, FL, ...; object decisions only).
@@ -33,7 +34,9 @@ class RowDecision:
 
     @property
     def element(self) -> str:
-        """The obstacle name, or the gap index as text."""
+        """The obstacle name, the gap index as text, or "" for a row with no decision."""
+        if self.decision == NONE:
+            return ""
         return self.obstacle if self.decision == OBJECT else str(self.gap)
 
 
@@ -70,7 +73,7 @@ class Demonstration:
         mode: "fixed" or "faithful".
         scene: the trial's scene (initial poses).
         left_handed: the demonstrator's handedness.
-        decisions: one per row, nearest row first.
+        decisions: one per row, nearest row first ("none" for a row the hand never crossed).
         keypoints: start, then per row a gap keypoint or approach + release, then the target.
         gap_flags: per row, per gap (left to right), whether the go path passed through it.
         link_lengths: the demonstrator's mean upper-arm and forearm lengths.

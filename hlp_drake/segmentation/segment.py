@@ -7,11 +7,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from hlp_drake.dataset.records import Trial
+from hlp_drake.scene.rows import Row
 from hlp_drake.segmentation.arm import arm_angles, link_lengths, medial_direction
-from hlp_drake.segmentation.demonstration import GAP, OBJECT, Demonstration, Keypoint, RowDecision
+from hlp_drake.segmentation.demonstration import GAP, NONE, OBJECT, Demonstration, Keypoint, RowDecision
 from hlp_drake.segmentation.modes import DEFAULT_MODE, Mode, is_faithful
 from hlp_drake.segmentation.motion import first_moved_per_row, motion_period
-from hlp_drake.taskspace import DIRECTIONS, Rect, TaskSpace, direction_blocks, direction_of
+from hlp_drake.taskspace import DIRECTIONS, Gap, Rect, TaskSpace, direction_blocks, direction_of
 
 ARM_TRACKERS = ("hand", "elbow", "upper_arm")
 SEGMENT_START_FALLBACK = 20  # frames before the approach when the previous keypoint is later (original)
@@ -65,6 +66,27 @@ def _inside(points: np.ndarray, rect: Rect) -> np.ndarray:
         (points[:, 0] > rect.x_min) & (points[:, 0] < rect.x_max)
         & (points[:, 1] > rect.y_min) & (points[:, 1] < rect.y_max)
     )
+
+
+def _crossing(go: np.ndarray, row: Row, gaps: list[Gap]) -> tuple[int, int] | None:
+    """(frame, position in ``gaps``) where the hand first crosses the row's depth (its members'
+    mean centre depth) and the gap whose lateral interval holds it there; None if it never does.
+
+    Raises:
+        Rejected: the hand crosses the row's depth over one of its obstacles.
+    """
+    frames = np.flatnonzero(go[:, 0] >= row.x)
+    if len(frames) == 0:
+        return None
+    frame = int(frames[0])
+    y = float(go[frame, 1])
+    if frame > 0:  # the lateral position where the path reaches the depth, between two samples
+        (x0, y0), (x1, y1) = go[frame - 1], go[frame]
+        y = float(y0 + (y1 - y0) * (row.x - x0) / (x1 - x0))
+    for index, gap in enumerate(gaps):
+        if gap.rect.y_min <= y <= gap.rect.y_max:
+            return frame, index
+    raise Rejected(f"the hand crossed row {row.index} over an obstacle (y {y:+.3f} m) and moved none there")
 
 
 def _moving_direction(space: TaskSpace, name: str, initial: np.ndarray, final: np.ndarray,
@@ -144,12 +166,18 @@ def segment_trial(trial: Trial, *, mode: Mode = DEFAULT_MODE, space: TaskSpace |
             previous = release
             continue
         gaps = space.gaps[row.index - 1]
-        inside = [np.flatnonzero(_inside(go, gap.rect)) for gap in gaps]
-        passed = [(frames[0], i) for i, frames in enumerate(inside) if len(frames)]
-        if not passed:
-            raise Rejected(f"the hand passed no gap of row {row.index} and moved no obstacle there")
-        # The original takes the leftmost flagged gap; the fixed mode the one the hand entered first.
-        frame, index = passed[0] if faithful else min(passed)
+        if faithful:
+            inside = [np.flatnonzero(_inside(go, gap.rect)) for gap in gaps]
+            passed = [(frames[0], i) for i, frames in enumerate(inside) if len(frames)]
+            if not passed:
+                raise Rejected(f"the hand passed no gap of row {row.index} and moved no obstacle there")
+            frame, index = passed[0]  # the original takes the leftmost flagged gap
+        else:
+            crossing = _crossing(go, row, gaps)
+            if crossing is None:  # a row beside the target: no decision was made there
+                decisions.append(RowDecision(row.index, NONE))
+                continue
+            frame, index = crossing
         if faithful and row.index > 1:
             # Row 2's gap direction starts where the 1-cm-rounded path is nearest the previous row.
             rounded_depth = np.round(go[:, 0] / ROUNDING) * ROUNDING

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from hlp_drake.taskspace import ALPHA, DIRECTIONS, Rect, block_array, rect_array
+from hlp_drake.taskspace.directions import DIRECTIONS
+from hlp_drake.taskspace.model import ALPHA, block_array, rect_array
+from hlp_drake.taskspace.rect import Rect
 
 CARDINAL_SHIFT = 0.2  # sideways shift of cardinal moves, fraction of the object's size
 # Per direction (order DIRECTIONS): whether a move shifts along x (by the depth) and along y (by the

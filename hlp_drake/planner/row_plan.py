@@ -1,0 +1,205 @@
+"""The row-by-row planner: the paper's Algorithm 1 for any layout and any number of rows.
+
+The paper plans two rows at once and names the way to more (Section VIII): rows handled
+recursively, each from a sub-start towards the target. Here the rows between the start and the
+target are planned in order. At each row the row-choice classifier Cr scores the row's gaps and
+obstacles as the hand sees them from its keypoint at the row before (its sub-start), on its way to
+the target, with the rows still ahead in view through the free-space route features. A beam keeps
+the most likely partial plans (the product of each row's normalised choice probabilities). A moved
+obstacle's direction comes from Cd and its release point is where the hand goes on from; the arm
+configurations (Ra) and the arm's expected collision are computed for every plan of the beam, as
+in Algorithm 1, and break ties.
+
+A row none of whose candidates lies within the demonstrations' range (``RowChoiceClassifier``'s
+novelty) keeps the one-line rule instead: the gap nearest the hand's line to the target.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from itertools import pairwise
+
+import numpy as np
+
+from hlp_drake.features import DIRECTION_FEATURES, direction_index
+from hlp_drake.features.direction import DirectionTable
+from hlp_drake.features.row_choice import RowCandidates, row_candidates
+from hlp_drake.learners.models import DecisionModels
+from hlp_drake.planner.config import PlannerConfig
+from hlp_drake.planner.plan import HighLevelPlan, PlanCandidate, PlanKeypoint
+from hlp_drake.planner.rollout import PrefixTree, arm_configurations, expected_collisions
+from hlp_drake.scene.rows import Row
+from hlp_drake.taskspace import DIRECTIONS, TaskSpace
+from hlp_drake.taskspace.band import band_coverage
+from hlp_drake.taskspace.relocation import relocated_array
+from hlp_drake.taskspace.routes import FreeRoutes
+
+REACH_FRACTION = 0.25  # the hand stops this many hand widths short of the target's near face
+
+
+@dataclass(frozen=True)
+class _Partial:
+    """A plan up to some row."""
+
+    keypoints: tuple[PlanKeypoint, ...]
+    hand: tuple[float, float]
+    removed: frozenset[int]
+    log_likelihood: float
+    scores: tuple[tuple[int, RowCandidates, np.ndarray, bool], ...]  # per row: candidates, p, evidence
+
+
+def planned_rows(space: TaskSpace, hand_width: float) -> list[Row]:
+    """The rows the hand crosses on its way: beyond the start, before it reaches the target (whose
+    near face it stops ``REACH_FRACTION`` hand widths short of; measured in the VR trials, a row
+    whose centre lies further on is not crossed: the hand reaches the target beside it)."""
+    scene = space.scene
+    reach = scene.target.x - scene.target.size[0] / 2.0 - REACH_FRACTION * hand_width
+    return [row for row in space.rows if scene.start[0] < row.x < reach]
+
+
+def _fallback(candidates: RowCandidates) -> np.ndarray:
+    """The one-line rule's choice as probabilities: the gap nearest the hand's line (else the
+    obstacle nearest it)."""
+    offset = candidates.X[:, 3] + 1e3 * candidates.X[:, 0]  # gaps first
+    p = np.zeros(len(candidates))
+    p[int(np.argmin(offset))] = 1.0
+    return p
+
+
+class _Expander:
+    """Grows partial plans by one row: Cr on the row's candidates, Cd for each obstacle moved."""
+
+    def __init__(self, space: TaskSpace, models: DecisionModels, config: PlannerConfig, hand_width: float,
+                 mirror: bool) -> None:
+        self.space, self.models, self.config, self.width, self.mirror = space, models, config, hand_width, mirror
+        self.routes = FreeRoutes(space.obstacle_bounds, space.scene.table.bounds, hand_width)
+        self.goal = np.asarray(space.target.center, float)
+        self.names = space.obstacle_names
+        self.directions = DirectionTable(space, self.names, mode=config.mode)
+        regions = relocated_array(space.obstacle_bounds, space.alpha)  # (n, 8, 4)
+        self.releases = np.stack([(regions[..., 0] + regions[..., 2]) / 2.0,
+                                  (regions[..., 1] + regions[..., 3]) / 2.0], axis=-1)
+
+    def candidates(self, beam: list[_Partial], row: Row) -> list[tuple[RowCandidates, np.ndarray, bool]]:
+        """Per partial plan: the row's candidates from its hand, their probabilities (summing to 1)
+        and whether any carried evidence (Cr asked once for the whole beam)."""
+        per_plan = row_candidates(self.space, row.index, np.array([p.hand for p in beam]), self.goal,
+                                  hand_width=self.width, routes=self.routes, removed=[p.removed for p in beam],
+                                  mirror=self.mirror, limit=self.config.classify_per_row)
+        X = np.vstack([c.X for c in per_plan])
+        probability = self.models.row.predict_proba(X)[:, 1] if len(X) else np.zeros(0)
+        novelty = self.models.row.novelty(X) if len(X) else np.zeros(0)
+        result, start = [], 0
+        for candidates in per_plan:
+            end = start + len(candidates)
+            evidence = bool(np.any(novelty[start:end] <= 1.0))
+            p = probability[start:end] if evidence else _fallback(candidates)
+            result.append((candidates, p / max(float(p.sum()), 1e-300), evidence))
+            start = end
+        return result
+
+    def moves(self, hand: tuple[float, float], obstacles: np.ndarray) -> list[str]:
+        """Cd's direction for each obstacle approached from ``hand``."""
+        classes = [direction_index(self.directions.hand_direction(int(k), hand)) for k in obstacles]
+        X = self.directions.features(np.asarray(obstacles, int), np.asarray(classes, int)).reshape(-1, len(DIRECTION_FEATURES))
+        return [DIRECTIONS[int(label)] for label in self.models.direction.predict(X)]
+
+    def grow(self, beam: list[_Partial], row: Row) -> list[_Partial]:
+        """Every partial plan of ``beam`` grown by its likely choices at ``row``."""
+        return [child for partial, scored in zip(beam, self.candidates(beam, row))
+                for child in self.children(partial, row, *scored)]
+
+    def children(self, partial: _Partial, row: Row, candidates: RowCandidates, p: np.ndarray,
+                 evidence: bool) -> list[_Partial]:
+        scores = (*partial.scores, (row.index, candidates, p, evidence))
+        if len(candidates) == 0:
+            return [_Partial(partial.keypoints, partial.hand, partial.removed, partial.log_likelihood, scores)]
+        keep = [k for k in np.argsort(-p, kind="stable") if p[k] >= self.config.min_share] or [int(np.argmax(p))]
+        objects = [k for k in keep if candidates.kinds[k] == "object"]
+        directions = dict(zip(objects, self.moves(partial.hand, candidates.obstacles[objects]))) if objects else {}
+        children = []
+        for k in keep:
+            log_likelihood = partial.log_likelihood + math.log(max(float(p[k]), 1e-300))
+            point = tuple(float(v) for v in candidates.points[k])
+            element = candidates.element(k, self.names)
+            if candidates.kinds[k] == "gap":
+                keypoints = (*partial.keypoints, PlanKeypoint("gap", point, row.index, element))
+                children.append(_Partial(keypoints, point, partial.removed, log_likelihood, scores))
+                continue
+            obstacle, direction = int(candidates.obstacles[k]), directions[k]
+            release = tuple(float(v) for v in self.releases[obstacle, DIRECTIONS.index(direction)])
+            keypoints = (*partial.keypoints, PlanKeypoint("move", point, row.index, element, direction),
+                         PlanKeypoint("release", release, row.index, element, direction))
+            children.append(_Partial(keypoints, release, partial.removed | {obstacle}, log_likelihood, scores))
+        return children
+
+
+def segment_collisions(space: TaskSpace, keypoints: tuple[PlanKeypoint, ...], hand_width: float) -> list[dict]:
+    """The hand's straight ways between consecutive keypoints that pass over an obstacle, each as
+    ``{"segment": i, "obstacle": name, "covered": fraction}``: the hand's band (``hand_width``)
+    against the obstacles where they stand at that moment (a moved one at the centre of its
+    relocated region from its release on, and not on the ways to and with it)."""
+    bounds = space.obstacle_bounds.copy()
+    regions = relocated_array(space.obstacle_bounds, space.alpha)
+    found = []
+    for i, (a, b) in enumerate(pairwise(keypoints)):
+        own = {space.obstacle_index[k.element] for k in (a, b) if k.action in ("move", "release")}
+        p0, p1 = np.asarray(a.position)[None], np.asarray(b.position)[None]
+        d = p1 - p0
+        length = float(np.hypot(*d[0]))
+        normal = np.array([[-d[0, 1], d[0, 0]]]) / (length if length > 0 else 1.0)
+        cover = band_coverage(p0, p1, normal, hand_width / 2.0, hand_width / 2.0, bounds)[0]
+        for k in np.flatnonzero(cover > 1e-9):
+            if int(k) not in own:
+                found.append({"segment": i, "obstacle": space.obstacle_names[k], "covered": float(cover[k])})
+        if b.action == "release":
+            k = space.obstacle_index[b.element]
+            bounds[k] = regions[k, DIRECTIONS.index(b.direction)]
+    return found
+
+
+def plan_rows(space: TaskSpace, models: DecisionModels, config: PlannerConfig, q0: np.ndarray,
+              links: tuple[float, float], hand_width: float, started: float) -> HighLevelPlan:
+    """The row-by-row plan of a valid scene's task space (see the module docstring)."""
+    scene = space.scene
+    expander = _Expander(space, models, config, hand_width, mirror=False)
+    start = PlanKeypoint("start", (float(scene.start[0]), float(scene.start[1])))
+    beam = [_Partial((start,), start.position, frozenset(), 0.0, ())]
+    for row in planned_rows(space, hand_width):
+        grown = sorted(expander.grow(beam, row), key=lambda c: -c.log_likelihood)
+        beam = grown[: config.beam]
+    target = PlanKeypoint("target", space.target.center, None, scene.target.name)
+    keypoints = [[*partial.keypoints, target] for partial in beam]
+    tree = PrefixTree.of(keypoints)
+    arms = arm_configurations(models, tree, q0, links[0] + links[1], False)
+    costs = expected_collisions(space, tree, arms, links, config.arm_band, False)
+    order = sorted(range(len(beam)), key=lambda i: (-beam[i].log_likelihood, costs[i]))
+    best = order[0]
+    chosen = tuple(
+        PlanKeypoint(k.action, k.position, k.row, k.element, k.direction, (float(q[0]), float(q[1])))
+        for k, q in zip(keypoints[best], arms[[0, *tree.paths[best]]].tolist()))
+    alternatives = tuple(PlanCandidate(tuple(keypoints[i]), costs[i]) for i in order[1:])
+    details = _details(space, beam[best], [beam[i].log_likelihood for i in order])
+    details["segment_collisions"] = segment_collisions(space, chosen, hand_width)
+    return HighLevelPlan(scene.name, chosen, costs[best], alternatives, time.perf_counter() - started, None, details)
+
+
+def _details(space: TaskSpace, partial: _Partial, log_likelihoods: list[float]) -> dict:
+    """What the chosen plan's rows looked like: per candidate its probability minus one half
+    (``gap_scores``, ``object_scores``: > 0 means Cr takes it, the evaluation's raw labels), the
+    rows' candidates, which rows' scores carried evidence, and the beam's log-likelihoods."""
+    names = space.obstacle_names
+    gap_scores, object_scores, candidates, evidence = {}, {}, {}, {}
+    for row, row_candidates_, p, informed in partial.scores:
+        elements = [row_candidates_.element(k, names) for k in range(len(row_candidates_))]
+        candidates[str(row)] = elements
+        evidence[str(row)] = informed
+        for k, element in enumerate(elements):
+            if row_candidates_.kinds[k] == "gap":
+                gap_scores[f"{row}:{element}"] = float(p[k]) - 0.5
+            else:
+                object_scores[element] = float(p[k]) - 0.5
+    return {"gap_scores": gap_scores, "object_scores": object_scores, "candidates": candidates,
+            "evidence": evidence, "log_likelihoods": log_likelihoods}

@@ -22,12 +22,12 @@ Writes ``DIR/sto_benchmark.json``, ``DIR/sto_comparison.csv`` and ``DIR/sto_comp
 from __future__ import annotations
 
 import argparse
-import copy
 import csv
 import json
 import os
 import platform
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -37,11 +37,13 @@ from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import load_scene
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.execution import plan_and_execute
-from hlp_drake.systems.planning import initial_sequence
-from hlp_drake.systems.rollout import RolloutOutcome, RolloutWorld, SceneRollouts
-from hlp_drake.systems.rollout_pool import RolloutPool, forget_worlds
-from hlp_drake.systems.sto import sample_base_noise
-from hlp_drake.systems.world_config import WorldConfig
+from hlp_drake.systems.optimiser import sample_base_noise
+from hlp_drake.systems.planning_diagram import initial_sequence
+from hlp_drake.systems.rollout_cost import RolloutOutcome
+from hlp_drake.systems.rollout_pool import RolloutPool
+from hlp_drake.systems.rollout_world import RolloutWorld
+from hlp_drake.systems.scenario import Scenario
+from hlp_drake.systems.scene_rollouts import SceneRollouts
 
 DEFAULT_SCENE = Path(__file__).resolve().parents[1] / "hlp_drake" / "scenes" / "default.yaml"
 HORIZON = 3.0
@@ -54,27 +56,28 @@ def truncated(sequence: ControlSequence, horizon: float) -> ControlSequence:
     return ControlSequence(times, np.column_stack([trajectory.value(t) for t in times]).T)
 
 
-def noisy(sequence: ControlSequence, config: WorldConfig, count: int, seed: int) -> list[ControlSequence]:
+def noisy(sequence: ControlSequence, config: Scenario, count: int, seed: int) -> list[ControlSequence]:
     rng = np.random.default_rng(seed)
-    return [sequence.with_base_velocity(v) for v in sample_base_noise(rng, sequence, config.sto.noise, count)]
+    return [sequence.with_base_velocity(v) for v in sample_base_noise(rng, sequence, config.optimiser.noise, count)]
+
+
+def planned(scene, planner: str, data: str = "") -> Scenario:
+    """The default scenario on ``scene`` with ``planner`` and the YAML settings ``data``."""
+    return Scenario(scene=scene).updated(f"planner: {{kind: {planner}}}\n{data}")
 
 
 def throughput_sequences(count: int) -> tuple:
     """The throughput scene (gen2 seed 0, 9 obstacles), a configuration without settling, and
     ``count`` noisy copies of the first ``HORIZON`` s of its straight-line initial sequence."""
     scene = generate_scene("gen2", 0, 9)
-    config = WorldConfig()
-    config.sto.settle_s = 0.0
-    base = truncated(initial_sequence(scene, planner="sto", config=config), HORIZON)
+    config = planned(scene, "sto", "optimiser: {settle_s: 0.0}")
+    base = truncated(initial_sequence(config), HORIZON)
     return scene, config, noisy(base, config, count, seed=1)
 
 
-def model_config(config: WorldConfig, step: float, reduced: bool) -> WorldConfig:
+def model_config(config: Scenario, step: float, reduced: bool) -> Scenario:
     """``config`` with the rollout time step ``step`` and the reduced model on or off."""
-    config = copy.deepcopy(config)
-    config.sto.rollout_time_step = step
-    config.sto.reduced_model = reduced
-    return config
+    return config.updated(f"optimiser: {{rollout_time_step: {step}, reduced_model: {str(reduced).lower()}}}")
 
 
 def throughput(count: int, steps: tuple[float, ...], repeats: int) -> dict:
@@ -93,10 +96,10 @@ def throughput(count: int, steps: tuple[float, ...], repeats: int) -> dict:
                 entry = result.setdefault(f"step_{step * 1000:g}ms", {}).setdefault(model, {})
                 for workers in (1, 2):
                     with RolloutPool(workers) as pool:
-                        pool.rollouts(scene, cfg, sequences[:workers])  # build the full worlds first
+                        pool.rollouts(cfg, sequences[:workers])  # build the full worlds first
                         for rerun in ("cold", "warm"):  # warm: every reduced world built by the cold pass
                             started, cpu = time.perf_counter(), time.process_time()
-                            outcomes = pool.rollouts(scene, cfg, sequences)
+                            outcomes = pool.rollouts(cfg, sequences)
                             elapsed, cpu = time.perf_counter() - started, time.process_time() - cpu
                             runs = entry.setdefault(f"workers_{workers}", {}).setdefault(rerun, [])
                             runs.append({"rollouts_per_s": count / elapsed, "wall_s": elapsed,
@@ -107,8 +110,8 @@ def throughput(count: int, steps: tuple[float, ...], repeats: int) -> dict:
                                          "costs": [o.cost for o in outcomes]})
                 runs = [run for w in (1, 2) for rerun in ("cold", "warm") for run in entry[f"workers_{w}"][rerun]]
                 entry["same_costs_everywhere"] = all(run["costs"] == runs[0]["costs"] for run in runs)
-    for step in (*steps, WorldConfig().plant.time_step):
-        world = RolloutWorld(scene, model_config(config, step, False))
+    for step in (*steps, Scenario().plant.time_step):
+        world = RolloutWorld(model_config(config, step, False))
         world.rollout(sequences[0])
         walls = [world.rollout(s).wall_s for s in sequences[:4]]
         result.setdefault("real_time_factor", {})[f"{step * 1000:g}ms"] = HORIZON / float(np.median(walls))
@@ -123,20 +126,20 @@ def validation_sequences(count: int, scenes: int) -> list[tuple]:
     default = load_scene(DEFAULT_SCENE)
     triples = []
     for planner in ("hlp", "sto"):
-        initial = initial_sequence(default, planner=planner, config=WorldConfig())
-        for i, sequence in enumerate(noisy(initial, WorldConfig(), count, seed=2)):
+        initial = initial_sequence(planned(default, planner))
+        for i, sequence in enumerate(noisy(initial, Scenario(), count, seed=2)):
             triples.append((default, f"default/{planner}/noisy{i}", sequence, True))
     scene, _, sequences = throughput_sequences(2 * count)
     triples += [(scene, f"throughput/noisy{i}", s, False) for i, s in enumerate(sequences)]
     for kind, seed in [(kind, seed) for seed in range(scenes) for kind in ("gen1", "gen2")]:
         scene = generate_scene(kind, seed, 9 if kind == "gen2" else None)
         for planner in ("hlp", "sto"):
-            sequence = initial_sequence(scene, planner=planner, config=WorldConfig())
+            sequence = initial_sequence(planned(scene, planner))
             if sequence is None:
                 print(f"{kind} seed {seed}, {planner}: no initial trajectory, left out")
                 continue
             triples.append((scene, f"{kind}{seed}/{planner}", sequence, True))
-            triples.append((scene, f"{kind}{seed}/{planner}/noisy", noisy(sequence, WorldConfig(), 1, seed=3)[0], True))
+            triples.append((scene, f"{kind}{seed}/{planner}/noisy", noisy(sequence, Scenario(), 1, seed=3)[0], True))
     return triples
 
 
@@ -159,17 +162,17 @@ def model_agreement(triples: list[tuple], steps: tuple[float, ...]) -> dict:
     """Success verdicts and costs of every sequence on the full and the reduced model at each rollout
     time step, and on the full model at the execution time step (the reference); and, as the scale
     of the differences, the full model's own sensitivity: the sequence nudged by 1 um (``nudged``)."""
-    full_step = WorldConfig().plant.time_step
+    full_step = Scenario().plant.time_step
     rows = []
     models: dict = {}
 
     def rollouts(scene, step: float, settle: bool) -> SceneRollouts:
         key = (id(scene), step, settle)
         if key not in models:
-            config = model_config(WorldConfig(), step, True)
+            config = model_config(Scenario(scene=scene), step, True)
             if not settle:
-                config.sto.settle_s = 0.0
-            models[key] = SceneRollouts(scene, config)
+                config = config.updated("optimiser: {settle_s: 0.0}")
+            models[key] = SceneRollouts(config)
         return models[key]
 
     for scene, label, sequence, settle in tqdm(triples, desc="model agreement", unit="sequence"):
@@ -214,16 +217,16 @@ def model_agreement(triples: list[tuple], steps: tuple[float, ...]) -> dict:
     return summary
 
 
-def comparison(config: WorldConfig, seeds: int, out: Path) -> dict:
+def comparison(config: Scenario, seeds: int, out: Path) -> dict:
     scenes = [load_scene(DEFAULT_SCENE)] + [generate_scene("gen1", seed) for seed in range(seeds)]
     rows = []
     for scene in tqdm(scenes, desc="HLP vs straight line", unit="scene"):
         for planner in ("hlp", "sto"):
-            # Fresh workers and no worlds kept in this process: neither planner reuses the rollout
-            # worlds the other one built on this scene (the pool's start-up is not in optimise_s).
-            forget_worlds()
-            with RolloutPool(config.sto.workers) as pool:
-                result = plan_and_execute(scene, planner=planner, config=config, pool=pool)
+            # A fresh pool: neither planner reuses the rollout worlds the other one built on this
+            # scene (the pool's start-up is not in optimise_s).
+            scenario = replace(config, scene=scene, planner=replace(config.planner, kind=planner))
+            with RolloutPool(config.optimiser.workers) as pool:
+                result = plan_and_execute(scenario, pool=pool)
                 rows.append({"scene": scene.name, "planner": planner, "success": result.success,
                              "failure_reason": result.failure_reason or "", "iterations": result.iterations,
                              "rollouts": result.rollouts, "init_s": result.timings["plan_s"] + result.timings["ik_s"],
@@ -323,7 +326,7 @@ def main() -> None:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     report = {"machine": {"platform": platform.platform(), "cpus": os.cpu_count(), "python": platform.python_version()}}
-    steps = (WorldConfig().sto.rollout_time_step, 0.01)
+    steps = (Scenario().optimiser.rollout_time_step, 0.01)
     report["throughput"] = throughput(args.throughput_rollouts, steps, args.throughput_repeats)
     print_throughput(report["throughput"], steps)
     if not args.skip_agreement:
@@ -331,7 +334,7 @@ def main() -> None:
             validation_sequences(args.agreement_sequences, args.validation_scenes), steps)
         print_agreement(report["model_agreement"], steps)
     if not args.skip_comparison:
-        report["comparison"] = c = comparison(WorldConfig(), args.gen1, out)
+        report["comparison"] = c = comparison(Scenario(), args.gen1, out)
         for planner in ("hlp", "sto"):
             s = c[planner]
             print(f"{planner}: success {s['success']}/{s['scenes']}, optimise median {s['optimise_s_median']:.2f} s, "

@@ -199,7 +199,7 @@ def test_a_different_run_in_the_directory_is_refused_unless_fresh(tmp_path, caps
     assert {name: (tmp_path / name).read_bytes() for name in OUTPUTS} == before
     assert run_cli(lambda a: main(a, job=cheap_job), [*argv, "--fresh"]) == 0
     assert [r["scene"] for r in read_rows(tmp_path / "results.csv")] == ["gen1-20"] * 2 + ["gen1-21"] * 2
-    with pytest.raises(HlpError, match="world config"):
+    with pytest.raises(HlpError, match="scenario"):
         run_experiment(settings(seed=20, config_yaml="motion: {tcp_speed: 0.05}"), tmp_path, job=cheap_job)
 
 
@@ -288,12 +288,12 @@ def test_cli_fast_public_api(tmp_path, capsys):
     assert run["command"].startswith("python -m hlp_drake.experiments gen2 --scenes 2")
     assert run["seeds"] == {"first": 5, "last": 6, "scenes": 2} and run["status"] == "complete"
     assert run["software"]["drake"] and run["software"]["numpy"] and run["machine"]["cpu_count"]
-    assert "sto:" in run["world_config"]
+    assert "optimiser:" in run["scenario"] and "scene:" in run["scenario"]
 
 
 def test_cli_end_to_end_with_the_real_planners(tmp_path):
-    config = tmp_path / "world.yaml"  # a small optimiser budget keeps the test's time bounded
-    config.write_text("sto:\n  max_iterations: 2\n  samples: 2\n  time_budget_s: 10.0\n  workers: 1\n")
+    config = tmp_path / "scenario.yaml"  # a small optimiser budget keeps the test's time bounded
+    config.write_text("optimiser:\n  max_iterations: 2\n  samples: 2\n  time_budget_s: 10.0\n  workers: 1\n")
     out = tmp_path / "out"
     result = run_module("hlp_drake.experiments", "gen1", "--scenes", "1", "--workers", "1", "--quiet",
                         "--config", str(config), "--out", str(out))
@@ -304,7 +304,7 @@ def test_cli_end_to_end_with_the_real_planners(tmp_path):
         assert not row["failure_reason"].startswith("crashed"), row["failure_reason"]
         assert float(row["init_s"]) > 0 and float(row["execute_s"]) > 0 and int(row["objects"]) == 6
         assert int(row["iterations"]) <= 2
-    assert "max_iterations: 2" in json.loads((out / "run.json").read_text())["world_config"]
+    assert "max_iterations: 2" in json.loads((out / "run.json").read_text())["scenario"]
     assert "Table II" in result.stdout and (out / "times.png").exists()
 
 
@@ -339,16 +339,12 @@ def test_rows_finishing_in_any_order_are_written_sorted(tmp_path):
 def test_a_drake_check_failing_in_a_job_is_that_jobs_crash_and_a_real_exit_is_not(monkeypatch):
     from hlp_drake.experiments.runner import run_job
     from hlp_drake.systems import execution
-    from hlp_drake.systems.world_config import WorldConfig, dump_world_config
+    from hlp_drake.systems.scenario import Scenario
 
-    job = Job("gen1", 0, 6, "gen1-0", "hlp", dump_world_config(WorldConfig()))
+    job = Job("gen1", 0, 6, "gen1-0", "hlp", Scenario().updated("optimiser: {workers: 1}").yaml)
 
-    from hlp_drake.systems import rollout_pool
-
-    rollout_pool._worlds["left by an earlier job"] = object()
-
-    def failing_check(*args, **kwargs):
-        assert not rollout_pool._worlds  # each job starts without another job's rollout worlds
+    def failing_check(scenario, *, pool, **kwargs):
+        assert scenario.scene.name == "gen1-0" and scenario.planner.kind == "hlp" and pool.workers == 1
         raise SystemExit("Failure at plant.h:1 in SetPositions(): condition 'AllFinite(q)' failed.")
 
     monkeypatch.setattr(execution, "plan_and_execute", failing_check)

@@ -1,6 +1,6 @@
 """One experiment job: plan and execute one scene with one planner, reduced to a ``results.csv`` row.
 
-A job is a pure function of its ``Job`` (kind, seed, object count, planner, world config YAML), so the
+A job is a pure function of its ``Job`` (kind, seed, object count, planner, scenario YAML), so the
 same job gives the same outcome in this process, a local worker process or a dask worker. Drake is
 imported inside ``run_job`` only: worker processes are spawned and import what they run.
 """
@@ -8,7 +8,7 @@ imported inside ``run_job`` only: worker processes are spawned and import what t
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from hlp_drake.errors import SceneError
@@ -31,7 +31,7 @@ class Job:
     objects: int  # the scene's number of obstacles
     scene: str  # the scene's name, e.g. "gen1-3" or "gen2-7-12"
     planner: str
-    config_yaml: str  # the world config as YAML text (``dump_world_config``), not a Drake object
+    config_yaml: str  # the scenario as YAML text (``Scenario.yaml``; its scene is replaced), not a Drake object
 
     @property
     def key(self) -> tuple[str, str]:
@@ -90,20 +90,20 @@ def run_job(job: Job) -> Row:
     is recorded as this planner's failure on this scene ("crashed: ..."), its times as NaN (left
     out of the means), rather than ending the run. The bundled decision models are loaded
     before the timed call, so a worker's first scene is not charged for loading them, and
-    every job starts without rollout worlds that an earlier job (maybe the other planner on the
-    same scene) built in this process.
+    every job has a rollout pool of its own: no job uses rollout worlds an earlier one (maybe the
+    other planner on the same scene) built.
     """
     from hlp_drake.learners.bundled import default_models
     from hlp_drake.systems.execution import plan_and_execute
-    from hlp_drake.systems.rollout import simulation_failure
-    from hlp_drake.systems.rollout_pool import forget_worlds
-    from hlp_drake.systems.world_config import load_world_config
+    from hlp_drake.systems.rollout_pool import RolloutPool
+    from hlp_drake.systems.rollout_world import simulation_failure
+    from hlp_drake.systems.scenario import load_scenario
 
-    config = load_world_config(overrides=job.config_yaml)
-    forget_worlds()
+    settings = load_scenario(data=job.config_yaml, where="the job's scenario")
     try:
-        result = plan_and_execute(job.make_scene(), planner=job.planner, models=default_models(),
-                                  config=config)
+        scenario = replace(settings, scene=job.make_scene(), planner=replace(settings.planner, kind=job.planner))
+        with RolloutPool(scenario.optimiser.workers) as pool:
+            result = plan_and_execute(scenario, pool=pool, models=default_models())
     except (Exception, SystemExit) as error:  # noqa: BLE001 - a crash is this planner's failure here
         if isinstance(error, SystemExit):
             simulation_failure(error)  # raises it again unless it is Drake's

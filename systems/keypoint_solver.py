@@ -35,6 +35,7 @@ from pydrake.trajectories import PiecewisePolynomial
 from hlp_drake.planner.plan import HighLevelPlan, PlanKeypoint
 from hlp_drake.systems.keyframes import Keyframes, describe_keypoint
 from hlp_drake.systems.planning_model import PlanningModel
+from hlp_drake.systems.push_transfer import TRANSFERRED
 from hlp_drake.systems.robot import (
     ARM_JOINTS,
     BASE_FOOTPRINT,
@@ -162,6 +163,9 @@ class KeypointSolver:
             return Keyframes.empty(
                 self._start, f"the plan is for scene {plan.scene!r}, this KeypointIk for {self._scene.name!r}"
             )
+        if any(k.action == "move" for k in plan.keypoints) and not plan.details.get(TRANSFERRED):
+            return Keyframes.empty(self._start, "the plan's moves are a person's (the obstacles' centres): put a "
+                                   "RobotPlanTransfer between the planner and KeypointIk")
         if not plan.ok:
             return Keyframes.empty(self._start, f"no plan: {plan.reason or 'fewer than two keypoints'}")
         started = time.perf_counter()

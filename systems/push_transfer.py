@@ -46,6 +46,9 @@ ROBOT_ACTIONS = ("start", "gap", "move", "release", "target", "transit", "approa
 """The actions of a robot plan: the person's (``hlp_drake.planner.ACTIONS``), "transit" (a waypoint
 lifted clear of the objects) and "approach" (the waypoint the gripper slides onto the target from)."""
 BACKWARD = ("BB", "BL", "BR")
+TRANSFERRED = "robot_plan"
+"""The key ``robot_plan`` sets in a plan's ``details``: its moves are the robot's pushes (``KeypointIk``
+refuses a person's moves, the obstacles' centres)."""
 
 def _robot_direction(rules: PushRules, space: TaskSpace, scene: Scene, name: str, direction: str,
                      footprints: Mapping[str, Rect] | None = None) -> str:
@@ -196,7 +199,7 @@ def robot_plan(plan: HighLevelPlan, scene: Scene, rules: PushRules) -> HighLevel
         else:
             placed[k.element] = push.footprint
             keypoints.append(replace(k, position=push.end, direction=push.direction))
-    return replace(plan, keypoints=tuple(keypoints))
+    return replace(plan, keypoints=tuple(keypoints), details={**plan.details, TRANSFERRED: True})
 
 
 def robot_alternatives(plan: HighLevelPlan, scene: Scene, rules: PushRules, limit: int) -> tuple[HighLevelPlan, ...]:

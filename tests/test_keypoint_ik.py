@@ -351,3 +351,20 @@ def test_keyframes_keep_the_robot_clear_of_itself(system, scene, solved):
         pairs = [p for p in query.ComputeSignedDistancePairwiseClosestPoints(0.05) if p.id_A in robot and p.id_B in robot]
         assert pairs, "the robot's self pairs should be checked"
         assert min(p.distance for p in pairs) >= CONFIG.ik.table_clearance - 1e-4
+
+
+def test_a_persons_plan_wired_straight_into_ik_is_refused_not_executed(system):
+    """A person's "move" keypoints are the obstacles' centres; only RobotPlanTransfer's plan is solved."""
+    from hlp_drake.learners.bundled import default_models
+    from hlp_drake.planner import plan as human_plan
+    from hlp_drake.systems.push_transfer import robot_plan
+    from hlp_drake.systems.transfer_geometry import gripper_geometry, push_rules
+
+    scene = generate_scene("gen1", 3)
+    person = human_plan(scene, default_models())
+    assert any(k.action == "move" for k in person.keypoints)
+    system = ik_for(scene)
+    refused = solve(system, person)
+    assert not refused.ok and "RobotPlanTransfer" in refused.problems[0]
+    robot = robot_plan(person, scene, push_rules(CONFIG.transfer, gripper_geometry()))
+    assert solve(system, robot).ok and person.details.get("robot_plan") is None

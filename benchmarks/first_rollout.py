@@ -39,9 +39,13 @@ def first_pass(kind: str, seed: int, objects: int | None, planner: str, config_y
     settings = load_scenario(data=config_yaml)
     scenario = replace(settings, scene=scene, planner=replace(settings.planner, kind=planner))
     outcome = first_rollout(scenario, models=default_models())
-    return {"scene": scene.name, "seed": seed, "objects": len(scene.obstacles),
-            "passed": bool(outcome is not None and outcome.success),
-            "reason": "no trajectory" if outcome is None else outcome.failure_reason}
+    return {
+        "scene": scene.name,
+        "seed": seed,
+        "objects": len(scene.obstacles),
+        "passed": bool(outcome is not None and outcome.success),
+        "reason": "no trajectory" if outcome is None else outcome.failure_reason,
+    }
 
 
 def main() -> None:
@@ -62,8 +66,9 @@ def main() -> None:
     except HlpError as error:
         parser.error(str(error))
     counts = args.objects if args.kind == "gen2" else [None]
-    jobs = [(args.kind, args.seed + i, n, args.planner, config_yaml)
-            for n in counts for i in range(args.scenes)]
+    jobs = [
+        (args.kind, args.seed + i, n, args.planner, config_yaml) for n in counts for i in range(args.scenes)
+    ]
     started = time.perf_counter()
     with ProcessPoolExecutor(args.workers, mp_context=multiprocessing.get_context("spawn")) as pool:
         outcomes = pool.map(first_pass, *zip(*jobs))

@@ -43,8 +43,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
     module = COMMANDS.get(args[0])
     if module is None:
-        print(f"error: unknown command {args[0]!r}; choose one of {', '.join(COMMANDS)} (see hlp-drake --help)",
-              file=sys.stderr)
+        print(
+            f"error: unknown command {args[0]!r}; choose one of {', '.join(COMMANDS)} (see hlp-drake --help)",
+            file=sys.stderr,
+        )
         return 2
     return run_cli(importlib.import_module(module).main, args[1:])
 

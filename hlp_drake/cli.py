@@ -35,8 +35,13 @@ def make_parser(prog: str, doc: str | None, **kwargs) -> Parser:
     """A ``Parser`` for the command ``prog``: the first paragraph of the docstring ``doc`` as its
     description, the rest as the epilog (both plain text), and ``--version``."""
     head, _, rest = (doc or "").strip().partition("\n\n")
-    parser = Parser(prog=prog, description=plain(head), epilog=plain(rest) or None,
-                    formatter_class=argparse.RawDescriptionHelpFormatter, **kwargs)
+    parser = Parser(
+        prog=prog,
+        description=plain(head),
+        epilog=plain(rest) or None,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        **kwargs,
+    )
     parser.add_argument("--version", action="version", version=f"%(prog)s (hlp_drake {__version__})")
     return parser
 

@@ -15,9 +15,15 @@ from tqdm import tqdm
 
 def plan_steps(plan) -> str:
     """A plan's keypoints as one line: ``start -> move Long RR -> release -> target``."""
-    return " -> ".join(
-        k.action + (f" {k.element}" if k.action in ("gap", "move") else "") + (f" {k.direction}" if k.action == "move" else "")
-        for k in plan.keypoints) or "(none)"
+    return (
+        " -> ".join(
+            k.action
+            + (f" {k.element}" if k.action in ("gap", "move") else "")
+            + (f" {k.direction}" if k.action == "move" else "")
+            for k in plan.keypoints
+        )
+        or "(none)"
+    )
 
 
 class ProgressListener:
@@ -47,8 +53,10 @@ class ProgressListener:
     def solved(self, keyframes, trajectory, seconds: float) -> None:
         solved = sum(keyframes.success)
         failed = "" if keyframes.ok else f"; failed: {'; '.join(keyframes.failures)}"
-        self._line(f"IK: {solved} of {len(keyframes.success)} keyframes, a {trajectory.end_time():.1f} s "
-                   f"trajectory ({seconds:.2f} s){failed}")
+        self._line(
+            f"IK: {solved} of {len(keyframes.success)} keyframes, a {trajectory.end_time():.1f} s "
+            f"trajectory ({seconds:.2f} s){failed}"
+        )
 
     def optimising(self) -> None:
         self._open(desc="optimise", unit="rollout")
@@ -61,14 +69,22 @@ class ProgressListener:
     def optimised(self, result) -> None:
         self._close()
         verdict = "success" if result.success else f"no success ({result.failure_reason})"
-        self._line(f"optimise: {verdict} after {result.iterations} iterations, {result.rollouts} rollouts "
-                   f"({result.optimise_s:.1f} s)")
+        self._line(
+            f"optimise: {verdict} after {result.iterations} iterations, {result.rollouts} rollouts "
+            f"({result.optimise_s:.1f} s)"
+        )
 
     def executing(self, duration: float) -> None:
         self._line(f"execute: up to {duration:.1f} s simulated (reach, settle, grasp and lift)")
         self._shown = 0.0
-        self._open(desc="execute", total=round(duration, 1), unit="s sim", bar_format=(
-            "{desc}: {percentage:3.0f}%|{bar}| {n:.1f}/{total:.1f} s simulated [{elapsed}<{remaining}]"))
+        self._open(
+            desc="execute",
+            total=round(duration, 1),
+            unit="s sim",
+            bar_format=(
+                "{desc}: {percentage:3.0f}%|{bar}| {n:.1f}/{total:.1f} s simulated [{elapsed}<{remaining}]"
+            ),
+        )
 
     def simulated(self, t: float) -> None:
         if self._bar is not None and t - self._shown >= 0.1:

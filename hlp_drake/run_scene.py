@@ -31,12 +31,18 @@ def summary(result) -> str:
     t = result.timings
     start = (result.optimisation or {}).get("start", 0)
     alternative = f", from the planner's alternative {start}" if start else ""
-    optimiser = (f"optimise {t['optimise_s']:.1f} s ({result.iterations} iterations, "
-                 f"{result.rollouts} rollouts{alternative})" if result.rollouts else "not optimised")
+    optimiser = (
+        f"optimise {t['optimise_s']:.1f} s ({result.iterations} iterations, "
+        f"{result.rollouts} rollouts{alternative})"
+        if result.rollouts
+        else "not optimised"
+    )
     grasp = {None: "not attempted", True: "held", False: "did not hold"}[result.grasp_held]
     lines = [
-        (f"timings: plan {t['plan_s']:.3f} s, IK {t['ik_s']:.2f} s, {optimiser}, execute {t['execute_s']:.1f} s "
-         f"({result.simulated_s:.1f} s simulated), total {t['total_s']:.1f} s"),
+        (
+            f"timings: plan {t['plan_s']:.3f} s, IK {t['ik_s']:.2f} s, {optimiser}, execute {t['execute_s']:.1f} s "
+            f"({result.simulated_s:.1f} s simulated), total {t['total_s']:.1f} s"
+        ),
         f"objects moved: {', '.join(result.objects_moved) or 'none'}; dropped: {', '.join(result.objects_dropped) or 'none'}",
         "success" if result.success else f"failure: {result.failure_reason}",
         f"grasp: {grasp}",
@@ -47,17 +53,29 @@ def summary(result) -> str:
 def _parser():
     parser = make_parser(PROG, __doc__)
     source = parser.add_mutually_exclusive_group()
-    source.add_argument("--scene", metavar="FILE", help="a scene file (YAML or JSON); default: the bundled default scene")
+    source.add_argument(
+        "--scene", metavar="FILE", help="a scene file (YAML or JSON); default: the bundled default scene"
+    )
     source.add_argument("--kind", choices=KINDS, help="generate a scene of this kind (with --seed)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the generated scene (default 0)")
     parser.add_argument("--objects", type=int, metavar="K", help="number of obstacles (gen2, unstructured)")
-    parser.add_argument("--planner", choices=("hlp", "sto"),
-                        help="initialise the optimiser with the human-like plan (hlp, the default) or the "
-                             "baseline's straight line (sto)")
-    parser.add_argument("--config", metavar="SCENARIO.yaml",
-                        help="scenario settings (see hlp_drake.systems.Scenario); --scene or --kind replace its scene")
-    parser.add_argument("--workers", type=int, metavar="N", help="rollout processes (default: the scenario's, 2)")
-    parser.add_argument("--meshcat", action="store_true", help="show the run live in MeshCat (prints the URL)")
+    parser.add_argument(
+        "--planner",
+        choices=("hlp", "sto"),
+        help="initialise the optimiser with the human-like plan (hlp, the default) or the "
+        "baseline's straight line (sto)",
+    )
+    parser.add_argument(
+        "--config",
+        metavar="SCENARIO.yaml",
+        help="scenario settings (see hlp_drake.systems.Scenario); --scene or --kind replace its scene",
+    )
+    parser.add_argument(
+        "--workers", type=int, metavar="N", help="rollout processes (default: the scenario's, 2)"
+    )
+    parser.add_argument(
+        "--meshcat", action="store_true", help="show the run live in MeshCat (prints the URL)"
+    )
     parser.add_argument("--html", metavar="FILE", help="write a self-contained MeshCat recording of the run")
     parser.add_argument("--contact-forces", action="store_true", help="draw the contact forces in MeshCat")
     parser.add_argument("--json", metavar="FILE", help="write the result as JSON")
@@ -81,12 +99,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     from hlp_drake.systems.scenario import load_scenario  # Drake is imported from here on
 
     scenario = load_scenario(args.config)
-    scenario = replace(scenario, scene=scene or scenario.scene,
-                       planner=replace(scenario.planner, kind=args.planner or scenario.planner.kind),
-                       optimiser=replace(scenario.optimiser, workers=args.workers or scenario.optimiser.workers))
+    scenario = replace(
+        scenario,
+        scene=scene or scenario.scene,
+        planner=replace(scenario.planner, kind=args.planner or scenario.planner.kind),
+        optimiser=replace(scenario.optimiser, workers=args.workers or scenario.optimiser.workers),
+    )
     if scene is None:
-        _print(f"scene {scenario.scene.name}: {len(scenario.scene.obstacles)} obstacles, "
-               f"planner {scenario.planner.kind}")
+        _print(
+            f"scene {scenario.scene.name}: {len(scenario.scene.obstacles)} obstacles, "
+            f"planner {scenario.planner.kind}"
+        )
     result, meshcat = _run(scenario, args, started)
     print(summary(result))
     if args.html:
@@ -129,8 +152,9 @@ def _run(scenario, args, started: float):
     with RolloutPool(workers, on_rollout=listener.rollout) as pool:
         if workers > 1:
             _print(f"rollout workers ready ({pool.startup_s:.1f} s)")
-        result = plan_and_execute(scenario, pool=pool, meshcat=meshcat, contact_forces=args.contact_forces,
-                                  listener=listener)
+        result = plan_and_execute(
+            scenario, pool=pool, meshcat=meshcat, contact_forces=args.contact_forces, listener=listener
+        )
     return result, meshcat
 
 

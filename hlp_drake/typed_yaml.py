@@ -132,7 +132,9 @@ def _freeze(schema: Any, value: Any) -> Any:
         return None if value is None else _freeze(inner, value)
     if _is_schema(schema):
         hints = _hints(schema)
-        return schema(**{f.name: _freeze(hints[f.name], getattr(value, f.name)) for f in dataclasses.fields(schema)})
+        return schema(
+            **{f.name: _freeze(hints[f.name], getattr(value, f.name)) for f in dataclasses.fields(schema)}
+        )
     items = _tuple_items(schema)
     if items is not None:
         return tuple(_freeze(items[0], v) for v in value)
@@ -210,7 +212,9 @@ def parse_yaml(text: str, where: str, error: type[HlpError] = HlpError) -> Any:
     except yaml.YAMLError as problem:
         mark = getattr(problem, "problem_mark", None)
         at = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
-        raise error(f"{where}: not valid YAML{at}: {getattr(problem, 'problem', None) or 'syntax error'}") from None
+        raise error(
+            f"{where}: not valid YAML{at}: {getattr(problem, 'problem', None) or 'syntax error'}"
+        ) from None
 
 
 def _clear_whole(schema: type, base: Any, document: Any) -> None:
@@ -226,8 +230,15 @@ def _clear_whole(schema: type, base: Any, document: Any) -> None:
                 _clear_whole(kind, getattr(base, name), document[name])
 
 
-def load_typed(schema: type[T], document: Any, *, defaults: T | None = None, where: str = "",
-               top: str = "document", error: type[HlpError] = HlpError) -> T:
+def load_typed(
+    schema: type[T],
+    document: Any,
+    *,
+    defaults: T | None = None,
+    where: str = "",
+    top: str = "document",
+    error: type[HlpError] = HlpError,
+) -> T:
     """``document`` (parsed YAML, e.g. from ``parse_yaml``) read as ``schema`` over ``defaults``.
 
     An empty document (None) gives the defaults. Every problem is one line, ``{where}: {path}:

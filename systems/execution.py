@@ -93,19 +93,34 @@ class ExecutionResult:
 
     def to_dict(self) -> dict[str, Any]:
         return {
-            "planner": self.planner, "scene": self.scene.name, "success": self.success,
-            "failure_reason": self.failure_reason, "plan": self.plan.to_dict(),
+            "planner": self.planner,
+            "scene": self.scene.name,
+            "success": self.success,
+            "failure_reason": self.failure_reason,
+            "plan": self.plan.to_dict(),
             "ik": {"ok": self.keyframes.ok, "failures": self.keyframes.failures},
-            "robot_actuated_dofs": 10, "timings": self.timings, "objects_moved": self.objects_moved,
-            "objects_dropped": self.objects_dropped, "target_distance": self.target_distance,
-            "simulated_s": self.simulated_s, "iterations": self.iterations, "rollouts": self.rollouts,
-            "optimisation": self.optimisation, "grasp_held": self.grasp_held,
+            "robot_actuated_dofs": 10,
+            "timings": self.timings,
+            "objects_moved": self.objects_moved,
+            "objects_dropped": self.objects_dropped,
+            "target_distance": self.target_distance,
+            "simulated_s": self.simulated_s,
+            "iterations": self.iterations,
+            "rollouts": self.rollouts,
+            "optimisation": self.optimisation,
+            "grasp_held": self.grasp_held,
         }
 
 
-def plan_and_execute(scenario: Scenario, *, pool: RolloutPool, models: DecisionModels | None = None,
-                     meshcat: Meshcat | None = None, contact_forces: bool = False,
-                     listener: RunListener | None = None) -> ExecutionResult:
+def plan_and_execute(
+    scenario: Scenario,
+    *,
+    pool: RolloutPool,
+    models: DecisionModels | None = None,
+    meshcat: Meshcat | None = None,
+    contact_forces: bool = False,
+    listener: RunListener | None = None,
+) -> ExecutionResult:
     """Plan ``scenario``'s scene with its planner, solve IK, optimise with the STO, execute with
     contact, and grasp.
 
@@ -143,7 +158,9 @@ def plan_and_execute(scenario: Scenario, *, pool: RolloutPool, models: DecisionM
     trajectory = planning.GetOutputPort("trajectory").Eval(context)
     solved = time.perf_counter()
     listener.solved(keyframes, trajectory, solved - planned)
-    result = ExecutionResult(scenario.planner.kind, scene, plan, keyframes, planning.GetOutputPort("robot_plan").Eval(context))
+    result = ExecutionResult(
+        scenario.planner.kind, scene, plan, keyframes, planning.GetOutputPort("robot_plan").Eval(context)
+    )
     result.timings = {"plan_s": planned - started, "ik_s": solved - planned, "optimise_s": 0.0}
     if not plan.ok:
         result.failure_reason = f"no plan: {plan.reason}"
@@ -165,20 +182,31 @@ def plan_and_execute(scenario: Scenario, *, pool: RolloutPool, models: DecisionM
     trajectory_source.UpdateTrajectory(sequence.to_trajectory())
     if meshcat is not None:
         frame_table(meshcat, scene)
-        heights = {"table_height": scene.table.height, "keypoint_height": tcp_keypoint_height(scene, scenario.ik)}
+        heights = {
+            "table_height": scene.table.height,
+            "keypoint_height": tcp_keypoint_height(scene, scenario.ik),
+        }
         draw_plan(meshcat, plan, path="plan", markers=False, **heights)
         draw_plan(meshcat, result.robot_plan, path="robot_plan", **heights)
     _execute(result, simulator, trajectory_source, sequence, scenario, meshcat, listener)
     executed = time.perf_counter()
     result.success = result.failure_reason is None
-    result.timings.update({"execute_s": executed - optimised, "total_s": executed - started,
-                           "pool_start_s": pool.startup_s})
+    result.timings.update(
+        {"execute_s": executed - optimised, "total_s": executed - started, "pool_start_s": pool.startup_s}
+    )
     listener.finished(result)
     return result
 
 
-def _execute(result: ExecutionResult, simulator: Simulator, source, sequence: ControlSequence, scenario: Scenario,
-             meshcat: Meshcat | None, listener: RunListener) -> None:
+def _execute(
+    result: ExecutionResult,
+    simulator: Simulator,
+    source,
+    sequence: ControlSequence,
+    scenario: Scenario,
+    meshcat: Meshcat | None,
+    listener: RunListener,
+) -> None:
     """Simulate ``sequence`` in the world, check the reach, then grasp and lift; fills ``result``."""
     scene = result.scene
     world = simulator.get_system().GetSubsystemByName("world")
@@ -195,13 +223,21 @@ def _execute(result: ExecutionResult, simulator: Simulator, source, sequence: Co
     try:
         simulator.AdvanceTo(sequence.duration + SETTLE_S)
         after = object_planar_poses(plant, plant_context, names)
-        result.objects_moved = [n for n in names if n != scene.target.name
-                                and np.hypot(*np.subtract(after[n][:2], before[n][:2])) > MOVED_TOLERANCE]
+        result.objects_moved = [
+            n
+            for n in names
+            if n != scene.target.name
+            and np.hypot(*np.subtract(after[n][:2], before[n][:2])) > MOVED_TOLERANCE
+        ]
         result.objects_dropped = fallen_objects(plant, plant_context, scene)
         tcp = plant.GetFrameByName(TCP_FRAME, robot).CalcPoseInWorld(plant_context).translation()
         inside, result.target_distance = pregrasp_check(
-            tcp, after[scene.target.name], scene, tcp_height=tcp_keypoint_height(scene, scenario.ik),
-            margin=scenario.optimiser.cost.pregrasp_margin)
+            tcp,
+            after[scene.target.name],
+            scene,
+            tcp_height=tcp_keypoint_height(scene, scenario.ik),
+            margin=scenario.optimiser.cost.pregrasp_margin,
+        )
         problem = reach_problem(result.objects_dropped, inside, result.target_distance)
         if problem is not None and result.failure_reason is None:
             result.failure_reason = f"in execution: {problem}"
@@ -225,8 +261,11 @@ def _grasp(simulator, source, sequence, scenario, plant, plant_context, scene) -
     if grasp is None:
         return False
     times, knots = grasp
-    source.UpdateTrajectory(sequence.followed_by(np.concatenate([[SETTLE_S], SETTLE_S + times]),
-                                                 np.vstack([sequence.knots[-1], knots])))
+    source.UpdateTrajectory(
+        sequence.followed_by(
+            np.concatenate([[SETTLE_S], SETTLE_S + times]), np.vstack([sequence.knots[-1], knots])
+        )
+    )
     target = object_body(plant, scene.target.name)
     z0 = target.EvalPoseInWorld(plant_context).translation()[2]
     simulator.AdvanceTo(sequence.duration + SETTLE_S + times[-1])

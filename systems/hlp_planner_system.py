@@ -30,8 +30,11 @@ class HlpPlannerSystem(LeafSystem):
         self._config = config or PlannerConfig(mode=self._models.mode)
         self._scene_port = declare_scene_input_port(self)
         self._plan_port = self.DeclareAbstractOutputPort(
-            name="plan", alloc=lambda: AbstractValue.Make(HighLevelPlan("", ())), calc=self._calc_plan,
-            prerequisites_of_calc={self.all_input_ports_ticket()})
+            name="plan",
+            alloc=lambda: AbstractValue.Make(HighLevelPlan("", ())),
+            calc=self._calc_plan,
+            prerequisites_of_calc={self.all_input_ports_ticket()},
+        )
 
     def get_scene_input_port(self):
         return self._scene_port

@@ -45,25 +45,38 @@ class KeypointIk(LeafSystem):
         solver = KeypointSolver(scenario)
         self._solver = solver
         empty_plan = HighLevelPlan(scene=scenario.scene.name, keypoints=(), reason="no plan given")
-        self._plan_port = self.DeclareAbstractInputPort(name="plan", model_value=AbstractValue.Make(empty_plan))
-        self._alternatives_port = self.DeclareAbstractInputPort(name="alternatives", model_value=AbstractValue.Make(()))
+        self._plan_port = self.DeclareAbstractInputPort(
+            name="plan", model_value=AbstractValue.Make(empty_plan)
+        )
+        self._alternatives_port = self.DeclareAbstractInputPort(
+            name="alternatives", model_value=AbstractValue.Make(())
+        )
         self._scratch = self.DeclareCacheEntry(
             description="planning model context",
-            value_producer=ValueProducer(allocate=lambda: AbstractValue.Make(solver.new_context()),
-                                         calc=lambda context, value: None),
+            value_producer=ValueProducer(
+                allocate=lambda: AbstractValue.Make(solver.new_context()), calc=lambda context, value: None
+            ),
             prerequisites_of_calc={self.nothing_ticket()},
         )
         plan_ticket = {self.input_port_ticket(self._plan_port.get_index())}
         self._keyframes_port = self.DeclareAbstractOutputPort(
-            name="keyframes", alloc=lambda: AbstractValue.Make(Keyframes.empty(solver.start)),
-            calc=self._calc_keyframes, prerequisites_of_calc=plan_ticket)
+            name="keyframes",
+            alloc=lambda: AbstractValue.Make(Keyframes.empty(solver.start)),
+            calc=self._calc_keyframes,
+            prerequisites_of_calc=plan_ticket,
+        )
         self._trajectory_port = self.DeclareAbstractOutputPort(
-            name="trajectory", alloc=lambda: AbstractValue.Make(PiecewisePolynomial()),
-            calc=self._calc_trajectory, prerequisites_of_calc=plan_ticket)
+            name="trajectory",
+            alloc=lambda: AbstractValue.Make(PiecewisePolynomial()),
+            calc=self._calc_trajectory,
+            prerequisites_of_calc=plan_ticket,
+        )
         self._alternative_trajectories_port = self.DeclareAbstractOutputPort(
-            name="alternative_trajectories", alloc=lambda: AbstractValue.Make(()),
+            name="alternative_trajectories",
+            alloc=lambda: AbstractValue.Make(()),
             calc=self._calc_alternative_trajectories,
-            prerequisites_of_calc={self.input_port_ticket(self._alternatives_port.get_index())})
+            prerequisites_of_calc={self.input_port_ticket(self._alternatives_port.get_index())},
+        )
 
     @property
     def solver(self) -> KeypointSolver:
@@ -90,12 +103,16 @@ class KeypointIk(LeafSystem):
 
     def _calc_keyframes(self, context: Context, output: AbstractValue) -> None:
         if not self._plan_port.HasValue(context):
-            output.set_value(Keyframes.empty(self._solver.start, "no plan: the plan input port is not connected"))
+            output.set_value(
+                Keyframes.empty(self._solver.start, "no plan: the plan input port is not connected")
+            )
             return
         output.set_value(self._solver.solve(self._plant_context(context), self._plan_port.Eval(context)))
 
     def _calc_trajectory(self, context: Context, output: AbstractValue) -> None:
-        output.set_value(self._solver.trajectory(self._plant_context(context), self._keyframes_port.Eval(context)))
+        output.set_value(
+            self._solver.trajectory(self._plant_context(context), self._keyframes_port.Eval(context))
+        )
 
     def _calc_alternative_trajectories(self, context: Context, output: AbstractValue) -> None:
         plans = self._alternatives_port.Eval(context) if self._alternatives_port.HasValue(context) else ()

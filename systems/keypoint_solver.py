@@ -130,14 +130,14 @@ class KeypointSolver:
                 GeometrySet(plant.GetCollisionGeometriesForBody(body)),
                 GeometrySet(plant.GetCollisionGeometriesForBody(grandparent)),
             )
-        model.scene_graph.collision_filter_manager(model.scene_graph.GetMyMutableContextFromRoot(context)).Apply(
-            declaration)
+        model.scene_graph.collision_filter_manager(
+            model.scene_graph.GetMyMutableContextFromRoot(context)
+        ).Apply(declaration)
         return context
 
     def plant_context(self, context: Context) -> Context:
         """The plant's part of a ``new_context``."""
         return self._plant.GetMyMutableContextFromRoot(context)
-
 
     @property
     def scene(self) -> Scene:
@@ -164,8 +164,11 @@ class KeypointSolver:
                 self._start, f"the plan is for scene {plan.scene!r}, this KeypointIk for {self._scene.name!r}"
             )
         if any(k.action == "move" for k in plan.keypoints) and not plan.details.get(TRANSFERRED):
-            return Keyframes.empty(self._start, "the plan's moves are a person's (the obstacles' centres): put a "
-                                   "RobotPlanTransfer between the planner and KeypointIk")
+            return Keyframes.empty(
+                self._start,
+                "the plan's moves are a person's (the obstacles' centres): put a "
+                "RobotPlanTransfer between the planner and KeypointIk",
+            )
         if not plan.ok:
             return Keyframes.empty(self._start, f"no plan: {plan.reason or 'fewer than two keypoints'}")
         started = time.perf_counter()
@@ -201,7 +204,9 @@ class KeypointSolver:
         shifted[self._index[BASE_JOINTS[1]]] += shift[1]
         return np.clip(shifted, self._lower, self._upper)
 
-    def _continued(self, plant_context: Context, previous: np.ndarray, target: np.ndarray) -> np.ndarray | None:
+    def _continued(
+        self, plant_context: Context, previous: np.ndarray, target: np.ndarray
+    ) -> np.ndarray | None:
         """The posture reached by solving ``CONTINUATION_STEPS - 1`` evenly spaced points of the
         straight tcp line from ``previous`` towards ``target`` (without the clearance constraint),
         each from the last; None if one fails. A far keypoint may need the arm to unfold while the
@@ -221,10 +226,15 @@ class KeypointSolver:
         counts when the constraints check out."""
         result = Solve(program, seed, self._options)
         solution = result.GetSolution(variables)
-        return result, solution, result.is_success() or program.CheckSatisfied(
-            program.GetAllConstraints(), solution, 1e-6)
+        return (
+            result,
+            solution,
+            result.is_success() or program.CheckSatisfied(program.GetAllConstraints(), solution, 1e-6),
+        )
 
-    def _program(self, plant_context: Context, target: np.ndarray, previous: np.ndarray, *, clearance: bool) -> tuple:
+    def _program(
+        self, plant_context: Context, target: np.ndarray, previous: np.ndarray, *, clearance: bool
+    ) -> tuple:
         """The IK program of one keypoint: (program, decision variables)."""
         ik_config = self._config.ik
         tolerance = ik_config.position_tolerance

@@ -64,8 +64,12 @@ class StoResult:
 
     def to_dict(self) -> dict:
         return {
-            "success": self.success, "failure_reason": self.failure_reason, "iterations": self.iterations,
-            "rollouts": self.rollouts, "optimise_s": self.optimise_s, "initial_cost": self.initial_cost,
+            "success": self.success,
+            "failure_reason": self.failure_reason,
+            "iterations": self.iterations,
+            "rollouts": self.rollouts,
+            "optimise_s": self.optimise_s,
+            "initial_cost": self.initial_cost,
             "start": self.start,
             "final_cost": self.outcome.cost if self.outcome is not None else None,
             "cost_terms": dict(self.outcome.terms) if self.outcome is not None else {},
@@ -73,8 +77,9 @@ class StoResult:
         }
 
 
-def sample_base_noise(rng: np.random.Generator, sequence: ControlSequence, noise: BaseNoise,
-                      samples: int) -> np.ndarray:
+def sample_base_noise(
+    rng: np.random.Generator, sequence: ControlSequence, noise: BaseNoise, samples: int
+) -> np.ndarray:
     """(samples, n, 3) Gaussian base velocities (vx, vy, yaw rate) per step of ``sequence``.
 
     All but ``noise.end_fraction`` of each sample's accumulated drift is taken out evenly over the
@@ -96,9 +101,14 @@ def mppi_weights(costs: np.ndarray, temperature: float) -> np.ndarray:
     return weights / np.sum(weights)
 
 
-def optimise(scenario: Scenario, initial: ControlSequence, pool: RolloutPool, *,
-             alternatives: Callable[[], Sequence[ControlSequence]] | None = None,
-             progress: Callable[[int, float], None] | None = None) -> StoResult:
+def optimise(
+    scenario: Scenario,
+    initial: ControlSequence,
+    pool: RolloutPool,
+    *,
+    alternatives: Callable[[], Sequence[ControlSequence]] | None = None,
+    progress: Callable[[int, float], None] | None = None,
+) -> StoResult:
     """Improve ``initial`` on ``scenario``'s scene (see the module's docstring); never raises for a bad scene.
 
     Args:
@@ -111,13 +121,25 @@ def optimise(scenario: Scenario, initial: ControlSequence, pool: RolloutPool, *,
     started = time.perf_counter()
     collisions = pool.world(scenario).start_collisions
     if collisions:
-        return StoResult(initial, None, False, f"the robot starts in collision with {', '.join(collisions)}",
-                         optimise_s=time.perf_counter() - started)
+        return StoResult(
+            initial,
+            None,
+            False,
+            f"the robot starts in collision with {', '.join(collisions)}",
+            optimise_s=time.perf_counter() - started,
+        )
     rng = np.random.default_rng(sto.seed)
     best = initial
     (outcome,) = pool.rollouts(scenario, [best])
-    result = StoResult(best, outcome, outcome.success, outcome.failure_reason, rollouts=1,
-                       costs=[outcome.cost], initial_cost=outcome.cost)
+    result = StoResult(
+        best,
+        outcome,
+        outcome.success,
+        outcome.failure_reason,
+        rollouts=1,
+        costs=[outcome.cost],
+        initial_cost=outcome.cost,
+    )
     if not result.success and alternatives is not None and sto.alternatives > 0:
         others = list(alternatives())[: sto.alternatives]
         if others:

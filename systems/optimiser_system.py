@@ -31,7 +31,9 @@ from hlp_drake.systems.scene_source import declare_scene_input_port, scene_input
 if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
 
-_EMPTY_RESULT = StoResult(ControlSequence(np.array([0.0, 1.0]), np.zeros((2, 11))), None, False, "not optimised")
+_EMPTY_RESULT = StoResult(
+    ControlSequence(np.array([0.0, 1.0]), np.zeros((2, 11))), None, False, "not optimised"
+)
 
 
 class StochasticTrajectoryOptimiser(LeafSystem):
@@ -49,17 +51,29 @@ class StochasticTrajectoryOptimiser(LeafSystem):
         self._pool = pool
         self._scene = declare_scene_input_port(self)
         self._input = self.DeclareAbstractInputPort(
-            name="initial_trajectory", model_value=AbstractValue.Make(PiecewisePolynomial()))
-        self._alternatives = self.DeclareAbstractInputPort(name="alternative_trajectories",
-                                                           model_value=AbstractValue.Make(()))
-        ticket = {self.input_port_ticket(port.get_index()) for port in (self._scene, self._input, self._alternatives)}
+            name="initial_trajectory", model_value=AbstractValue.Make(PiecewisePolynomial())
+        )
+        self._alternatives = self.DeclareAbstractInputPort(
+            name="alternative_trajectories", model_value=AbstractValue.Make(())
+        )
+        ticket = {
+            self.input_port_ticket(port.get_index())
+            for port in (self._scene, self._input, self._alternatives)
+        }
         self._result = self.DeclareAbstractOutputPort(
-            name="result", alloc=lambda: AbstractValue.Make(_EMPTY_RESULT), calc=self._calc_result,
-            prerequisites_of_calc=ticket)
+            name="result",
+            alloc=lambda: AbstractValue.Make(_EMPTY_RESULT),
+            calc=self._calc_result,
+            prerequisites_of_calc=ticket,
+        )
         self._trajectory = self.DeclareAbstractOutputPort(
-            name="trajectory", alloc=lambda: AbstractValue.Make(PiecewisePolynomial()),
-            calc=lambda context, output: output.set_value(self._result.Eval(context).sequence.to_trajectory()),
-            prerequisites_of_calc=ticket)
+            name="trajectory",
+            alloc=lambda: AbstractValue.Make(PiecewisePolynomial()),
+            calc=lambda context, output: output.set_value(
+                self._result.Eval(context).sequence.to_trajectory()
+            ),
+            prerequisites_of_calc=ticket,
+        )
 
     def get_scene_input_port(self):
         return self._scene

@@ -39,8 +39,9 @@ def scenario_models(scenario: Scenario) -> DecisionModels:
     return _models_in(scenario.planner.models) if scenario.planner.models else default_models()
 
 
-def make_planning_diagram(scenario: Scenario, *, pool: RolloutPool | None = None,
-                          models: DecisionModels | None = None) -> Diagram:
+def make_planning_diagram(
+    scenario: Scenario, *, pool: RolloutPool | None = None, models: DecisionModels | None = None
+) -> Diagram:
     """``scene`` input -> planner block -> push transfer -> KeypointIk -> StochasticTrajectoryOptimiser.
 
     The planner block is ``scenario.planner.kind``'s: "hlp" (``HlpPlannerSystem``) or "sto" (the
@@ -78,7 +79,9 @@ def make_planning_diagram(scenario: Scenario, *, pool: RolloutPool | None = None
         optimiser = builder.AddNamedSystem("optimiser", StochasticTrajectoryOptimiser(scenario, pool))
         builder.ConnectToSame(block.get_scene_input_port(), optimiser.get_scene_input_port())
         builder.Connect(ik.get_trajectory_output_port(), optimiser.get_initial_trajectory_input_port())
-        builder.Connect(ik.get_alternative_trajectories_output_port(), optimiser.get_alternatives_input_port())
+        builder.Connect(
+            ik.get_alternative_trajectories_output_port(), optimiser.get_alternatives_input_port()
+        )
         builder.ExportOutput(optimiser.get_trajectory_output_port(), "optimised_trajectory")
         builder.ExportOutput(optimiser.get_result_output_port(), "optimisation")
     diagram = builder.Build()

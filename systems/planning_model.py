@@ -32,7 +32,11 @@ class PlanningModel:
         plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
         self.robot = add_robot(plant)
         self.scene_models: SceneModels = add_scene(
-            plant, scenario.scene, contact=scenario.contact, bodies=scenario.bodies, weld_objects=True,
+            plant,
+            scenario.scene,
+            contact=scenario.contact,
+            bodies=scenario.bodies,
+            weld_objects=True,
             with_objects=with_objects,
         )
         plant.Finalize()

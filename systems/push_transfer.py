@@ -50,8 +50,15 @@ TRANSFERRED = "robot_plan"
 """The key ``robot_plan`` sets in a plan's ``details``: its moves are the robot's pushes (``KeypointIk``
 refuses a person's moves, the obstacles' centres)."""
 
-def _robot_direction(rules: PushRules, space: TaskSpace, scene: Scene, name: str, direction: str,
-                     footprints: Mapping[str, Rect] | None = None) -> str:
+
+def _robot_direction(
+    rules: PushRules,
+    space: TaskSpace,
+    scene: Scene,
+    name: str,
+    direction: str,
+    footprints: Mapping[str, Rect] | None = None,
+) -> str:
     """The robot's push direction for a person's move of obstacle ``name`` towards ``direction``
     (the other objects at ``footprints``, by default where the scene has them)."""
     if direction not in BACKWARD:
@@ -65,7 +72,9 @@ def _robot_direction(rules: PushRules, space: TaskSpace, scene: Scene, name: str
 
     def blocking(side: str) -> float:  # how much of the corridor the obstacle still covers after the push
         unit = _unit(side)
-        travel = push_travel(rules, space, scene, name, unit, _wanted(space, name, side), footprints=footprints)
+        travel = push_travel(
+            rules, space, scene, name, unit, _wanted(space, name, side), footprints=footprints
+        )
         lateral = (corners + travel * unit - start) @ normal
         half = rules.corridor_half_width
         return max(0.0, min(lateral.max(), half) - max(lateral.min(), -half))
@@ -85,8 +94,15 @@ def _wanted(space: TaskSpace, name: str, direction: str) -> float:
     return max(float(np.dot(shift, _unit(direction))), 0.0)
 
 
-def push_travel(rules: PushRules, space: TaskSpace, scene: Scene, name: str, unit: np.ndarray, wanted: float,
-                footprints: Mapping[str, Rect] | None = None) -> float:
+def push_travel(
+    rules: PushRules,
+    space: TaskSpace,
+    scene: Scene,
+    name: str,
+    unit: np.ndarray,
+    wanted: float,
+    footprints: Mapping[str, Rect] | None = None,
+) -> float:
     """How far (<= ``wanted``, in ``rules.travel_step`` steps) obstacle ``name`` can be pushed along
     ``unit`` before its footprint comes within ``rules.edge_margin`` of the table's edge or
     ``rules.object_margin`` of another object, the objects' footprints being ``footprints`` (by default
@@ -100,12 +116,21 @@ def push_travel(rules: PushRules, space: TaskSpace, scene: Scene, name: str, uni
     start = rect_array([rect])[0]
     boxes = np.vstack([start, start + np.outer(steps, [unit[0], unit[1], unit[0], unit[1]])])
     x_min, y_min, x_max, y_max = scene.table.bounds
-    edges = np.column_stack([boxes[:, 0] - x_min, boxes[:, 1] - y_min, x_max - boxes[:, 2], y_max - boxes[:, 3]])
+    edges = np.column_stack(
+        [boxes[:, 0] - x_min, boxes[:, 1] - y_min, x_max - boxes[:, 2], y_max - boxes[:, 3]]
+    )
     blocked = _nearing(edges, rules.edge_margin)
     others = rect_array([r for other, r in footprints.items() if other != name])
     if others.size:  # the gap to each other object along the axis that separates them most
-        gaps = np.max([others[None, :, 0] - boxes[:, None, 2], boxes[:, None, 0] - others[None, :, 2],
-                       others[None, :, 1] - boxes[:, None, 3], boxes[:, None, 1] - others[None, :, 3]], axis=0)
+        gaps = np.max(
+            [
+                others[None, :, 0] - boxes[:, None, 2],
+                boxes[:, None, 0] - others[None, :, 2],
+                others[None, :, 1] - boxes[:, None, 3],
+                boxes[:, None, 1] - others[None, :, 3],
+            ],
+            axis=0,
+        )
         blocked |= _nearing(gaps, rules.object_margin)
     stops = np.flatnonzero(blocked[1:])  # blocked[i + 1]: after steps[i]
     if stops.size == 0:
@@ -130,8 +155,9 @@ class RobotPush:
     footprint: Rect
 
 
-def robot_push(rules: PushRules, space: TaskSpace, scene: Scene, name: str, direction: str,
-               placed: Mapping[str, Rect]) -> RobotPush:
+def robot_push(
+    rules: PushRules, space: TaskSpace, scene: Scene, name: str, direction: str, placed: Mapping[str, Rect]
+) -> RobotPush:
     """The push of obstacle ``name`` towards ``direction``: towards its relocated place, short of
     the edge and the other objects (at ``placed``), from just behind its face opposite the push."""
     rect = space.rects[name]
@@ -142,13 +168,23 @@ def robot_push(rules: PushRules, space: TaskSpace, scene: Scene, name: str, dire
     reach = abs(unit[0]) * rect.depth / 2.0 + abs(unit[1]) * rect.width / 2.0 + clearance
     start = np.array(rect.center) - reach * unit
     dx, dy = travel * unit
-    return RobotPush(direction, travel, (float(start[0]), float(start[1])),
-                     (float(start[0] + dx), float(start[1] + dy)),
-                     Rect(rect.x_min + dx, rect.y_min + dy, rect.x_max + dx, rect.y_max + dy))
+    return RobotPush(
+        direction,
+        travel,
+        (float(start[0]), float(start[1])),
+        (float(start[0] + dx), float(start[1] + dy)),
+        Rect(rect.x_min + dx, rect.y_min + dy, rect.x_max + dx, rect.y_max + dy),
+    )
 
 
-def chosen_push(rules: PushRules, space: TaskSpace, scene: Scene, move: PlanKeypoint, rest: Sequence[PlanKeypoint],
-                placed: Mapping[str, Rect]) -> RobotPush:
+def chosen_push(
+    rules: PushRules,
+    space: TaskSpace,
+    scene: Scene,
+    move: PlanKeypoint,
+    rest: Sequence[PlanKeypoint],
+    placed: Mapping[str, Rect],
+) -> RobotPush:
     """The robot's push for the person's ``move``: towards the person's direction (a backward move
     made sideways), unless that leaves the obstacle within ``rules.way_clearance`` of the way on through
     the gaps to the target (``rest``: the plan's later keypoints); then the push among LL, RR and
@@ -160,11 +196,16 @@ def chosen_push(rules: PushRules, space: TaskSpace, scene: Scene, move: PlanKeyp
     def clear(push: RobotPush) -> bool:
         points = [push.end, *ways]
         return push.travel >= rules.min_push_travel and not any(
-            crosses(rules, a, b, [push.footprint], clearance=rules.way_clearance) for a, b in pairwise(points))
+            crosses(rules, a, b, [push.footprint], clearance=rules.way_clearance) for a, b in pairwise(points)
+        )
 
     if not ways or clear(first):
         return first
-    others = [robot_push(rules, space, scene, move.element, d, placed) for d in ("LL", "RR", "FF") if d != first.direction]
+    others = [
+        robot_push(rules, space, scene, move.element, d, placed)
+        for d in ("LL", "RR", "FF")
+        if d != first.direction
+    ]
     return max((push for push in others if clear(push)), key=lambda push: push.travel, default=first)
 
 
@@ -181,14 +222,16 @@ def robot_plan(plan: HighLevelPlan, scene: Scene, rules: PushRules) -> HighLevel
     for i, k in enumerate(plan.keypoints):
         if k.action not in ("move", "release") or k.element not in space.rects:
             if k.action == "target" and keypoints:
-                for point in approach(rules, keypoints[-1].position, placed[scene.target.name], placed, scene.target.name):
+                for point in approach(
+                    rules, keypoints[-1].position, placed[scene.target.name], placed, scene.target.name
+                ):
                     keypoints += _way_to(rules, keypoints, point, scene, placed)
                     keypoints.append(point)
             keypoints += _way_to(rules, keypoints, k, scene, placed)
             keypoints.append(k)
             continue
         if k.action == "move" or k.element not in pushes:
-            pushes[k.element] = chosen_push(rules, space, scene, k, plan.keypoints[i + 1:], placed)
+            pushes[k.element] = chosen_push(rules, space, scene, k, plan.keypoints[i + 1 :], placed)
         push = pushes[k.element]
         if push.travel < rules.min_push_travel:
             continue
@@ -202,7 +245,9 @@ def robot_plan(plan: HighLevelPlan, scene: Scene, rules: PushRules) -> HighLevel
     return replace(plan, keypoints=tuple(keypoints), details={**plan.details, TRANSFERRED: True})
 
 
-def robot_alternatives(plan: HighLevelPlan, scene: Scene, rules: PushRules, limit: int) -> tuple[HighLevelPlan, ...]:
+def robot_alternatives(
+    plan: HighLevelPlan, scene: Scene, rules: PushRules, limit: int
+) -> tuple[HighLevelPlan, ...]:
     """The robot plans (``robot_plan``) of ``plan``'s alternative candidates, best first: at most
     ``limit``, each different from the chosen plan's and from the earlier ones (two candidates
     can differ only where the transfer makes them the same, e.g. in a push it leaves out)."""
@@ -211,8 +256,16 @@ def robot_alternatives(plan: HighLevelPlan, scene: Scene, rules: PushRules, limi
     seen = {robot_plan(plan, scene, rules).keypoints}
     found: list[HighLevelPlan] = []
     for candidate in plan.alternatives:
-        robot = robot_plan(replace(plan, keypoints=candidate.keypoints,
-                                   expected_collision=candidate.expected_collision, alternatives=()), scene, rules)
+        robot = robot_plan(
+            replace(
+                plan,
+                keypoints=candidate.keypoints,
+                expected_collision=candidate.expected_collision,
+                alternatives=(),
+            ),
+            scene,
+            rules,
+        )
         if robot.ok and robot.keypoints not in seen:
             seen.add(robot.keypoints)
             found.append(robot)
@@ -221,8 +274,9 @@ def robot_alternatives(plan: HighLevelPlan, scene: Scene, rules: PushRules, limi
     return tuple(found)
 
 
-def approach(rules: PushRules, previous: tuple[float, float], target: Rect, placed: Mapping[str, Rect], name: str
-             ) -> list[PlanKeypoint]:
+def approach(
+    rules: PushRules, previous: tuple[float, float], target: Rect, placed: Mapping[str, Rect], name: str
+) -> list[PlanKeypoint]:
     """The waypoint ``approach_gap`` behind the ``target`` footprint from which the gripper slides
     straight onto it, if the way from ``previous`` would come in more than ``rules.approach_angle`` off
     the approach axis and the gripper fits there, clear of the other objects (``placed``, the
@@ -238,8 +292,9 @@ def approach(rules: PushRules, previous: tuple[float, float], target: Rect, plac
     return [PlanKeypoint("approach", (float(x), float(y)), element=name)]
 
 
-def _way_to(rules: PushRules, keypoints: list[PlanKeypoint], k: PlanKeypoint, scene: Scene,
-            placed: Mapping[str, Rect]) -> list[PlanKeypoint]:
+def _way_to(
+    rules: PushRules, keypoints: list[PlanKeypoint], k: PlanKeypoint, scene: Scene, placed: Mapping[str, Rect]
+) -> list[PlanKeypoint]:
     """The transit waypoints on the way from the last of ``keypoints`` to ``k``, a push start or a
     waypoint the hand passes: over the objects to a push start, or where the straight way would
     pass over an object (the target aside), if the arm can come down at ``k`` (the target aside
@@ -254,8 +309,9 @@ def _way_to(rules: PushRules, keypoints: list[PlanKeypoint], k: PlanKeypoint, sc
     return transit(rules, keypoints[-1], k, transit_height(rules, scene), under)
 
 
-def crosses(rules: PushRules, a: tuple[float, float], b: tuple[float, float], rects, *,
-            clearance: float | None = None) -> bool:
+def crosses(
+    rules: PushRules, a: tuple[float, float], b: tuple[float, float], rects, *, clearance: float | None = None
+) -> bool:
     """Whether the straight tcp path from ``a`` to ``b`` passes within ``clearance`` (default
     ``rules.path_clearance``) of any of ``rects`` (sampled every ``rules.travel_step``)."""
     clearance = rules.path_clearance if clearance is None else clearance
@@ -264,8 +320,12 @@ def crosses(rules: PushRules, a: tuple[float, float], b: tuple[float, float], re
         return False
     count = max(int(np.ceil(np.hypot(b[0] - a[0], b[1] - a[1]) / rules.travel_step)), 1) + 1
     points = np.linspace(a, b, count)[:, None, :]
-    inside = ((points[..., 0] > boxes[:, 0] - clearance) & (points[..., 0] < boxes[:, 2] + clearance)
-              & (points[..., 1] > boxes[:, 1] - clearance) & (points[..., 1] < boxes[:, 3] + clearance))
+    inside = (
+        (points[..., 0] > boxes[:, 0] - clearance)
+        & (points[..., 0] < boxes[:, 2] + clearance)
+        & (points[..., 1] > boxes[:, 1] - clearance)
+        & (points[..., 1] < boxes[:, 3] + clearance)
+    )
     return bool(inside.any())
 
 
@@ -280,12 +340,16 @@ def arm_shadow(rules: PushRules, x: float, y: float) -> Rect:
     return Rect(x - rules.arm_shadow_length, y - half, x, y + half)
 
 
-def transit(rules: PushRules, previous: PlanKeypoint, push: PlanKeypoint, height: float, objects) -> list[PlanKeypoint]:
+def transit(
+    rules: PushRules, previous: PlanKeypoint, push: PlanKeypoint, height: float, objects
+) -> list[PlanKeypoint]:
     """The waypoints over the objects from ``previous`` to the push start ``push``: lifted above
     ``previous`` and above the push start, from where the arm comes straight down. None if an
     object lies under the arm at the push start (``arm_shadow``): the push start is then reached
     directly, at push height."""
     if any(arm_shadow(rules, *push.position).overlap(o) > 0.0 for o in objects):
         return []
-    return [PlanKeypoint("transit", point, push.row, push.element, height=height)
-            for point in (previous.position, push.position)]
+    return [
+        PlanKeypoint("transit", point, push.row, push.element, height=height)
+        for point in (previous.position, push.position)
+    ]

@@ -33,18 +33,28 @@ class RobotPlanTransfer(LeafSystem):
         limit = scenario.optimiser.alternatives
         self._rules = rules
         self._scene_port = declare_scene_input_port(self)
-        self._plan_port = self.DeclareAbstractInputPort(name="plan", model_value=AbstractValue.Make(HighLevelPlan("", ())))
+        self._plan_port = self.DeclareAbstractInputPort(
+            name="plan", model_value=AbstractValue.Make(HighLevelPlan("", ()))
+        )
         ticket = {self.all_input_ports_ticket()}
         self._out_port = self.DeclareAbstractOutputPort(
-            name="robot_plan", alloc=lambda: AbstractValue.Make(HighLevelPlan("", ())),
+            name="robot_plan",
+            alloc=lambda: AbstractValue.Make(HighLevelPlan("", ())),
             calc=lambda context, output: output.set_value(
-                robot_plan(self._plan_port.Eval(context), scene_input(self._scene_port, context), rules)),
-            prerequisites_of_calc=ticket)
+                robot_plan(self._plan_port.Eval(context), scene_input(self._scene_port, context), rules)
+            ),
+            prerequisites_of_calc=ticket,
+        )
         self._alternatives_port = self.DeclareAbstractOutputPort(
-            name="robot_alternatives", alloc=lambda: AbstractValue.Make(()),
-            calc=lambda context, output: output.set_value(robot_alternatives(
-                self._plan_port.Eval(context), scene_input(self._scene_port, context), rules, limit)),
-            prerequisites_of_calc=ticket)
+            name="robot_alternatives",
+            alloc=lambda: AbstractValue.Make(()),
+            calc=lambda context, output: output.set_value(
+                robot_alternatives(
+                    self._plan_port.Eval(context), scene_input(self._scene_port, context), rules, limit
+                )
+            ),
+            prerequisites_of_calc=ticket,
+        )
 
     @property
     def rules(self) -> PushRules:

@@ -18,6 +18,7 @@ from hlp_drake.systems.scene_models import off_table_mask
 
 BLOWN_UP_COST = 1.0e9
 
+
 @dataclass(frozen=True)
 class RolloutSamples:
     """A rollout's state read every sample period (T samples, m objects; object 0 is the target).
@@ -78,14 +79,16 @@ def _half_extent(size: tuple[float, float, float]) -> float:
     return 0.5 * max(size[0], size[1])
 
 
-def pregrasp_check(tcp: np.ndarray, target_position: np.ndarray, scene: Scene, *, tcp_height: float,
-                   margin: float) -> tuple[bool, float]:
+def pregrasp_check(
+    tcp: np.ndarray, target_position: np.ndarray, scene: Scene, *, tcp_height: float, margin: float
+) -> tuple[bool, float]:
     """Whether the target (centre at ``target_position``) is inside the gripper's pre-grasp region at
     tcp position ``tcp``: horizontally within the target's radius + ``margin``, and the tcp within
     ``margin`` of the grasp height. Also returns the horizontal distance."""
     distance = float(np.hypot(*(np.asarray(tcp)[:2] - np.asarray(target_position)[:2])))
     inside = distance <= _half_extent(scene.target.size) + margin and abs(tcp[2] - tcp_height) <= margin
     return inside, distance
+
 
 def reach_problem(fallen, inside: bool, distance: float) -> str | None:
     """Why a reach failed the success test (None if it passed)."""
@@ -96,25 +99,40 @@ def reach_problem(fallen, inside: bool, distance: float) -> str | None:
     return None
 
 
-def rollout_cost(samples: RolloutSamples, scene: Scene, sto: StoConfig, *, tcp_height: float,
-                 effort: float, step_duration: float) -> RolloutOutcome:
+def rollout_cost(
+    samples: RolloutSamples,
+    scene: Scene,
+    sto: StoConfig,
+    *,
+    tcp_height: float,
+    effort: float,
+    step_duration: float,
+) -> RolloutOutcome:
     """The cost of a rollout from its samples (see ``StoCost`` for the terms)."""
     weights = sto.cost
     names = [obj.name for obj in scene.objects]
     simulated = float(samples.times[-1]) if len(samples.times) else 0.0
     if samples.blew_up is not None:
-        return RolloutOutcome(BLOWN_UP_COST, {"blew_up": BLOWN_UP_COST}, False,
-                              f"the simulation blew up: {samples.blew_up}", math.inf, simulated_s=simulated)
+        return RolloutOutcome(
+            BLOWN_UP_COST,
+            {"blew_up": BLOWN_UP_COST},
+            False,
+            f"the simulation blew up: {samples.blew_up}",
+            math.inf,
+            simulated_s=simulated,
+        )
     positions, tcp = samples.positions, samples.tcp
     per_step = (samples.times[1] - samples.times[0]) / step_duration if len(samples.times) > 1 else 1.0
     off = np.array([off_table_mask(p, scene.table) for p in positions])  # (T, m)
     final = positions[-1]
     start = positions[0]
-    inside, distance = pregrasp_check(tcp[-1], final[0], scene, tcp_height=tcp_height,
-                                      margin=weights.pregrasp_margin)
+    inside, distance = pregrasp_check(
+        tcp[-1], final[0], scene, tcp_height=tcp_height, margin=weights.pregrasp_margin
+    )
     moved = np.sum((final[:, :2] - start[:, :2]) ** 2, axis=1)
     near = [
-        name for name, obj, p, gone in zip(names[1:], scene.obstacles, final[1:], off[-1, 1:])
+        name
+        for name, obj, p, gone in zip(names[1:], scene.obstacles, final[1:], off[-1, 1:])
         if not gone and np.hypot(*(tcp[-1, :2] - p[:2])) <= _half_extent(obj.size) + weights.near_distance
     ]
     excess = np.clip(samples.max_force - weights.force_limit, 0.0, None)
@@ -130,6 +148,6 @@ def rollout_cost(samples: RolloutSamples, scene: Scene, sto: StoConfig, *, tcp_h
     }
     fallen = tuple(name for name, f in zip(names, off[-1]) if f)
     reason = reach_problem(fallen, inside, distance)
-    return RolloutOutcome(float(sum(terms.values())), terms, reason is None, reason, distance, fallen, simulated)
-
-
+    return RolloutOutcome(
+        float(sum(terms.values())), terms, reason is None, reason, distance, fallen, simulated
+    )

@@ -77,7 +77,9 @@ class RolloutPool:
         startup_s: how long starting the worker processes took, s.
     """
 
-    def __init__(self, workers: int = 1, *, on_rollout: Callable[[RolloutOutcome], None] | None = None) -> None:
+    def __init__(
+        self, workers: int = 1, *, on_rollout: Callable[[RolloutOutcome], None] | None = None
+    ) -> None:
         if workers < 1:
             raise ValueError(f"workers must be >= 1, got {workers}")
         self.workers = int(workers)
@@ -87,7 +89,9 @@ class RolloutPool:
         self._executor: ProcessPoolExecutor | None = None
         if self.workers > 1:
             started = time.perf_counter()
-            self._executor = ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("spawn"))
+            self._executor = ProcessPoolExecutor(
+                self.workers, mp_context=multiprocessing.get_context("spawn")
+            )
             # Start every worker (and import Drake there) now, not inside the first optimisation.
             list(self._executor.map(_warm_up, [0.2] * self.workers))
             self.startup_s = time.perf_counter() - started

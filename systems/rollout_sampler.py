@@ -33,7 +33,9 @@ class Schedule(Protocol):
     def welded_at(self, t: float) -> frozenset[str]: ...
 
 
-def sample_rollout(sequence: ControlSequence, sto: StoConfig, worlds: WorldSet, schedule: Schedule) -> RolloutSamples:
+def sample_rollout(
+    sequence: ControlSequence, sto: StoConfig, worlds: WorldSet, schedule: Schedule
+) -> RolloutSamples:
     """Roll ``sequence`` out and read the state every ``sto.sample_period``, on worlds of one scene
     with fewer and fewer objects welded.
 
@@ -90,6 +92,14 @@ def sample_rollout(sequence: ControlSequence, sto: StoConfig, worlds: WorldSet, 
             else:
                 world.begin(sequence, time=at[0], states=at[1])
     positions, tcps, forces, contacts, _ = zip(*readings) if readings else ([], [], [], [], [])
-    return RolloutSamples(times[: len(readings)], np.array(positions), np.array(tcps), np.array(forces),
-                          np.array(contacts, dtype=bool), problem, touched, welded=tuple(sorted(welded)),
-                          switches=switches)
+    return RolloutSamples(
+        times[: len(readings)],
+        np.array(positions),
+        np.array(tcps),
+        np.array(forces),
+        np.array(contacts, dtype=bool),
+        problem,
+        touched,
+        welded=tuple(sorted(welded)),
+        switches=switches,
+    )

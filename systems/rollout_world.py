@@ -36,6 +36,7 @@ if TYPE_CHECKING:
 MOVED = 1.0e-3
 """A free object whose geometry has moved more than this from its start (m) is watched near welded ones."""
 
+
 def simulation_failure(error: BaseException) -> str:
     """The first line of a Drake simulation failure: a ``RuntimeError``, or one of Drake's internal
     checks failing (pydrake raises those as ``SystemExit("Failure at ...")``, e.g. non-finite
@@ -99,7 +100,9 @@ class RolloutWorld:
         self.scenario = scenario
         self.welded_objects = frozenset(welded_objects)
         builder = DiagramBuilder()
-        world = builder.AddSystem(make_world_diagram(rollout_scenario(scenario), welded_objects=self.welded_objects))
+        world = builder.AddSystem(
+            make_world_diagram(rollout_scenario(scenario), welded_objects=self.welded_objects)
+        )
         plant, robot = world_plant(world)
         start = plant.GetPositions(plant.CreateDefaultContext(), robot)
         hold = ControlSequence(np.array([0.0, 1.0]), np.vstack([start, start])).to_trajectory()
@@ -125,8 +128,12 @@ class RolloutWorld:
             g: int(plant.GetBodyFromFrameId(inspector.GetFrameId(g)).index())
             for g in inspector.GetAllGeometryIds(Role.kProximity)
         }
-        self._welded_bodies = {int(b.index()): b.name() for b in self.objects if b.name() in self.welded_objects}
-        self._moving = [robot] + [b.model_instance() for b in self.objects if b.name() not in self.welded_objects]
+        self._welded_bodies = {
+            int(b.index()): b.name() for b in self.objects if b.name() in self.welded_objects
+        }
+        self._moving = [robot] + [
+            b.model_instance() for b in self.objects if b.name() not in self.welded_objects
+        ]
         robot_bodies = [plant.get_body(i) for i in plant.GetBodyIndices(robot)]
         self._num_robot_watched = len(robot_bodies)
         self._watched = robot_bodies + self.objects
@@ -154,8 +161,9 @@ class RolloutWorld:
                 hits.add((b if a_robot else a).name())
         return tuple(sorted(hits))
 
-    def begin(self, sequence: ControlSequence, *, time: float = 0.0,
-              states: dict[str, np.ndarray] | None = None) -> None:
+    def begin(
+        self, sequence: ControlSequence, *, time: float = 0.0, states: dict[str, np.ndarray] | None = None
+    ) -> None:
         """Load ``sequence`` and reset to the initial state, or to time ``time`` with the given model
         instances' states (``states()`` of another world of this scene; the rest start at rest)."""
         self._source.UpdateTrajectory(sequence.to_trajectory())
@@ -170,8 +178,10 @@ class RolloutWorld:
     def states(self) -> dict[str, np.ndarray]:
         """Positions and velocities of the robot and of every free object, by model instance name."""
         plant = self.plant
-        return {plant.GetModelInstanceName(i): plant.GetPositionsAndVelocities(self._plant_context, i)
-                for i in self._moving}
+        return {
+            plant.GetModelInstanceName(i): plant.GetPositionsAndVelocities(self._plant_context, i)
+            for i in self._moving
+        }
 
     def advance_to(self, t: float) -> str | None:
         """Simulate up to time ``t``; why the solver failed (None if it did not)."""
@@ -212,7 +222,9 @@ class RolloutWorld:
         """The rollout's state now."""
         plant, context = self.plant, self._plant_context
         positions = np.array([body.EvalPoseInWorld(context).translation() for body in self.objects])
-        speeds = [np.linalg.norm(body.EvalSpatialVelocityInWorld(context).translational()) for body in self.objects]
+        speeds = [
+            np.linalg.norm(body.EvalSpatialVelocityInWorld(context).translational()) for body in self.objects
+        ]
         tcp = self._tcp.CalcPoseInWorld(context).translation()
         results = plant.get_contact_results_output_port().Eval(context)
         max_force, table_contact = 0.0, False
@@ -221,7 +233,9 @@ class RolloutWorld:
             a, b = int(info.bodyA_index()), int(info.bodyB_index())
             if a in self.object_bodies or b in self.object_bodies:
                 max_force = max(max_force, float(np.linalg.norm(info.contact_force())))
-            if (a in self.robot_bodies and b in self._table_bodies) or (b in self.robot_bodies and a in self._table_bodies):
+            if (a in self.robot_bodies and b in self._table_bodies) or (
+                b in self.robot_bodies and a in self._table_bodies
+            ):
                 table_contact = True
         problem = None
         sto = self.scenario.optimiser
@@ -235,7 +249,9 @@ class RolloutWorld:
         sunk = over & (positions[:, 2] < table.height - sto.max_sink)  # a centre inside the table top
         if np.max(speeds) > sto.max_object_speed:
             name = self.scene.objects[int(np.argmax(speeds))].name
-            problem = f"{name} moves at {np.max(speeds):.1f} m/s over the table (limit {sto.max_object_speed} m/s)"
+            problem = (
+                f"{name} moves at {np.max(speeds):.1f} m/s over the table (limit {sto.max_object_speed} m/s)"
+            )
         elif np.any(sunk):
             problem = f"{self.scene.objects[int(np.argmax(sunk))].name} sank into the table"
         return Reading(positions, tcp, max_force, table_contact, problem)
@@ -257,8 +273,14 @@ class RolloutWorld:
         """
         if samples.touched:
             raise ValueError(f"the rollout came near the welded {', '.join(samples.touched)}")
-        return rollout_cost(samples, self.scene, self.scenario.optimiser, tcp_height=self._tcp_height,
-                            effort=sequence.effort(), step_duration=float(np.mean(sequence.steps)))
+        return rollout_cost(
+            samples,
+            self.scene,
+            self.scenario.optimiser,
+            tcp_height=self._tcp_height,
+            effort=sequence.effort(),
+            step_duration=float(np.mean(sequence.steps)),
+        )
 
     def rollout(self, sequence: ControlSequence) -> RolloutOutcome:
         """Simulate ``sequence`` and cost it (see ``cost``)."""

@@ -114,8 +114,13 @@ class Scenario:
         return load_scenario(data=data, defaults=self, where=where)
 
 
-def load_scenario(filename: str | Path | None = None, *, data: str | None = None, defaults: Scenario | None = None,
-                  where: str | None = None) -> Scenario:
+def load_scenario(
+    filename: str | Path | None = None,
+    *,
+    data: str | None = None,
+    defaults: Scenario | None = None,
+    where: str | None = None,
+) -> Scenario:
     """``defaults`` (``Scenario()``), updated by the file ``filename`` and then by the YAML text ``data``.
 
     Args:

@@ -84,8 +84,15 @@ def scenario_problems(scenario: Scenario) -> list[str]:
             problems.append(f"optimiser.{name} must be >= 1, got {getattr(sto, name)}")
     if int(sto.alternatives) < 0:
         problems.append(f"optimiser.alternatives must be >= 0, got {sto.alternatives}")
-    for name in ("time_budget_s", "step_duration", "mppi_temperature", "rollout_time_step",
-                 "sample_period", "max_object_speed", "max_sink"):
+    for name in (
+        "time_budget_s",
+        "step_duration",
+        "mppi_temperature",
+        "rollout_time_step",
+        "sample_period",
+        "max_object_speed",
+        "max_sink",
+    ):
         positive(f"optimiser.{name}", getattr(sto, name))
     positive("optimiser.settle_s", sto.settle_s, zero_ok=True)
     positive("optimiser.weld_clearance", sto.weld_clearance)

@@ -64,10 +64,15 @@ class SceneFromPlant(LeafSystem):
         super().__init__()
         self._template = template
         self._bodies = {o.name: int(plant.GetBodyByName(o.name).index()) for o in template.objects}
-        self._poses = self.DeclareAbstractInputPort(name="body_poses", model_value=AbstractValue.Make([RigidTransform()]))
+        self._poses = self.DeclareAbstractInputPort(
+            name="body_poses", model_value=AbstractValue.Make([RigidTransform()])
+        )
         self._scene = self.DeclareAbstractOutputPort(
-            name=SCENE_PORT, alloc=lambda: AbstractValue.Make(template), calc=self._calc_scene,
-            prerequisites_of_calc={self.input_port_ticket(self._poses.get_index())})
+            name=SCENE_PORT,
+            alloc=lambda: AbstractValue.Make(template),
+            calc=self._calc_scene,
+            prerequisites_of_calc={self.input_port_ticket(self._poses.get_index())},
+        )
 
     def get_body_poses_input_port(self) -> InputPort:
         return self._poses

@@ -12,10 +12,13 @@ from hlp_drake.systems.scene_source import declare_scene_input_port, scene_input
 
 def straight_line_plan(scene: Scene) -> HighLevelPlan:
     """The baseline's initial plan: from the start straight to the target."""
-    return HighLevelPlan(scene.name, (
-        PlanKeypoint("start", (float(scene.start[0]), float(scene.start[1]))),
-        PlanKeypoint("target", (float(scene.target.x), float(scene.target.y)), None, scene.target.name),
-    ))
+    return HighLevelPlan(
+        scene.name,
+        (
+            PlanKeypoint("start", (float(scene.start[0]), float(scene.start[1]))),
+            PlanKeypoint("target", (float(scene.target.x), float(scene.target.y)), None, scene.target.name),
+        ),
+    )
 
 
 class StraightLinePlanSystem(LeafSystem):
@@ -26,10 +29,13 @@ class StraightLinePlanSystem(LeafSystem):
         super().__init__()
         self._scene_port = declare_scene_input_port(self)
         self._plan_port = self.DeclareAbstractOutputPort(
-            name="plan", alloc=lambda: AbstractValue.Make(HighLevelPlan("", ())),
+            name="plan",
+            alloc=lambda: AbstractValue.Make(HighLevelPlan("", ())),
             calc=lambda context, output: output.set_value(
-                straight_line_plan(scene_input(self._scene_port, context))),
-            prerequisites_of_calc={self.all_input_ports_ticket()})
+                straight_line_plan(scene_input(self._scene_port, context))
+            ),
+            prerequisites_of_calc={self.all_input_ports_ticket()},
+        )
 
     def get_scene_input_port(self):
         return self._scene_port

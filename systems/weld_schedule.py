@@ -52,12 +52,22 @@ class Sweep:
         scene_graph = world.world.GetSubsystemByName("scene_graph")
         geometries = {"robot": [], "objects": [], "table": []}
         for g, body in world.geometry_body.items():
-            kind = "robot" if body in world.robot_bodies else "objects" if body in world.object_bodies else "table"
+            kind = (
+                "robot"
+                if body in world.robot_bodies
+                else "objects"
+                if body in world.object_bodies
+                else "table"
+            )
             geometries[kind].append(g)
         robot, objects, table = (GeometrySet(geometries[k]) for k in ("robot", "objects", "table"))
         scene_graph.collision_filter_manager(scene_graph.GetMyMutableContextFromRoot(context)).Apply(
-            CollisionFilterDeclaration().ExcludeWithin(robot).ExcludeWithin(objects)
-            .ExcludeBetween(robot, table).ExcludeBetween(objects, table))
+            CollisionFilterDeclaration()
+            .ExcludeWithin(robot)
+            .ExcludeWithin(objects)
+            .ExcludeBetween(robot, table)
+            .ExcludeBetween(objects, table)
+        )
         self._context = context
 
     def approach_times(self, sequence: ControlSequence, clearance: float) -> dict[str, float]:

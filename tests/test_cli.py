@@ -28,8 +28,16 @@ def test_help_is_plain_text_and_every_command_has_a_version(module, capsys):
     assert __version__ in capsys.readouterr().out
 
 
-@pytest.mark.parametrize("module", ["hlp_drake.run_scene", "hlp_drake.experiments.cli", "hlp_drake.train",
-                                    "hlp_drake.evaluate", "hlp_drake.segment"])
+@pytest.mark.parametrize(
+    "module",
+    [
+        "hlp_drake.run_scene",
+        "hlp_drake.experiments.cli",
+        "hlp_drake.train",
+        "hlp_drake.evaluate",
+        "hlp_drake.segment",
+    ],
+)
 def test_long_commands_take_quiet(module, capsys):
     with pytest.raises(SystemExit):
         importlib.import_module(module).main(["--help"])
@@ -51,5 +59,7 @@ def test_the_console_script_is_installed():
     script = Path(sys.executable).with_name("hlp-drake")
     if not script.exists():
         pytest.skip(f"{script} is not installed (pip install -e . installs it)")
-    result = subprocess.run([str(script), "--version"], capture_output=True, text=True, timeout=60, check=False)
+    result = subprocess.run(
+        [str(script), "--version"], capture_output=True, text=True, timeout=60, check=False
+    )
     assert result.returncode == 0 and result.stdout.strip() == f"hlp-drake {__version__}"

@@ -66,5 +66,7 @@ def test_plans_from_the_plants_body_poses_in_a_diagram_and_again_when_an_object_
     assert now.obstacles[0].yaw == pytest.approx(moved.yaw + 0.3) and now.obstacles[1:] == scene.obstacles[1:]
     again = diagram.GetOutputPort("plan").Eval(context)
     assert again is not seen
-    assert again.to_dict()["keypoints"] == plan(replace(scene, obstacles=now.obstacles), default_models()).to_dict()[
-        "keypoints"]
+    assert (
+        again.to_dict()["keypoints"]
+        == plan(replace(scene, obstacles=now.obstacles), default_models()).to_dict()["keypoints"]
+    )

@@ -109,7 +109,9 @@ def test_keyframes_respect_joint_limits_and_keep_the_gripper_open(system, solved
     plant = system.solver.planning_model.plant
     lower, upper = plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits()
     assert np.all(keyframes.positions >= lower - 1e-6) and np.all(keyframes.positions <= upper + 1e-6)
-    np.testing.assert_allclose(keyframes.positions[:, 9:], np.tile(system.solver.start[9:], (3, 1)), atol=1e-9)
+    np.testing.assert_allclose(
+        keyframes.positions[:, 9:], np.tile(system.solver.start[9:], (3, 1)), atol=1e-9
+    )
     assert np.all(keyframes.positions[:, 0] < 0.0)  # the arm's mount stays in front of the table
 
 
@@ -135,7 +137,8 @@ def test_trajectory_starts_at_the_start_and_passes_through_the_keyframes(system,
     middle = 0.5 * (breaks[0] + breaks[1])
     np.testing.assert_allclose(
         trajectory.value(middle).ravel(),
-        0.5 * (trajectory.value(breaks[0]) + trajectory.value(breaks[1])).ravel(), atol=1e-9,
+        0.5 * (trajectory.value(breaks[0]) + trajectory.value(breaks[1])).ravel(),
+        atol=1e-9,
     )
 
 
@@ -222,17 +225,23 @@ def test_alternative_trajectories_are_solved_only_when_asked_for_and_like_the_pl
     main, other = through_gaps(scene, to_target=True), through_gaps(scene, to_target=False)
     system.GetInputPort("plan").FixValue(context, main)
     system.GetInputPort("alternatives").FixValue(
-        context, (other, HighLevelPlan(scene=scene.name, keypoints=(), reason="no plan"), main))
+        context, (other, HighLevelPlan(scene=scene.name, keypoints=(), reason="no plan"), main)
+    )
     trajectory = system.GetOutputPort("trajectory").Eval(context)
-    assert port.cache_entry().is_out_of_date(context)  # the alternatives are not solved for the plan's trajectory
+    assert port.cache_entry().is_out_of_date(
+        context
+    )  # the alternatives are not solved for the plan's trajectory
     alternatives = port.Eval(context)
     assert len(alternatives) == 2  # the plan-less one has no trajectory
     assert not port.cache_entry().is_out_of_date(context) and port.Eval(context) is alternatives  # cached
     _, expected = evaluate(system, other)
     for got, want in ((alternatives[0], expected), (alternatives[1], trajectory)):
         np.testing.assert_allclose(got.get_segment_times(), want.get_segment_times())
-        np.testing.assert_allclose(got.vector_values(got.get_segment_times()),
-                                   want.vector_values(want.get_segment_times()), atol=1e-9)
+        np.testing.assert_allclose(
+            got.vector_values(got.get_segment_times()),
+            want.vector_values(want.get_segment_times()),
+            atol=1e-9,
+        )
 
 
 def test_no_plan_and_wrong_scene_are_problems_not_successes(system, scene):
@@ -319,12 +328,15 @@ def test_tcp_reaches_0_95_m_past_the_front_edge_and_the_edge_itself(height):
 def test_transit_keypoints_are_reached_at_their_height_and_timed_at_the_transit_speed(system, scene):
     gap = gap_centres(scene)[0]
     height = 0.25
-    plan = HighLevelPlan(scene=scene.name, keypoints=(
-        PlanKeypoint("start", scene.start),
-        PlanKeypoint("transit", scene.start, height=height),
-        PlanKeypoint("transit", gap, height=height),
-        PlanKeypoint("gap", gap, row=0, element="0"),
-    ))
+    plan = HighLevelPlan(
+        scene=scene.name,
+        keypoints=(
+            PlanKeypoint("start", scene.start),
+            PlanKeypoint("transit", scene.start, height=height),
+            PlanKeypoint("transit", gap, height=height),
+            PlanKeypoint("gap", gap, row=0, element="0"),
+        ),
+    )
     keyframes, trajectory = evaluate(system, plan)
     assert keyframes.ok, keyframes.failures
     z = keyframes.tcp_positions[:, 2] - scene.table.height
@@ -347,8 +359,14 @@ def test_keyframes_keep_the_robot_clear_of_itself(system, scene, solved):
     context = system.solver.new_context()
     for q in keyframes.positions:
         model.plant.SetPositions(system.solver.plant_context(context), model.robot, q)
-        query = model.scene_graph.get_query_output_port().Eval(model.scene_graph.GetMyContextFromRoot(context))
-        pairs = [p for p in query.ComputeSignedDistancePairwiseClosestPoints(0.05) if p.id_A in robot and p.id_B in robot]
+        query = model.scene_graph.get_query_output_port().Eval(
+            model.scene_graph.GetMyContextFromRoot(context)
+        )
+        pairs = [
+            p
+            for p in query.ComputeSignedDistancePairwiseClosestPoints(0.05)
+            if p.id_A in robot and p.id_B in robot
+        ]
         assert pairs, "the robot's self pairs should be checked"
         assert min(p.distance for p in pairs) >= CONFIG.ik.table_clearance - 1e-4
 

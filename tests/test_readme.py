@@ -72,8 +72,9 @@ def test_every_bash_block_runs(tmp_path):
 def test_the_python_block_is_the_example_file_and_runs(tmp_path):
     (code,) = blocks("python")
     assert code == (REPO / "examples" / "compose_diagram.py").read_text()
-    result = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True,
-                            timeout=600, check=False)
+    result = subprocess.run(
+        [sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=600, check=False
+    )
     assert result.returncode == 0, result.stderr
     lines = result.stdout.splitlines()
     assert lines[0].startswith("robot plan: start -> ") and lines[0].endswith(" -> target")
@@ -95,6 +96,8 @@ def test_the_yaml_blocks_load_as_a_scenario_and_a_scene(tmp_path):
     assert scene.name == "example" and [o.name for o in scene.obstacles] == ["box1"]
 
 
-@pytest.mark.parametrize("link", sorted(set(re.findall(r"\]\(((?:docs|examples)/[^)#]+)", (REPO / "README.md").read_text()))))
+@pytest.mark.parametrize(
+    "link", sorted(set(re.findall(r"\]\(((?:docs|examples)/[^)#]+)", (REPO / "README.md").read_text())))
+)
 def test_the_readmes_links_into_the_repository_exist(link):
     assert (REPO / link).exists(), link

@@ -27,11 +27,23 @@ RULES = push_rules(TransferConfig(), gripper_geometry())
 
 def test_the_transfers_clearances_are_the_robot_models_sizes_plus_the_margins():
     geometry = gripper_geometry()  # the tcp 14 cm ahead of the flange, the fingertips 2 cm ahead of it
-    assert (geometry.tcp_offset, geometry.fingertip_reach, geometry.finger_half_width, geometry.wrist_radius) == (
-        0.14, 0.02, 0.055, 0.045)
-    assert (RULES.forward_clearance, RULES.sideways_clearance, RULES.corridor_half_width, RULES.way_clearance) == (
-        0.05, 0.075, 0.08, 0.055)
-    assert (RULES.transit_clearance, RULES.arm_shadow_length, RULES.arm_shadow_half_width) == (0.07, 0.35, 0.06)
+    assert (
+        geometry.tcp_offset,
+        geometry.fingertip_reach,
+        geometry.finger_half_width,
+        geometry.wrist_radius,
+    ) == (0.14, 0.02, 0.055, 0.045)
+    assert (
+        RULES.forward_clearance,
+        RULES.sideways_clearance,
+        RULES.corridor_half_width,
+        RULES.way_clearance,
+    ) == (0.05, 0.075, 0.08, 0.055)
+    assert (RULES.transit_clearance, RULES.arm_shadow_length, RULES.arm_shadow_half_width) == (
+        0.07,
+        0.35,
+        0.06,
+    )
     wider = push_rules(TransferConfig(sideways_margin=0.03), geometry)
     assert wider.sideways_clearance == 0.085 and wider.forward_clearance == RULES.forward_clearance
 
@@ -46,7 +58,7 @@ def test_push_transfer_puts_the_tcp_behind_the_obstacle():
     lifted = max(o.size[2] for o in scene.objects) + 0.07
     transits = [i for i, k in enumerate(robot.keypoints) if k.action == "transit"]
     for i in transits[1::2]:  # lifted above the previous waypoint, then above the next one
-        before, up, over, after = robot.keypoints[i - 2:i + 2]
+        before, up, over, after = robot.keypoints[i - 2 : i + 2]
         assert (up.position, over.position) == (before.position, after.position)
         assert up.height == over.height == pytest.approx(lifted)
     for k in robot.keypoints:
@@ -64,15 +76,16 @@ def test_robot_alternatives_are_the_next_distinct_candidates_in_rank_order():
     scene = generate_scene("gen2", 39, 9)
     human = plan(scene, default_models())
     chosen = robot_plan(human, scene, RULES)
-    candidates = [robot_plan(replace(human, keypoints=c.keypoints), scene, RULES).keypoints
-                  for c in human.alternatives]
+    candidates = [
+        robot_plan(replace(human, keypoints=c.keypoints), scene, RULES).keypoints for c in human.alternatives
+    ]
     alternatives = robot_alternatives(human, scene, RULES, 3)
     assert len(alternatives) == 3 and all(a.ok for a in alternatives)
     found = [a.keypoints for a in alternatives]
     assert len({chosen.keypoints, *found}) == 4  # distinct from the chosen plan and from each other
     ranks = [candidates.index(k) for k in found]
     assert ranks == sorted(ranks)  # best first, the first of equal robot plans
-    assert all(k in (chosen.keypoints, *found) for k in candidates[:ranks[-1]])  # none skipped
+    assert all(k in (chosen.keypoints, *found) for k in candidates[: ranks[-1]])  # none skipped
     assert robot_alternatives(human, scene, RULES, 1) == alternatives[:1]
     assert robot_alternatives(human, scene, RULES, 0) == ()
     assert robot_alternatives(replace(human, keypoints=(), reason="no plan"), scene, RULES, 3) == ()
@@ -94,13 +107,17 @@ def test_planning_diagram_swaps_the_planner_block():
 
 def test_run_scene_end_to_end_json(tmp_path):
     out = tmp_path / "run.json"
-    result = run_module("hlp_drake.run_scene", "--kind", "vr", "--seed", "1", "--workers", "1", "--json", str(out))
+    result = run_module(
+        "hlp_drake.run_scene", "--kind", "vr", "--seed", "1", "--workers", "1", "--json", str(out)
+    )
     assert result.returncode in (0, 1), result.stderr
     report = json.loads(out.read_text())
     assert report["planner"] == "hlp" and report["robot_actuated_dofs"] == 10
     assert set(report["timings"]) >= {"plan_s", "ik_s", "optimise_s", "total_s"}
-    assert [k["action"] for k in report["plan"]["keypoints"]][::len(report["plan"]["keypoints"]) - 1] == [
-        "start", "target"]
+    assert [k["action"] for k in report["plan"]["keypoints"]][:: len(report["plan"]["keypoints"]) - 1] == [
+        "start",
+        "target",
+    ]
     assert isinstance(report["objects_moved"], list) and isinstance(report["objects_dropped"], list)
     assert report["success"] == (result.returncode == 0) == (report["failure_reason"] is None)
     assert ("success" if report["success"] else "failure:") in result.stdout
@@ -117,7 +134,11 @@ def test_run_scene_bad_scene_file_is_one_line(tmp_path):
     result = run_module("hlp_drake.run_scene", "--scene", str(bad), "--json", str(out))
     assert result.returncode == 2
     lines = result.stderr.strip().splitlines()
-    assert len(lines) >= 1 and all(line.startswith("error: ") for line in lines) and "Traceback" not in result.stderr
+    assert (
+        len(lines) >= 1
+        and all(line.startswith("error: ") for line in lines)
+        and "Traceback" not in result.stderr
+    )
     assert not out.exists()
     scene = generate_scene("vr", 1)
     overlapping = tmp_path / "overlap.yaml"
@@ -155,13 +176,19 @@ def test_pushes_stop_short_of_the_table_edge_and_the_other_objects():
             assert y_min + EDGE_MARGIN <= rect.y_min + dy and rect.y_max + dy <= y_max - EDGE_MARGIN
             for other, r in space.rects.items():
                 if other != name:
-                    apart = (rect.x_min + dx >= r.x_max + OBJECT_MARGIN or r.x_min >= rect.x_max + dx + OBJECT_MARGIN
-                             or rect.y_min + dy >= r.y_max + OBJECT_MARGIN or r.y_min >= rect.y_max + dy + OBJECT_MARGIN)
+                    apart = (
+                        rect.x_min + dx >= r.x_max + OBJECT_MARGIN
+                        or r.x_min >= rect.x_max + dx + OBJECT_MARGIN
+                        or rect.y_min + dy >= r.y_max + OBJECT_MARGIN
+                        or r.y_min >= rect.y_max + dy + OBJECT_MARGIN
+                    )
                     assert apart or travel == 0.0, (name, other, travel)
     # Unobstructed, the push goes as far as wanted.
     lone = scene_with_one_obstacle(scene)
     lone_space = TaskSpace(lone)
-    assert push_travel(RULES, lone_space, lone, lone.obstacles[0].name, np.array([0.0, 1.0]), 0.02) == pytest.approx(0.02)
+    assert push_travel(
+        RULES, lone_space, lone, lone.obstacles[0].name, np.array([0.0, 1.0]), 0.02
+    ) == pytest.approx(0.02)
 
 
 def test_pushes_stop_short_of_where_earlier_pushes_left_the_other_objects():
@@ -179,10 +206,15 @@ def test_pushes_stop_short_of_where_earlier_pushes_left_the_other_objects():
     moved = dict(space.rects)
     moved[other] = Rect(rect.x_min, rect.y_max + 0.05, rect.x_max, rect.y_max + 0.10)
     travel = push_travel(RULES, space, scene, name, unit, 0.2, footprints=moved)
-    assert travel == pytest.approx(0.05 - OBJECT_MARGIN, abs=0.005 + 1e-9) and travel < 0.05 - OBJECT_MARGIN + 1e-9
+    assert (
+        travel == pytest.approx(0.05 - OBJECT_MARGIN, abs=0.005 + 1e-9)
+        and travel < 0.05 - OBJECT_MARGIN + 1e-9
+    )
     # With every other object pushed far away, nothing but the table's edge limits it.
     cleared = {n: (r if n == name else Rect(-10.0, -10.0, -9.9, -9.9)) for n, r in space.rects.items()}
-    assert push_travel(RULES, space, scene, name, unit, 0.2, footprints=cleared) >= push_travel(RULES, space, scene, name, unit, 0.2)
+    assert push_travel(RULES, space, scene, name, unit, 0.2, footprints=cleared) >= push_travel(
+        RULES, space, scene, name, unit, 0.2
+    )
 
 
 def scene_obstacle_names(scene):
@@ -230,7 +262,9 @@ def test_an_obstacle_already_near_an_edge_can_be_pushed_along_it_but_not_towards
     obstacle = lone.obstacles[0]
     half = TaskSpace(lone).rects[obstacle.name].width / 2
     y_max = lone.table.bounds[3]
-    near = replace(lone, obstacles=(replace(obstacle, y=y_max - half - EDGE_MARGIN / 2),))  # 1.5 cm from the edge
+    near = replace(
+        lone, obstacles=(replace(obstacle, y=y_max - half - EDGE_MARGIN / 2),)
+    )  # 1.5 cm from the edge
     space = TaskSpace(near)
     assert push_travel(RULES, space, near, obstacle.name, np.array([1.0, 0.0]), 0.05) == pytest.approx(0.05)
     assert push_travel(RULES, space, near, obstacle.name, np.array([0.0, 1.0]), 0.05) == 0.0
@@ -250,7 +284,9 @@ def test_a_backward_move_becomes_the_sideways_push_that_clears_the_corridor():
     for direction in ("BL", "BR", "BB"):
         assert _robot_direction(RULES, space, scene, "FailOnTouchObstacleLong", direction) == "RR"
     # On the left of the line, with room on both sides, it goes left whatever the person's side.
-    assert {_robot_direction(RULES, space, scene, "FailOnTouchObstacleMed", d) for d in ("BL", "BR", "BB")} == {"LL"}
+    assert {
+        _robot_direction(RULES, space, scene, "FailOnTouchObstacleMed", d) for d in ("BL", "BR", "BB")
+    } == {"LL"}
     # Forward and sideways moves are kept.
     assert _robot_direction(RULES, space, scene, "FailOnTouchObstacleLong", "LL") == "LL"
     assert _robot_direction(RULES, space, scene, "FailOnTouchObstacleLong", "FR") == "FR"
@@ -267,8 +303,12 @@ def _websocket_frames(url: str, *, seconds: float) -> bytes:
     host, port = url.removeprefix("ws://").split(":")
     with socket.create_connection((host, int(port)), timeout=seconds) as sock:
         key = base64.b64encode(os.urandom(16)).decode()
-        sock.sendall((f"GET / HTTP/1.1\r\nHost: {host}:{port}\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
-                      f"Sec-WebSocket-Key: {key}\r\nSec-WebSocket-Version: 13\r\n\r\n").encode())
+        sock.sendall(
+            (
+                f"GET / HTTP/1.1\r\nHost: {host}:{port}\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                f"Sec-WebSocket-Key: {key}\r\nSec-WebSocket-Version: 13\r\n\r\n"
+            ).encode()
+        )
         data, deadline = b"", time.monotonic() + seconds
         while time.monotonic() < deadline:
             sock.settimeout(max(deadline - time.monotonic(), 0.01))
@@ -285,10 +325,10 @@ def _websocket_frames(url: str, *, seconds: float) -> bytes:
     while i + 2 <= len(frames):
         length, i = frames[i + 1] & 0x7F, i + 2
         if length == 126:
-            length, i = int.from_bytes(frames[i:i + 2], "big"), i + 2
+            length, i = int.from_bytes(frames[i : i + 2], "big"), i + 2
         elif length == 127:
-            length, i = int.from_bytes(frames[i:i + 8], "big"), i + 8
-        payloads += frames[i:i + length]
+            length, i = int.from_bytes(frames[i : i + 8], "big"), i + 8
+        payloads += frames[i : i + length]
         i += length
     return payloads
 
@@ -305,22 +345,35 @@ def test_run_scene_meshcat_serves_the_run_live(tmp_path):
     out = tmp_path / "run.json"
     process = subprocess.Popen(
         [sys.executable, "-m", "hlp_drake.run_scene", "--meshcat", "--workers", "1", "--json", str(out)],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-        env={**os.environ, "DRAKE_ALLOW_NETWORK": "meshcat"})
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "DRAKE_ALLOW_NETWORK": "meshcat"},
+    )
     try:
         lines = []
         for line in process.stdout:
             lines.append(line)
             if "keeps serving" in line:
                 break
-        url = next((line.split("MeshCat: ")[1].strip() for line in lines if line.startswith("MeshCat: ")), None)
+        url = next(
+            (line.split("MeshCat: ")[1].strip() for line in lines if line.startswith("MeshCat: ")), None
+        )
         if url is None:
-            pytest.skip(f"MeshCat did not start here: {process.stderr.read() if process.poll() is not None else lines}")
+            pytest.skip(
+                f"MeshCat did not start here: {process.stderr.read() if process.poll() is not None else lines}"
+            )
         page = urllib.request.urlopen(url, timeout=10).read()
         assert b"<title>Drake MeshCat</title>" in page
         scene_tree = _websocket_frames(url.replace("http://", "ws://"), seconds=3.0)
-        for path in (b"/drake/robot_plan/00_start", b"/drake/robot_plan/path", b"/drake/plan/path", b"mobile_ur5",
-                     b"Target", b"table"):
+        for path in (
+            b"/drake/robot_plan/00_start",
+            b"/drake/robot_plan/path",
+            b"/drake/plan/path",
+            b"mobile_ur5",
+            b"Target",
+            b"table",
+        ):
             assert path in scene_tree, path
         process.send_signal(signal.SIGINT)
         assert process.wait(timeout=30) == 0
@@ -347,8 +400,28 @@ def test_transit_goes_over_the_objects_where_the_arm_can_come_down():
     assert (over.row, over.element) == (push.row, push.element)
     # An object under the wrist there: no transit, the push start is reached at push height.
     assert transit(RULES, previous, push, 0.25, [*beside, Rect(0.40, 0.25, 0.45, 0.30)]) == []
-    assert transit(RULES, previous, push, 0.25, [Rect(0.60 - ARM_SHADOW_LENGTH - 0.05, 0.1, 0.60 - ARM_SHADOW_LENGTH + 0.01, 0.3)]) == []
-    assert len(transit(RULES, previous, push, 0.25, [Rect(0.60 - ARM_SHADOW_LENGTH - 0.05, 0.1, 0.60 - ARM_SHADOW_LENGTH - 0.01, 0.3)])) == 2
+    assert (
+        transit(
+            RULES,
+            previous,
+            push,
+            0.25,
+            [Rect(0.60 - ARM_SHADOW_LENGTH - 0.05, 0.1, 0.60 - ARM_SHADOW_LENGTH + 0.01, 0.3)],
+        )
+        == []
+    )
+    assert (
+        len(
+            transit(
+                RULES,
+                previous,
+                push,
+                0.25,
+                [Rect(0.60 - ARM_SHADOW_LENGTH - 0.05, 0.1, 0.60 - ARM_SHADOW_LENGTH - 0.01, 0.3)],
+            )
+        )
+        == 2
+    )
 
 
 def test_a_way_that_would_pass_over_an_object_goes_over_it():
@@ -360,7 +433,9 @@ def test_a_way_that_would_pass_over_an_object_goes_over_it():
     box = Rect(0.40, 0.00, 0.50, 0.10)
     assert crosses(RULES, (0.30, 0.05), (0.60, 0.05), [box])  # straight through
     assert crosses(RULES, (0.30, 0.10 + PATH_CLEARANCE - 0.005), (0.60, 0.10 + PATH_CLEARANCE - 0.005), [box])
-    assert not crosses(RULES, (0.30, 0.10 + PATH_CLEARANCE + 0.005), (0.60, 0.10 + PATH_CLEARANCE + 0.005), [box])
+    assert not crosses(
+        RULES, (0.30, 0.10 + PATH_CLEARANCE + 0.005), (0.60, 0.10 + PATH_CLEARANCE + 0.005), [box]
+    )
     assert not crosses(RULES, (0.30, 0.05), (0.60, 0.05), [])
     # gen2 seed 12, 9 obstacles: from where obstacle_4's push ends, the way to the next gap would
     # sweep the gripper through obstacle_5 at push height; the robot plan goes over it instead.
@@ -368,7 +443,7 @@ def test_a_way_that_would_pass_over_an_object_goes_over_it():
     space = TaskSpace(scene)
     keypoints = robot_plan(plan(scene, default_models()), scene, RULES).keypoints
     i = next(i for i, k in enumerate(keypoints) if k.action == "release" and k.element == "obstacle_4")
-    release, up, over, gap = keypoints[i:i + 4]
+    release, up, over, gap = keypoints[i : i + 4]
     assert crosses(RULES, release.position, gap.position, [space.rects["obstacle_5"]])
     assert (up.action, over.action, gap.action) == ("transit", "transit", "gap")
     assert (up.position, over.position) == (release.position, gap.position)
@@ -386,13 +461,15 @@ def test_a_push_that_would_leave_the_obstacle_in_the_way_goes_another_way():
     space = TaskSpace(scene)
     human = plan(scene, default_models())
     i = next(i for i, k in enumerate(human.keypoints) if k.action == "move")
-    move, rest = human.keypoints[i], human.keypoints[i + 1:]
+    move, rest = human.keypoints[i], human.keypoints[i + 1 :]
     assert (move.element, move.direction) == ("FailOnTouchObstacleLong-1", "FF")
     ways = [k.position for k in rest if k.action in ("gap", "target")]
 
     def in_the_way(push):
         points = [push.end, *ways]
-        return any(crosses(RULES, a, b, [push.footprint], clearance=WAY_CLEARANCE) for a, b in pairwise(points))
+        return any(
+            crosses(RULES, a, b, [push.footprint], clearance=WAY_CLEARANCE) for a, b in pairwise(points)
+        )
 
     forwards = robot_push(RULES, space, scene, move.element, "FF", space.rects)
     assert forwards.travel > 0.0 and in_the_way(forwards)
@@ -403,13 +480,18 @@ def test_a_push_that_would_leave_the_obstacle_in_the_way_goes_another_way():
     assert push.travel == max(p.travel for p in sideways if not in_the_way(p) and p.travel >= 0.01)
     robot = robot_plan(human, scene, RULES)
     assert [(k.action, k.direction) for k in robot.keypoints if k.action in ("move", "release")] == [
-        ("move", push.direction), ("release", push.direction)]
+        ("move", push.direction),
+        ("release", push.direction),
+    ]
     # Pushes already clear of the way keep the person's direction (gen1 seed 3: right, then left).
     scene = generate_scene("gen1", 3)
     human = plan(scene, default_models())
     robot = robot_plan(human, scene, RULES)
-    assert [k.direction for k in robot.keypoints if k.action == "move"] == [
-        k.direction for k in human.keypoints if k.action == "move"] == ["RR", "LL"]
+    assert (
+        [k.direction for k in robot.keypoints if k.action == "move"]
+        == [k.direction for k in human.keypoints if k.action == "move"]
+        == ["RR", "LL"]
+    )
 
 
 def test_the_gripper_slides_onto_the_target_along_its_approach_axis():
@@ -434,4 +516,6 @@ def test_the_gripper_slides_onto_the_target_along_its_approach_axis():
     before, last = keypoints[-2:]
     space = TaskSpace(scene)
     assert (before.action, last.action) == ("approach", "target")
-    assert before.position == pytest.approx((space.rects[scene.target.name].x_min - APPROACH_GAP, scene.target.y))
+    assert before.position == pytest.approx(
+        (space.rects[scene.target.name].x_min - APPROACH_GAP, scene.target.y)
+    )

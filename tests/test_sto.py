@@ -107,7 +107,11 @@ def test_noise_is_seeded_and_keeps_only_part_of_its_drift():
     a = sample_base_noise(np.random.default_rng(3), sequence, config.noise, 6)
     b = sample_base_noise(np.random.default_rng(3), sequence, config.noise, 6)
     np.testing.assert_array_equal(a, b)
-    raw = np.random.default_rng(3).normal(size=(6, 8, 3)) * [config.noise.vx, config.noise.vy, config.noise.yaw_rate]
+    raw = np.random.default_rng(3).normal(size=(6, 8, 3)) * [
+        config.noise.vx,
+        config.noise.vy,
+        config.noise.yaw_rate,
+    ]
     end = np.einsum("knj,n->kj", a, sequence.steps)
     np.testing.assert_allclose(end, config.noise.end_fraction * np.einsum("knj,n->kj", raw, sequence.steps))
 
@@ -129,9 +133,14 @@ def synthetic_samples(scene, *, tcp_end, moved=None, force=0.0, blew_up=None):
     if moved is not None:
         end[moved[0]] += moved[1]
     height = tcp_keypoint_height(scene, Scenario().ik)
-    return RolloutSamples(np.array([0.0, 0.5]), np.stack([positions, end]),
-                          np.array([[0.0, 0.0, height], [*tcp_end, height]]), np.array([0.0, force]),
-                          np.array([False, False]), blew_up)
+    return RolloutSamples(
+        np.array([0.0, 0.5]),
+        np.stack([positions, end]),
+        np.array([[0.0, 0.0, height], [*tcp_end, height]]),
+        np.array([0.0, force]),
+        np.array([False, False]),
+        blew_up,
+    )
 
 
 def test_cost_rewards_reaching_and_charges_falls_forces_and_blow_ups(scene):
@@ -142,10 +151,14 @@ def test_cost_rewards_reaching_and_charges_falls_forces_and_blow_ups(scene):
     sto = config.optimiser
     reached = rollout_cost(synthetic_samples(scene, tcp_end=target), scene, sto, **kwargs)
     assert reached.success and reached.failure_reason is None and reached.cost < 1.0
-    short_of = rollout_cost(synthetic_samples(scene, tcp_end=(target[0] - 0.2, target[1])), scene, sto, **kwargs)
+    short_of = rollout_cost(
+        synthetic_samples(scene, tcp_end=(target[0] - 0.2, target[1])), scene, sto, **kwargs
+    )
     assert not short_of.success and "pre-grasp" in short_of.failure_reason
     assert short_of.terms["goal"] == pytest.approx(sto.cost.goal_weight * 0.2)
-    fell = rollout_cost(synthetic_samples(scene, tcp_end=target, moved=(1, [0.0, 5.0, -1.0])), scene, sto, **kwargs)
+    fell = rollout_cost(
+        synthetic_samples(scene, tcp_end=target, moved=(1, [0.0, 5.0, -1.0])), scene, sto, **kwargs
+    )
     assert not fell.success and scene.obstacles[0].name in fell.failure_reason
     assert fell.terms["off_table"] > 0 and fell.terms["disturbance"] > 0
     pushed = rollout_cost(synthetic_samples(scene, tcp_end=target, force=100.0), scene, sto, **kwargs)
@@ -190,7 +203,8 @@ def test_where_the_hlps_plan_fails_at_its_first_rollout_its_next_candidates_are_
             diagram.GetInputPort("scene").FixValue(context, scene)
             transfer = diagram.GetSubsystemByName("robot_plan_transfer")
             alternatives = transfer.GetOutputPort("robot_alternatives").Eval(
-                transfer.GetMyContextFromRoot(context))
+                transfer.GetMyContextFromRoot(context)
+            )
             results[planner] = (len(alternatives), diagram.GetOutputPort("optimisation").Eval(context))
     count, hlp = results["hlp"]
     assert count == 3
@@ -209,7 +223,9 @@ def test_holding_still_fails_with_the_goal_cost(world, scene):
 def test_impossible_object_speed_counts_as_a_blow_up(scene, trajectories):
     config = on(scene, "optimiser: {max_object_speed: 1.0e-4}")  # any push now exceeds it
     outcome = RolloutWorld(config).rollout(ControlSequence.from_trajectory(trajectories["sto"], 0.5))
-    assert not outcome.success and outcome.cost == BLOWN_UP_COST and "over the table" in outcome.failure_reason
+    assert (
+        not outcome.success and outcome.cost == BLOWN_UP_COST and "over the table" in outcome.failure_reason
+    )
 
 
 def test_a_drake_internal_check_failing_mid_rollout_is_a_failure_and_the_world_goes_on(scene, trajectories):
@@ -233,7 +249,9 @@ def test_only_drake_failures_count_as_simulation_failures():
     from hlp_drake.systems.rollout_world import simulation_failure
 
     assert simulation_failure(RuntimeError("SAP failed\nmore")) == "SAP failed"
-    assert simulation_failure(SystemExit("Failure at x.h:1 in f(): condition 'c' failed.")).startswith("Failure at")
+    assert simulation_failure(SystemExit("Failure at x.h:1 in f(): condition 'c' failed.")).startswith(
+        "Failure at"
+    )
     with pytest.raises(SystemExit):
         simulation_failure(SystemExit(2))
 
@@ -263,7 +281,9 @@ def test_the_reduced_model_welds_only_objects_nothing_comes_near(scene, trajecto
     sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), PUSHING_HORIZON)
     full, samples = world.simulate(sequence), reduced.simulate(sequence)
     names = [obj.name for obj in scene.objects]
-    pushed = {n for n, d in zip(names, np.linalg.norm(full.positions[-1] - full.positions[0], axis=1)) if d > 0.01}
+    pushed = {
+        n for n, d in zip(names, np.linalg.norm(full.positions[-1] - full.positions[0], axis=1)) if d > 0.01
+    }
     assert len(pushed) == 2 and samples.welded and samples.switches > 0
     assert not pushed & set(samples.welded)  # a pushed object is never welded
     approach = Sweep(world).approach_times(sequence, config.optimiser.weld_clearance)
@@ -284,7 +304,10 @@ def test_an_object_pushed_towards_a_welded_one_frees_it_from_the_sample_before(s
     alone = RolloutWorld(on(scene), welded_objects=[chained]).simulate(sequence)
     assert alone.touched == (chained,) and alone.times[-1] < 2.5  # no world to go on with: it stops there
     config = on(scene, "optimiser: {weld_clearance: 0.01, weld_lookahead: 0.0}")  # the schedule frees late...
-    assert Sweep(world).approach_times(sequence, config.optimiser.weld_clearance)[chained] > alone.times[-1] + 0.1
+    assert (
+        Sweep(world).approach_times(sequence, config.optimiser.weld_clearance)[chained]
+        > alone.times[-1] + 0.1
+    )
     samples = SceneRollouts(config).simulate(sequence)  # ...so the check during the rollout must
     assert chained not in samples.welded and samples.switches >= 2 and samples.touched == ()
     np.testing.assert_allclose(samples.positions, world.simulate(sequence).positions, atol=1e-3)
@@ -350,7 +373,9 @@ def test_a_failed_initial_rollout_goes_on_from_the_planners_first_passing_altern
         assert result.success and result.iterations == 0 and result.start == 2  # the first that passes
         assert result.rollouts == 1 + 3 and result.sequence is not stuck
         assert result.to_dict()["start"] == 2 and result.costs[-1] < result.costs[0]
-        one = config.updated("optimiser: {alternatives: 1}")  # only the first: it fails too, and costs no less
+        one = config.updated(
+            "optimiser: {alternatives: 1}"
+        )  # only the first: it fails too, and costs no less
         capped = optimise(one, stuck, pool, alternatives=alternatives)
         assert not capped.success and capped.start == 0 and capped.rollouts == 1 + 1 + 1
         none = config.updated("optimiser: {alternatives: 0}")
@@ -359,8 +384,13 @@ def test_a_failed_initial_rollout_goes_on_from_the_planners_first_passing_altern
 
 
 def test_a_start_in_collision_fails_without_rollouts(scene, trajectories):
-    blocker = SceneObject(name="Blocker", shape="box", x=float(scene.start[0]) + 0.03, y=float(scene.start[1]),
-                          size=(0.04, 0.16, 0.12))  # wider than the open fingers
+    blocker = SceneObject(
+        name="Blocker",
+        shape="box",
+        x=float(scene.start[0]) + 0.03,
+        y=float(scene.start[1]),
+        size=(0.04, 0.16, 0.12),
+    )  # wider than the open fingers
     blocked = dataclasses.replace(scene, obstacles=(*scene.obstacles, blocker))
     initial = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)
     with RolloutPool(1) as pool:
@@ -373,7 +403,10 @@ def test_optimiser_block_ports_and_cache(scene, trajectories):
     with RolloutPool(1) as pool:
         block = StochasticTrajectoryOptimiser(on(scene, "optimiser: {max_iterations: 1}"), pool)
         assert [block.get_input_port(i).get_name() for i in range(block.num_input_ports())] == [
-            "scene", "initial_trajectory", "alternative_trajectories"]
+            "scene",
+            "initial_trajectory",
+            "alternative_trajectories",
+        ]
         context = block.CreateDefaultContext()
         empty = block.get_result_output_port().Eval(context)
         assert not empty.success and empty.failure_reason == "no initial trajectory"
@@ -398,9 +431,15 @@ def test_an_unreachable_target_fails_with_a_reason_and_no_rollouts(scene):
     far = dataclasses.replace(scene.target, x=scene.table.length + 1.5)
     with RolloutPool(1) as pool:
         unreachable = on(dataclasses.replace(scene, target=far))  # (an invalid scene: built, not loaded)
-        straight = dataclasses.replace(unreachable, planner=dataclasses.replace(unreachable.planner, kind="sto"))
+        straight = dataclasses.replace(
+            unreachable, planner=dataclasses.replace(unreachable.planner, kind="sto")
+        )
         result = plan_and_execute(straight, pool=pool)
-    assert not result.success and result.failure_reason.startswith("IK failed") and "Target" in result.failure_reason
+    assert (
+        not result.success
+        and result.failure_reason.startswith("IK failed")
+        and "Target" in result.failure_reason
+    )
     assert result.rollouts == 0 and result.grasp_held is None
 
 

@@ -103,7 +103,10 @@ def test_a_scenarios_scene_is_read_whole_in_the_scene_file_format(tmp_path):
     assert scenario.scene == scene and scenario.optimiser.samples == 3
     with pytest.raises(HlpError) as info:  # a scene is whole: no field of the default scene is kept
         load_scenario(data="scene: {name: partial, start: [0.1, 0.0]}\n")
-    assert info.value.problems == ("overrides: scene: missing field 'table'", "overrides: scene: missing field 'target'")
+    assert info.value.problems == (
+        "overrides: scene: missing field 'table'",
+        "overrides: scene: missing field 'target'",
+    )
 
 
 @pytest.mark.parametrize(
@@ -116,7 +119,10 @@ def test_a_scenarios_scene_is_read_whole_in_the_scene_file_format(tmp_path):
         ("plant: {discrete_contact_approximation: tamsi}\n", "SAP"),
         ("plant: {time_step: 0.0}\n", "plant.time_step must be > 0"),
         ("bodies: {object_min_mass: 1.0, object_max_mass: 0.5}\n", "object_max_mass"),
-        ("optimiser: {update: annealing}\n", "optimiser.update: expected one of greedy, mppi, got 'annealing'"),
+        (
+            "optimiser: {update: annealing}\n",
+            "optimiser.update: expected one of greedy, mppi, got 'annealing'",
+        ),
         ("optimiser: {samples: 0}\n", "optimiser.samples"),
         ("optimiser: {noise: {end_fraction: 1.5}}\n", "optimiser.noise.end_fraction"),
         ("optimiser: {weld_clearance: 0.0}\n", "optimiser.weld_clearance"),
@@ -249,7 +255,9 @@ def test_world_diagram_builds_with_named_ports(worlds, scenes, kind):
     context = world.CreateDefaultContext()
     plant_context = plant.GetMyContextFromRoot(context)
     np.testing.assert_allclose(
-        plant.GetPositions(plant_context, robot), start_configuration(scene, Scenario().ik, plant, robot), atol=1e-12
+        plant.GetPositions(plant_context, robot),
+        start_configuration(scene, Scenario().ik, plant, robot),
+        atol=1e-12,
     )
     poses = object_planar_poses(plant, plant_context, scene)
     for obj in scene.objects:
@@ -357,7 +365,9 @@ def test_world_with_a_yaml_config_and_without_gravity_compensation(tmp_path):
     assert plant.time_step() == 0.005
     names = {system.get_name() for system in world.GetSystems()}
     assert "gravity_compensation" not in names
-    assert "gravity_compensation" in {s.get_name() for s in make_world_diagram(Scenario(scene=scene)).GetSystems()}
+    assert "gravity_compensation" in {
+        s.get_name() for s in make_world_diagram(Scenario(scene=scene)).GetSystems()
+    }
 
 
 def test_meshcat_visualisation_is_optional(monkeypatch):

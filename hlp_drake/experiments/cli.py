@@ -33,20 +33,40 @@ PROG = "python -m hlp_drake.experiments"
 def _parser() -> argparse.ArgumentParser:
     parser = make_parser(PROG, __doc__)
     parser.add_argument("kind", choices=KINDS, help="gen1: Table II; gen2: Table III")
-    parser.add_argument("--scenes", type=int, default=100, metavar="N", help="scenes per condition (default 100)")
-    parser.add_argument("--objects", type=int, nargs="+", default=[5, 7, 9], metavar="K",
-                        help="gen2's object counts, one condition each (default 5 7 9; gen1 ignores it: 6)")
+    parser.add_argument(
+        "--scenes", type=int, default=100, metavar="N", help="scenes per condition (default 100)"
+    )
+    parser.add_argument(
+        "--objects",
+        type=int,
+        nargs="+",
+        default=[5, 7, 9],
+        metavar="K",
+        help="gen2's object counts, one condition each (default 5 7 9; gen1 ignores it: 6)",
+    )
     parser.add_argument("--seed", type=int, default=0, metavar="S", help="scene i has seed S + i (default 0)")
     parser.add_argument("--workers", type=int, metavar="N", help="jobs at a time (default: one per core)")
-    parser.add_argument("--executor", choices=EXECUTORS, default="local",
-                        help="local (default): this process or a process pool; dask: a dask cluster")
-    parser.add_argument("--scheduler", metavar="ADDRESS",
-                        help="dask scheduler address (default: a LocalCluster of --workers processes)")
-    parser.add_argument("--config", metavar="SCENARIO.yaml",
-                        help="scenario settings (see hlp_drake.systems.Scenario); each job has its own scene")
+    parser.add_argument(
+        "--executor",
+        choices=EXECUTORS,
+        default="local",
+        help="local (default): this process or a process pool; dask: a dask cluster",
+    )
+    parser.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="dask scheduler address (default: a LocalCluster of --workers processes)",
+    )
+    parser.add_argument(
+        "--config",
+        metavar="SCENARIO.yaml",
+        help="scenario settings (see hlp_drake.systems.Scenario); each job has its own scene",
+    )
     parser.add_argument("--fresh", action="store_true", help="discard DIR's earlier results and start over")
     add_quiet(parser)
-    parser.add_argument("--out", required=True, metavar="DIR", help="output directory (resumes the run there)")
+    parser.add_argument(
+        "--out", required=True, metavar="DIR", help="output directory (resumes the run there)"
+    )
     return parser
 
 
@@ -62,8 +82,15 @@ def main(argv: Sequence[str] | None = None, *, job: JobFunction = run_job) -> in
         except (OSError, UnicodeDecodeError) as error:
             raise HlpError(f"{args.config}: cannot read the scenario: {error}") from None
     settings = ExperimentSettings(
-        kind=args.kind, scenes=args.scenes, objects=tuple(args.objects), seed=args.seed, workers=args.workers,
-        executor=args.executor, scheduler=args.scheduler, config_yaml=config_yaml, fresh=args.fresh,
+        kind=args.kind,
+        scenes=args.scenes,
+        objects=tuple(args.objects),
+        seed=args.seed,
+        workers=args.workers,
+        executor=args.executor,
+        scheduler=args.scheduler,
+        config_yaml=config_yaml,
+        fresh=args.fresh,
         progress=not args.quiet,
     )
     command = f"{PROG} {shlex.join(sys.argv[1:] if argv is None else argv)}"

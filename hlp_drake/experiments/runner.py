@@ -31,7 +31,9 @@ class Job:
     objects: int  # the scene's number of obstacles
     scene: str  # the scene's name, e.g. "gen1-3" or "gen2-7-12"
     planner: str
-    config_yaml: str  # the scenario as YAML text (``Scenario.yaml``; its scene is replaced), not a Drake object
+    config_yaml: (
+        str  # the scenario as YAML text (``Scenario.yaml``; its scene is replaced), not a Drake object
+    )
 
     @property
     def key(self) -> tuple[str, str]:
@@ -62,23 +64,46 @@ def make_jobs(kind: str, seeds: Iterable[int], objects: Iterable[int], config_ya
                 scene = generate_scene(kind, seed, count)
             except SceneError as error:
                 objects_note = "" if count is None else f" with {count} objects"
-                raise SceneError(f"cannot generate the {kind} scene of seed {seed}{objects_note}: {error}") \
-                    from None
-            jobs += [Job(kind, seed, len(scene.obstacles), scene.name, planner, config_yaml)
-                     for planner in PLANNERS]
+                raise SceneError(
+                    f"cannot generate the {kind} scene of seed {seed}{objects_note}: {error}"
+                ) from None
+            jobs += [
+                Job(kind, seed, len(scene.obstacles), scene.name, planner, config_yaml)
+                for planner in PLANNERS
+            ]
     return jobs
 
 
-def make_row(job: Job, *, success: bool, failure_reason: str | None, plan_s: float, ik_s: float,
-             optimise_s: float, execute_s: float, rollouts: int, iterations: int, objects_moved: int,
-             objects_dropped: int) -> Row:
+def make_row(
+    job: Job,
+    *,
+    success: bool,
+    failure_reason: str | None,
+    plan_s: float,
+    ik_s: float,
+    optimise_s: float,
+    execute_s: float,
+    rollouts: int,
+    iterations: int,
+    objects_moved: int,
+    objects_dropped: int,
+) -> Row:
     """The row of ``job``'s outcome: init = plan + IK, total = init + optimise (execution excluded)."""
     init_s = plan_s + ik_s
     return {
-        "scene": job.scene, "objects": job.objects, "planner": job.planner, "success": bool(success),
-        "failure_reason": failure_reason, "init_s": init_s, "optimise_s": optimise_s,
-        "total_s": init_s + optimise_s, "rollouts": int(rollouts), "objects_moved": int(objects_moved),
-        "objects_dropped": int(objects_dropped), "seed": job.seed, "iterations": int(iterations),
+        "scene": job.scene,
+        "objects": job.objects,
+        "planner": job.planner,
+        "success": bool(success),
+        "failure_reason": failure_reason,
+        "init_s": init_s,
+        "optimise_s": optimise_s,
+        "total_s": init_s + optimise_s,
+        "rollouts": int(rollouts),
+        "objects_moved": int(objects_moved),
+        "objects_dropped": int(objects_dropped),
+        "seed": job.seed,
+        "iterations": int(iterations),
         "execute_s": execute_s,
     }
 
@@ -101,7 +126,9 @@ def run_job(job: Job) -> Row:
 
     settings = load_scenario(data=job.config_yaml, where="the job's scenario")
     try:
-        scenario = replace(settings, scene=job.make_scene(), planner=replace(settings.planner, kind=job.planner))
+        scenario = replace(
+            settings, scene=job.make_scene(), planner=replace(settings.planner, kind=job.planner)
+        )
         with RolloutPool(scenario.optimiser.workers) as pool:
             result = plan_and_execute(scenario, pool=pool, models=default_models())
     except (Exception, SystemExit) as error:  # noqa: BLE001 - a crash is this planner's failure here
@@ -109,12 +136,30 @@ def run_job(job: Job) -> Row:
             simulation_failure(error)  # raises it again unless it is Drake's
         reason = " ".join(f"crashed: {type(error).__name__}: {error}".split())[:300]
         nan = float("nan")
-        return make_row(job, success=False, failure_reason=reason, plan_s=nan, ik_s=nan, optimise_s=nan,
-                        execute_s=nan, rollouts=0, iterations=0, objects_moved=0, objects_dropped=0)
+        return make_row(
+            job,
+            success=False,
+            failure_reason=reason,
+            plan_s=nan,
+            ik_s=nan,
+            optimise_s=nan,
+            execute_s=nan,
+            rollouts=0,
+            iterations=0,
+            objects_moved=0,
+            objects_dropped=0,
+        )
     t = result.timings
     return make_row(
-        job, success=result.success, failure_reason=result.failure_reason, plan_s=t["plan_s"], ik_s=t["ik_s"],
-        optimise_s=t.get("optimise_s", 0.0), execute_s=t.get("execute_s", 0.0), rollouts=result.rollouts,
-        iterations=result.iterations, objects_moved=len(result.objects_moved),
+        job,
+        success=result.success,
+        failure_reason=result.failure_reason,
+        plan_s=t["plan_s"],
+        ik_s=t["ik_s"],
+        optimise_s=t.get("optimise_s", 0.0),
+        execute_s=t.get("execute_s", 0.0),
+        rollouts=result.rollouts,
+        iterations=result.iterations,
+        objects_moved=len(result.objects_moved),
         objects_dropped=len(result.objects_dropped),
     )

@@ -1,8 +1,8 @@
 """Make, draw and check scene files: python -m hlp_drake.scene {generate,show,validate}.
 
-    python -m hlp_drake.scene generate --kind vr|gen1|gen2|unstructured --seed N [--objects K] --out FILE
-    python -m hlp_drake.scene show FILE --png OUT.png [--plan]
-    python -m hlp_drake.scene validate FILE
+python -m hlp_drake.scene generate --kind vr|gen1|gen2|unstructured --seed N [--objects K] --out FILE
+python -m hlp_drake.scene show FILE --png OUT.png [--plan]
+python -m hlp_drake.scene validate FILE
 """
 
 from __future__ import annotations
@@ -27,8 +27,11 @@ def _parser():
     show = commands.add_parser("show", help="draw a scene file top-down")
     show.add_argument("file")
     show.add_argument("--png", required=True, help="output PNG")
-    show.add_argument("--plan", action="store_true",
-                      help="draw the human-like plan (bundled models) and the pushing robot's plan over it")
+    show.add_argument(
+        "--plan",
+        action="store_true",
+        help="draw the human-like plan (bundled models) and the pushing robot's plan over it",
+    )
     validate = commands.add_parser("validate", help="check a scene file")
     validate.add_argument("file")
     return parser
@@ -65,7 +68,10 @@ def _plans(scene) -> dict:
     from hlp_drake.systems.transfer_geometry import gripper_geometry, push_rules
 
     human = plan(scene, default_models())
-    return {"human plan": human, "robot plan": robot_plan(human, scene, push_rules(Scenario().transfer, gripper_geometry()))}
+    return {
+        "human plan": human,
+        "robot plan": robot_plan(human, scene, push_rules(Scenario().transfer, gripper_geometry())),
+    }
 
 
 if __name__ == "__main__":

@@ -105,12 +105,41 @@ def test_planning_diagram_swaps_the_planner_block():
         assert len(keyframes.success) == len(actions)
 
 
-def test_run_scene_end_to_end_json(tmp_path):
-    out = tmp_path / "run.json"
+def recorded(html: str) -> bytes:
+    """The MeshCat commands a static HTML recording replays (its base64 data URLs, decoded)."""
+    import base64
+    import re
+
+    return b"".join(base64.b64decode(b) for b in re.findall(r"base64,([A-Za-z0-9+/=]+)\"\)", html))
+
+
+def test_run_scene_end_to_end_json_and_html(tmp_path):
+    out, html = tmp_path / "run.json", tmp_path / "run.html"
     result = run_module(
-        "hlp_drake.run_scene", "--kind", "vr", "--seed", "1", "--workers", "1", "--json", str(out)
+        "hlp_drake.run_scene",
+        "--kind",
+        "vr",
+        "--seed",
+        "1",
+        "--workers",
+        "1",
+        "--json",
+        str(out),
+        "--html",
+        str(html),
     )
     assert result.returncode in (0, 1), result.stderr
+    # The recording opens framed on the table, with both plans as paths and the robot plan's markers,
+    # and no contact forces unless asked for.
+    commands = recorded(html.read_text())
+    for path in (
+        b"/Cameras/default",
+        b"/drake/plan/path",
+        b"/drake/robot_plan/path",
+        b"/drake/robot_plan/00_start",
+    ):
+        assert path in commands, path
+    assert b"contact_forces" not in commands and b"animation" in commands
     report = json.loads(out.read_text())
     assert report["planner"] == "hlp" and report["robot_actuated_dofs"] == 10
     assert set(report["timings"]) >= {"plan_s", "ik_s", "optimise_s", "total_s"}

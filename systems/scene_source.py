@@ -18,12 +18,16 @@ from pydrake.math import RigidTransform
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context, InputPort, LeafSystem
 
-from hlp_drake.scene.model import Scene, SceneObject
+from hlp_drake.scene.model import Scene, SceneObject, Table
 
 if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
 
 SCENE_PORT = "scene"
+MODEL_SCENE = Scene(
+    Table(1.0, 1.0, 1.0), (0.0, 0.0), SceneObject("none", "cylinder", 0.5, 0.0, (0.1, 0.1, 0.1))
+)
+"""The ``scene`` ports' model value (a type for Drake, never planned on: an unconnected port is an error)."""
 SAME_POSE = 1e-9
 """An object within this (m, rad) of its template pose keeps the template's numbers: the plant
 stores orientations as quaternions, and a yaw's round trip through one is off by ~1e-16."""
@@ -31,7 +35,7 @@ stores orientations as quaternions, and a yaw's round trip through one is off by
 
 def declare_scene_input_port(system: LeafSystem) -> InputPort:
     """Declare ``system``'s abstract ``scene`` input port (a ``Scene``)."""
-    return system.DeclareAbstractInputPort(name=SCENE_PORT, model_value=AbstractValue.Make(None))
+    return system.DeclareAbstractInputPort(name=SCENE_PORT, model_value=AbstractValue.Make(MODEL_SCENE))
 
 
 def scene_input(port: InputPort, context: Context) -> Scene:

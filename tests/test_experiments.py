@@ -27,19 +27,10 @@ from hlp_drake.experiments.cli import main
 from hlp_drake.experiments.results import COLUMNS, read_results, results_csv, write_durable
 from hlp_drake.experiments.summary import summarise
 
-REQUIRED_COLUMNS = [
-    "scene",
-    "objects",
-    "planner",
-    "success",
-    "failure_reason",
-    "init_s",
-    "optimise_s",
-    "total_s",
-    "rollouts",
-    "objects_moved",
-    "objects_dropped",
-]
+# fmt: off
+REQUIRED_COLUMNS = ["scene", "objects", "planner", "success", "failure_reason", "init_s", "optimise_s",
+                    "total_s", "rollouts", "objects_moved", "objects_dropped"]
+# fmt: on
 OUTPUTS = ("results.csv", "config.json", "run.json", "summary.md", "summary.json", "success.png", "times.png")
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 from dataclasses import replace
@@ -27,23 +28,18 @@ RULES = push_rules(TransferConfig(), gripper_geometry())
 
 def test_the_transfers_clearances_are_the_robot_models_sizes_plus_the_margins():
     geometry = gripper_geometry()  # the tcp 14 cm ahead of the flange, the fingertips 2 cm ahead of it
-    assert (
-        geometry.tcp_offset,
-        geometry.fingertip_reach,
-        geometry.finger_half_width,
-        geometry.wrist_radius,
-    ) == (0.14, 0.02, 0.055, 0.045)
-    assert (
-        RULES.forward_clearance,
-        RULES.sideways_clearance,
-        RULES.corridor_half_width,
-        RULES.way_clearance,
-    ) == (0.05, 0.075, 0.08, 0.055)
-    assert (RULES.transit_clearance, RULES.arm_shadow_length, RULES.arm_shadow_half_width) == (
-        0.07,
-        0.35,
-        0.06,
-    )
+    sizes = {"tcp_offset": 0.14, "fingertip_reach": 0.02, "finger_half_width": 0.055, "wrist_radius": 0.045}
+    assert dataclasses.asdict(geometry) == sizes
+    clearances = {
+        "forward_clearance": 0.05,
+        "sideways_clearance": 0.075,
+        "corridor_half_width": 0.08,
+        "way_clearance": 0.055,
+        "transit_clearance": 0.07,
+        "arm_shadow_length": 0.35,
+        "arm_shadow_half_width": 0.06,
+    }
+    assert {name: getattr(RULES, name) for name in clearances} == clearances
     wider = push_rules(TransferConfig(sideways_margin=0.03), geometry)
     assert wider.sideways_clearance == 0.085 and wider.forward_clearance == RULES.forward_clearance
 

@@ -1,10 +1,10 @@
 """How often a planner's initial trajectory passes at its first rollout, before any optimisation.
 
     python benchmarks/first_rollout.py gen1 [--scenes 100] [--seed S] [--objects 5 7 9] [--planner hlp]
-        [--config WORLD.yaml] [--workers 2] [--json OUT]
+        [--config SCENARIO.yaml] [--workers 2] [--json OUT]
 
 Plans each seeded scene, solves IK and rolls the initial trajectory out once, as the optimiser's
-first rollout (``systems.planning.first_rollout``: reduced model, rollout time step). Prints the
+first rollout (``systems.planning_diagram.first_rollout``: reduced model, rollout time step). Prints the
 passes per object count and every failing scene with its reason. The optimiser stops at a passing
 first rollout, so this count decides most of the planning time; comparing two configurations
 (``--config`` with, say, ``motion: {closed_among_obstacles: false}``) shows what a planning or
@@ -25,20 +25,27 @@ from tqdm import tqdm
 from hlp_drake.atomic import write_text_atomic
 from hlp_drake.errors import HlpError
 from hlp_drake.scene.generators import generate_scene
-from hlp_drake.systems.world_config import dump_world_config, load_world_config
 
 
 def first_pass(kind: str, seed: int, objects: int | None, planner: str, config_yaml: str) -> dict:
     """One scene's first-rollout outcome as a JSON-ready row."""
+    from dataclasses import replace
+
     from hlp_drake.learners.bundled import default_models
-    from hlp_drake.systems.planning import first_rollout
+    from hlp_drake.systems.planning_diagram import first_rollout
+    from hlp_drake.systems.scenario import load_scenario
 
     scene = generate_scene(kind, seed, objects)
-    outcome = first_rollout(scene, planner=planner, models=default_models(),
-                            config=load_world_config(overrides=config_yaml))
-    return {"scene": scene.name, "seed": seed, "objects": len(scene.obstacles),
-            "passed": bool(outcome is not None and outcome.success),
-            "reason": "no trajectory" if outcome is None else outcome.failure_reason}
+    settings = load_scenario(data=config_yaml)
+    scenario = replace(settings, scene=scene, planner=replace(settings.planner, kind=planner))
+    outcome = first_rollout(scenario, models=default_models())
+    return {
+        "scene": scene.name,
+        "seed": seed,
+        "objects": len(scene.obstacles),
+        "passed": bool(outcome is not None and outcome.success),
+        "reason": "no trajectory" if outcome is None else outcome.failure_reason,
+    }
 
 
 def main() -> None:
@@ -48,17 +55,20 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0, help="scene i has seed S + i")
     parser.add_argument("--objects", type=int, nargs="+", default=[5, 7, 9], help="gen2 object counts")
     parser.add_argument("--planner", choices=("hlp", "sto"), default="hlp")
-    parser.add_argument("--config", type=Path, help="world configuration YAML (default: the defaults)")
+    parser.add_argument("--config", type=Path, help="scenario settings YAML (default: the defaults)")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--json", type=Path, help="write the rows and counts here")
     args = parser.parse_args()
+    from hlp_drake.systems.scenario import load_scenario
+
     try:
-        config_yaml = dump_world_config(load_world_config(args.config))
+        config_yaml = load_scenario(args.config).yaml
     except HlpError as error:
         parser.error(str(error))
     counts = args.objects if args.kind == "gen2" else [None]
-    jobs = [(args.kind, args.seed + i, n, args.planner, config_yaml)
-            for n in counts for i in range(args.scenes)]
+    jobs = [
+        (args.kind, args.seed + i, n, args.planner, config_yaml) for n in counts for i in range(args.scenes)
+    ]
     started = time.perf_counter()
     with ProcessPoolExecutor(args.workers, mp_context=multiprocessing.get_context("spawn")) as pool:
         outcomes = pool.map(first_pass, *zip(*jobs))

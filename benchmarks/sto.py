@@ -22,12 +22,12 @@ Writes ``DIR/sto_benchmark.json``, ``DIR/sto_comparison.csv`` and ``DIR/sto_comp
 from __future__ import annotations
 
 import argparse
-import copy
 import csv
 import json
 import os
 import platform
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -37,11 +37,13 @@ from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import load_scene
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.execution import plan_and_execute
-from hlp_drake.systems.planning import initial_sequence
-from hlp_drake.systems.rollout import RolloutOutcome, RolloutWorld, SceneRollouts
-from hlp_drake.systems.rollout_pool import RolloutPool, forget_worlds
-from hlp_drake.systems.sto import sample_base_noise
-from hlp_drake.systems.world_config import WorldConfig
+from hlp_drake.systems.optimiser import sample_base_noise
+from hlp_drake.systems.planning_diagram import initial_sequence
+from hlp_drake.systems.rollout_cost import RolloutOutcome
+from hlp_drake.systems.rollout_pool import RolloutPool
+from hlp_drake.systems.rollout_world import RolloutWorld
+from hlp_drake.systems.scenario import Scenario
+from hlp_drake.systems.scene_rollouts import SceneRollouts
 
 DEFAULT_SCENE = Path(__file__).resolve().parents[1] / "hlp_drake" / "scenes" / "default.yaml"
 HORIZON = 3.0
@@ -54,27 +56,31 @@ def truncated(sequence: ControlSequence, horizon: float) -> ControlSequence:
     return ControlSequence(times, np.column_stack([trajectory.value(t) for t in times]).T)
 
 
-def noisy(sequence: ControlSequence, config: WorldConfig, count: int, seed: int) -> list[ControlSequence]:
+def noisy(sequence: ControlSequence, config: Scenario, count: int, seed: int) -> list[ControlSequence]:
     rng = np.random.default_rng(seed)
-    return [sequence.with_base_velocity(v) for v in sample_base_noise(rng, sequence, config.sto.noise, count)]
+    return [
+        sequence.with_base_velocity(v)
+        for v in sample_base_noise(rng, sequence, config.optimiser.noise, count)
+    ]
+
+
+def planned(scene, planner: str, data: str = "") -> Scenario:
+    """The default scenario on ``scene`` with ``planner`` and the YAML settings ``data``."""
+    return Scenario(scene=scene).updated(f"planner: {{kind: {planner}}}\n{data}")
 
 
 def throughput_sequences(count: int) -> tuple:
     """The throughput scene (gen2 seed 0, 9 obstacles), a configuration without settling, and
     ``count`` noisy copies of the first ``HORIZON`` s of its straight-line initial sequence."""
     scene = generate_scene("gen2", 0, 9)
-    config = WorldConfig()
-    config.sto.settle_s = 0.0
-    base = truncated(initial_sequence(scene, planner="sto", config=config), HORIZON)
+    config = planned(scene, "sto", "optimiser: {settle_s: 0.0}")
+    base = truncated(initial_sequence(config), HORIZON)
     return scene, config, noisy(base, config, count, seed=1)
 
 
-def model_config(config: WorldConfig, step: float, reduced: bool) -> WorldConfig:
+def model_config(config: Scenario, step: float, reduced: bool) -> Scenario:
     """``config`` with the rollout time step ``step`` and the reduced model on or off."""
-    config = copy.deepcopy(config)
-    config.sto.rollout_time_step = step
-    config.sto.reduced_model = reduced
-    return config
+    return config.updated(f"optimiser: {{rollout_time_step: {step}, reduced_model: {str(reduced).lower()}}}")
 
 
 def throughput(count: int, steps: tuple[float, ...], repeats: int) -> dict:
@@ -84,8 +90,13 @@ def throughput(count: int, steps: tuple[float, ...], repeats: int) -> dict:
     load than the rate); and the real-time factor of one rollout at those steps and at the
     execution's."""
     scene, config, sequences = throughput_sequences(count)
-    result = {"scene": scene.name, "objects": len(scene.objects), "horizon_s": HORIZON, "rollouts": count,
-              "load_before": os.getloadavg()}
+    result = {
+        "scene": scene.name,
+        "objects": len(scene.objects),
+        "horizon_s": HORIZON,
+        "rollouts": count,
+        "load_before": os.getloadavg(),
+    }
     for repeat in range(repeats):
         for step in steps:
             for model in ("full", "reduced"):
@@ -93,22 +104,29 @@ def throughput(count: int, steps: tuple[float, ...], repeats: int) -> dict:
                 entry = result.setdefault(f"step_{step * 1000:g}ms", {}).setdefault(model, {})
                 for workers in (1, 2):
                     with RolloutPool(workers) as pool:
-                        pool.rollouts(scene, cfg, sequences[:workers])  # build the full worlds first
+                        pool.rollouts(cfg, sequences[:workers])  # build the full worlds first
                         for rerun in ("cold", "warm"):  # warm: every reduced world built by the cold pass
                             started, cpu = time.perf_counter(), time.process_time()
-                            outcomes = pool.rollouts(scene, cfg, sequences)
+                            outcomes = pool.rollouts(cfg, sequences)
                             elapsed, cpu = time.perf_counter() - started, time.process_time() - cpu
                             runs = entry.setdefault(f"workers_{workers}", {}).setdefault(rerun, [])
-                            runs.append({"rollouts_per_s": count / elapsed, "wall_s": elapsed,
-                                         "cpu_s_per_rollout": cpu / count if workers == 1 else None,
-                                         "load": os.getloadavg()[0],
-                                         "welded_mean": float(np.mean([len(o.welded) for o in outcomes])),
-                                         "switches": [o.switches for o in outcomes],
-                                         "costs": [o.cost for o in outcomes]})
-                runs = [run for w in (1, 2) for rerun in ("cold", "warm") for run in entry[f"workers_{w}"][rerun]]
+                            runs.append(
+                                {
+                                    "rollouts_per_s": count / elapsed,
+                                    "wall_s": elapsed,
+                                    "cpu_s_per_rollout": cpu / count if workers == 1 else None,
+                                    "load": os.getloadavg()[0],
+                                    "welded_mean": float(np.mean([len(o.welded) for o in outcomes])),
+                                    "switches": [o.switches for o in outcomes],
+                                    "costs": [o.cost for o in outcomes],
+                                }
+                            )
+                runs = [
+                    run for w in (1, 2) for rerun in ("cold", "warm") for run in entry[f"workers_{w}"][rerun]
+                ]
                 entry["same_costs_everywhere"] = all(run["costs"] == runs[0]["costs"] for run in runs)
-    for step in (*steps, WorldConfig().plant.time_step):
-        world = RolloutWorld(scene, model_config(config, step, False))
+    for step in (*steps, Scenario().plant.time_step):
+        world = RolloutWorld(model_config(config, step, False))
         world.rollout(sequences[0])
         walls = [world.rollout(s).wall_s for s in sequences[:4]]
         result.setdefault("real_time_factor", {})[f"{step * 1000:g}ms"] = HORIZON / float(np.median(walls))
@@ -123,20 +141,22 @@ def validation_sequences(count: int, scenes: int) -> list[tuple]:
     default = load_scene(DEFAULT_SCENE)
     triples = []
     for planner in ("hlp", "sto"):
-        initial = initial_sequence(default, planner=planner, config=WorldConfig())
-        for i, sequence in enumerate(noisy(initial, WorldConfig(), count, seed=2)):
+        initial = initial_sequence(planned(default, planner))
+        for i, sequence in enumerate(noisy(initial, Scenario(), count, seed=2)):
             triples.append((default, f"default/{planner}/noisy{i}", sequence, True))
     scene, _, sequences = throughput_sequences(2 * count)
     triples += [(scene, f"throughput/noisy{i}", s, False) for i, s in enumerate(sequences)]
     for kind, seed in [(kind, seed) for seed in range(scenes) for kind in ("gen1", "gen2")]:
         scene = generate_scene(kind, seed, 9 if kind == "gen2" else None)
         for planner in ("hlp", "sto"):
-            sequence = initial_sequence(scene, planner=planner, config=WorldConfig())
+            sequence = initial_sequence(planned(scene, planner))
             if sequence is None:
                 print(f"{kind} seed {seed}, {planner}: no initial trajectory, left out")
                 continue
             triples.append((scene, f"{kind}{seed}/{planner}", sequence, True))
-            triples.append((scene, f"{kind}{seed}/{planner}/noisy", noisy(sequence, WorldConfig(), 1, seed=3)[0], True))
+            triples.append(
+                (scene, f"{kind}{seed}/{planner}/noisy", noisy(sequence, Scenario(), 1, seed=3)[0], True)
+            )
     return triples
 
 
@@ -159,17 +179,17 @@ def model_agreement(triples: list[tuple], steps: tuple[float, ...]) -> dict:
     """Success verdicts and costs of every sequence on the full and the reduced model at each rollout
     time step, and on the full model at the execution time step (the reference); and, as the scale
     of the differences, the full model's own sensitivity: the sequence nudged by 1 um (``nudged``)."""
-    full_step = WorldConfig().plant.time_step
+    full_step = Scenario().plant.time_step
     rows = []
     models: dict = {}
 
     def rollouts(scene, step: float, settle: bool) -> SceneRollouts:
         key = (id(scene), step, settle)
         if key not in models:
-            config = model_config(WorldConfig(), step, True)
+            config = model_config(Scenario(scene=scene), step, True)
             if not settle:
-                config.sto.settle_s = 0.0
-            models[key] = SceneRollouts(scene, config)
+                config = config.updated("optimiser: {settle_s: 0.0}")
+            models[key] = SceneRollouts(config)
         return models[key]
 
     for scene, label, sequence, settle in tqdm(triples, desc="model agreement", unit="sequence"):
@@ -207,27 +227,51 @@ def model_agreement(triples: list[tuple], steps: tuple[float, ...]) -> dict:
                 "cost_gap_max": max(costs, default=0.0),
                 "term_gap_max": {k: max(g[k] for g in sane) for k in sane[0] if k != "cost"} if sane else {},
             }
-    summary["rows"] = [{"sequence": r["sequence"], "objects": r["objects"], "duration_s": r["duration_s"],
-                        **{k: {"success": o.success, "cost": o.cost, "welded": len(o.welded), "switches": o.switches,
-                               "wall_s": o.wall_s}
-                           for k, o in r.items() if isinstance(o, RolloutOutcome)}} for r in rows]
+    summary["rows"] = [
+        {
+            "sequence": r["sequence"],
+            "objects": r["objects"],
+            "duration_s": r["duration_s"],
+            **{
+                k: {
+                    "success": o.success,
+                    "cost": o.cost,
+                    "welded": len(o.welded),
+                    "switches": o.switches,
+                    "wall_s": o.wall_s,
+                }
+                for k, o in r.items()
+                if isinstance(o, RolloutOutcome)
+            },
+        }
+        for r in rows
+    ]
     return summary
 
 
-def comparison(config: WorldConfig, seeds: int, out: Path) -> dict:
+def comparison(config: Scenario, seeds: int, out: Path) -> dict:
     scenes = [load_scene(DEFAULT_SCENE)] + [generate_scene("gen1", seed) for seed in range(seeds)]
     rows = []
     for scene in tqdm(scenes, desc="HLP vs straight line", unit="scene"):
         for planner in ("hlp", "sto"):
-            # Fresh workers and no worlds kept in this process: neither planner reuses the rollout
-            # worlds the other one built on this scene (the pool's start-up is not in optimise_s).
-            forget_worlds()
-            with RolloutPool(config.sto.workers) as pool:
-                result = plan_and_execute(scene, planner=planner, config=config, pool=pool)
-                rows.append({"scene": scene.name, "planner": planner, "success": result.success,
-                             "failure_reason": result.failure_reason or "", "iterations": result.iterations,
-                             "rollouts": result.rollouts, "init_s": result.timings["plan_s"] + result.timings["ik_s"],
-                             "optimise_s": result.timings["optimise_s"], "grasp_held": result.grasp_held})
+            # A fresh pool: neither planner reuses the rollout worlds the other one built on this
+            # scene (the pool's start-up is not in optimise_s).
+            scenario = replace(config, scene=scene, planner=replace(config.planner, kind=planner))
+            with RolloutPool(config.optimiser.workers) as pool:
+                result = plan_and_execute(scenario, pool=pool)
+                rows.append(
+                    {
+                        "scene": scene.name,
+                        "planner": planner,
+                        "success": result.success,
+                        "failure_reason": result.failure_reason or "",
+                        "iterations": result.iterations,
+                        "rollouts": result.rollouts,
+                        "init_s": result.timings["plan_s"] + result.timings["ik_s"],
+                        "optimise_s": result.timings["optimise_s"],
+                        "grasp_held": result.grasp_held,
+                    }
+                )
     with (out / "sto_comparison.csv").open("w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=list(rows[0]))
         writer.writeheader()
@@ -236,11 +280,19 @@ def comparison(config: WorldConfig, seeds: int, out: Path) -> dict:
     for planner in ("hlp", "sto"):
         mine = [r for r in rows if r["planner"] == planner]
         times = np.array([r["optimise_s"] for r in mine])
-        summary[planner] = {"scenes": len(mine), "success": int(sum(r["success"] for r in mine)),
-                            "optimise_s_median": float(np.median(times)), "optimise_s_mean": float(np.mean(times)),
-                            "rollouts_mean": float(np.mean([r["rollouts"] for r in mine]))}
-    summary["ratio_hlp_to_sto_mean_optimise_s"] = summary["hlp"]["optimise_s_mean"] / summary["sto"]["optimise_s_mean"]
-    summary["ratio_hlp_to_sto_median_optimise_s"] = summary["hlp"]["optimise_s_median"] / summary["sto"]["optimise_s_median"]
+        summary[planner] = {
+            "scenes": len(mine),
+            "success": int(sum(r["success"] for r in mine)),
+            "optimise_s_median": float(np.median(times)),
+            "optimise_s_mean": float(np.mean(times)),
+            "rollouts_mean": float(np.mean([r["rollouts"] for r in mine])),
+        }
+    summary["ratio_hlp_to_sto_mean_optimise_s"] = (
+        summary["hlp"]["optimise_s_mean"] / summary["sto"]["optimise_s_mean"]
+    )
+    summary["ratio_hlp_to_sto_median_optimise_s"] = (
+        summary["hlp"]["optimise_s_median"] / summary["sto"]["optimise_s_median"]
+    )
     plot_comparison(rows, out / "sto_comparison.png")
     return summary
 
@@ -254,14 +306,22 @@ def plot_comparison(rows: list[dict], path: Path) -> None:
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     x = np.arange(len(scenes))
     fig, ax = plt.subplots(figsize=(max(6, 0.7 * len(scenes) + 2), 4))
-    for offset, planner, colour, label in ((-0.2, "hlp", "tab:green", "HLP-initialised"),
-                                           (0.2, "sto", "tab:gray", "straight-line-initialised")):
+    for offset, planner, colour, label in (
+        (-0.2, "hlp", "tab:green", "HLP-initialised"),
+        (0.2, "sto", "tab:gray", "straight-line-initialised"),
+    ):
         mine = {r["scene"]: r for r in rows if r["planner"] == planner}
         heights = [mine[s]["optimise_s"] for s in scenes]
         bars = ax.bar(x + offset, heights, 0.4, color=colour, label=label)
         for bar, s in zip(bars, scenes):
             if not mine[s]["success"]:
-                ax.annotate("x", (bar.get_x() + bar.get_width() / 2, bar.get_height()), ha="center", va="bottom", color="red")
+                ax.annotate(
+                    "x",
+                    (bar.get_x() + bar.get_width() / 2, bar.get_height()),
+                    ha="center",
+                    va="bottom",
+                    color="red",
+                )
     ax.set_xticks(x, scenes, rotation=45, ha="right")
     ax.set_ylabel("optimisation time (s)")
     ax.set_title("STO optimisation time per scene (red x: failed)")
@@ -272,40 +332,62 @@ def plot_comparison(rows: list[dict], path: Path) -> None:
 
 
 def print_throughput(t: dict, steps: tuple[float, ...]) -> None:
-    print(f"throughput ({t['objects']} objects, {HORIZON:g} s horizon, {t['rollouts']} rollouts; "
-          f"load before {t['load_before'][0]:.2f}), rollouts/s per repeat:")
+    print(
+        f"throughput ({t['objects']} objects, {HORIZON:g} s horizon, {t['rollouts']} rollouts; "
+        f"load before {t['load_before'][0]:.2f}), rollouts/s per repeat:"
+    )
     for step in steps:
         for model in ("full", "reduced"):
             entry = t[f"step_{step * 1000:g}ms"][model]
             for w in (1, 2):
-                cells = "; ".join(f"{rerun} " + ", ".join(f"{run['rollouts_per_s']:.2f} (load {run['load']:.1f})"
-                                                          for run in entry[f"workers_{w}"][rerun])
-                                  for rerun in ("cold", "warm"))
+                cells = "; ".join(
+                    f"{rerun} "
+                    + ", ".join(
+                        f"{run['rollouts_per_s']:.2f} (load {run['load']:.1f})"
+                        for run in entry[f"workers_{w}"][rerun]
+                    )
+                    for rerun in ("cold", "warm")
+                )
                 print(f"  {step * 1000:g} ms, {model} model, {w} worker{'s' if w > 1 else ''}: {cells}")
-            cpu = [run["cpu_s_per_rollout"] for rerun in ("cold", "warm") for run in entry["workers_1"][rerun]]
-            print(f"  {step * 1000:g} ms, {model} model: CPU time per rollout on 1 worker "
-                  + ", ".join(f"{c:.3f}" for c in cpu) + " s")
-            print(f"  {step * 1000:g} ms, {model} model: welded at the end "
-                  f"{entry['workers_1']['cold'][0]['welded_mean']:.1f} objects on average; same costs on 1 and 2 "
-                  f"workers, cold and warm: {entry['same_costs_everywhere']}")
-    print("real-time factor of one rollout (full model): "
-          + ", ".join(f"{rtf:.1f} at {k}" for k, rtf in t["real_time_factor"].items()))
+            cpu = [
+                run["cpu_s_per_rollout"] for rerun in ("cold", "warm") for run in entry["workers_1"][rerun]
+            ]
+            print(
+                f"  {step * 1000:g} ms, {model} model: CPU time per rollout on 1 worker "
+                + ", ".join(f"{c:.3f}" for c in cpu)
+                + " s"
+            )
+            print(
+                f"  {step * 1000:g} ms, {model} model: welded at the end "
+                f"{entry['workers_1']['cold'][0]['welded_mean']:.1f} objects on average; same costs on 1 and 2 "
+                f"workers, cold and warm: {entry['same_costs_everywhere']}"
+            )
+    print(
+        "real-time factor of one rollout (full model): "
+        + ", ".join(f"{rtf:.1f} at {k}" for k, rtf in t["real_time_factor"].items())
+    )
 
 
 def print_agreement(a: dict, steps: tuple[float, ...]) -> None:
     n = a["sequences"]
-    print(f"rollout models vs the full model at the execution step ({n} sequences, "
-          f"{a['successes_reference']} successes):")
+    print(
+        f"rollout models vs the full model at the execution step ({n} sequences, "
+        f"{a['successes_reference']} successes):"
+    )
     for step in steps:
         e = a[f"step_{step * 1000:g}ms"]
-        print(f"  {step * 1000:g} ms: verdicts agree with the reference: full {e['full_vs_reference']}/{n}, "
-              f"reduced {e['reduced_vs_reference']}/{n}; welded at the end {e['welded_at_end_mean']:.1f} of "
-              f"{e['objects_mean']:.1f} objects, {e['switches']} switches; wall {e['wall_s_full']:.0f} s full, "
-              f"{e['wall_s_reduced']:.0f} s reduced")
+        print(
+            f"  {step * 1000:g} ms: verdicts agree with the reference: full {e['full_vs_reference']}/{n}, "
+            f"reduced {e['reduced_vs_reference']}/{n}; welded at the end {e['welded_at_end_mean']:.1f} of "
+            f"{e['objects_mean']:.1f} objects, {e['switches']} switches; wall {e['wall_s_full']:.0f} s full, "
+            f"{e['wall_s_reduced']:.0f} s reduced"
+        )
         for name in ("reduced_vs_full", "nudged_vs_full"):
             g = e[name]
-            print(f"    {name.replace('_', ' ')}: verdicts agree {g['verdicts_agree']}/{n}, |cost gap| median "
-                  f"{g['cost_gap_median']:.3g}, p90 {g['cost_gap_p90']:.3g}, max {g['cost_gap_max']:.3g}")
+            print(
+                f"    {name.replace('_', ' ')}: verdicts agree {g['verdicts_agree']}/{n}, |cost gap| median "
+                f"{g['cost_gap_median']:.3g}, p90 {g['cost_gap_p90']:.3g}, max {g['cost_gap_max']:.3g}"
+            )
 
 
 def main() -> None:
@@ -313,31 +395,48 @@ def main() -> None:
     parser.add_argument("--out", default="benchmark-results", help="output directory")
     parser.add_argument("--gen1", type=int, default=10, help="Generalization I scenes (seeds 0..N-1)")
     parser.add_argument("--throughput-rollouts", type=int, default=16)
-    parser.add_argument("--throughput-repeats", type=int, default=2, help="throughput measurements per setting")
+    parser.add_argument(
+        "--throughput-repeats", type=int, default=2, help="throughput measurements per setting"
+    )
     parser.add_argument("--agreement-sequences", type=int, default=8, help="noisy sequences per planner")
-    parser.add_argument("--validation-scenes", type=int, default=2,
-                        help="Generalization I and II scenes (seeds 0..N-1) in the model agreement")
+    parser.add_argument(
+        "--validation-scenes",
+        type=int,
+        default=2,
+        help="Generalization I and II scenes (seeds 0..N-1) in the model agreement",
+    )
     parser.add_argument("--skip-agreement", action="store_true", help="skip the rollout models' agreement")
     parser.add_argument("--skip-comparison", action="store_true")
     args = parser.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    report = {"machine": {"platform": platform.platform(), "cpus": os.cpu_count(), "python": platform.python_version()}}
-    steps = (WorldConfig().sto.rollout_time_step, 0.01)
+    report = {
+        "machine": {
+            "platform": platform.platform(),
+            "cpus": os.cpu_count(),
+            "python": platform.python_version(),
+        }
+    }
+    steps = (Scenario().optimiser.rollout_time_step, 0.01)
     report["throughput"] = throughput(args.throughput_rollouts, steps, args.throughput_repeats)
     print_throughput(report["throughput"], steps)
     if not args.skip_agreement:
         report["model_agreement"] = model_agreement(
-            validation_sequences(args.agreement_sequences, args.validation_scenes), steps)
+            validation_sequences(args.agreement_sequences, args.validation_scenes), steps
+        )
         print_agreement(report["model_agreement"], steps)
     if not args.skip_comparison:
-        report["comparison"] = c = comparison(WorldConfig(), args.gen1, out)
+        report["comparison"] = c = comparison(Scenario(), args.gen1, out)
         for planner in ("hlp", "sto"):
             s = c[planner]
-            print(f"{planner}: success {s['success']}/{s['scenes']}, optimise median {s['optimise_s_median']:.2f} s, "
-                  f"mean {s['optimise_s_mean']:.2f} s, rollouts mean {s['rollouts_mean']:.1f}")
-        print(f"HLP / straight line optimisation time: mean {c['ratio_hlp_to_sto_mean_optimise_s']:.2f}, "
-              f"median {c['ratio_hlp_to_sto_median_optimise_s']:.2f}")
+            print(
+                f"{planner}: success {s['success']}/{s['scenes']}, optimise median {s['optimise_s_median']:.2f} s, "
+                f"mean {s['optimise_s_mean']:.2f} s, rollouts mean {s['rollouts_mean']:.1f}"
+            )
+        print(
+            f"HLP / straight line optimisation time: mean {c['ratio_hlp_to_sto_mean_optimise_s']:.2f}, "
+            f"median {c['ratio_hlp_to_sto_median_optimise_s']:.2f}"
+        )
     (out / "sto_benchmark.json").write_text(json.dumps(report, indent=2) + "\n")
     print(f"wrote {out / 'sto_benchmark.json'}")
 

@@ -1,13 +1,54 @@
-"""Shared command-line plumbing: user errors become one line on stderr and a non-zero exit."""
+"""Shared command-line plumbing: one parser style, one progress flag, user errors as one line and exit 2.
+
+Every command (``python -m hlp_drake.X`` or ``hlp-drake X``) builds its parser with ``make_parser``:
+the help shows the module's docstring without reStructuredText markup, ``--version`` prints the
+package's version, and a usage error is one ``error: ...`` line with exit status 2. Commands with
+progress bars take ``--quiet`` (``add_quiet``) to turn them off.
+"""
 
 from __future__ import annotations
 
+import argparse
 import sys
 from collections.abc import Callable, Sequence
+from typing import NoReturn
 
+from hlp_drake import __version__
 from hlp_drake.errors import HlpError
 
 EXIT_USER_ERROR = 2
+
+
+def plain(text: str) -> str:
+    """``text`` (a docstring) without reStructuredText's double backticks."""
+    return text.replace("``", "")
+
+
+class Parser(argparse.ArgumentParser):
+    """An argument parser whose usage errors are one-line ``HlpError``s (exit 2 through ``run_cli``)."""
+
+    def error(self, message: str) -> NoReturn:
+        raise HlpError(f"{message} (see {self.prog} --help)")
+
+
+def make_parser(prog: str, doc: str | None, **kwargs) -> Parser:
+    """A ``Parser`` for the command ``prog``: the first paragraph of the docstring ``doc`` as its
+    description, the rest as the epilog (both plain text), and ``--version``."""
+    head, _, rest = (doc or "").strip().partition("\n\n")
+    parser = Parser(
+        prog=prog,
+        description=plain(head),
+        epilog=plain(rest) or None,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        **kwargs,
+    )
+    parser.add_argument("--version", action="version", version=f"%(prog)s (hlp_drake {__version__})")
+    return parser
+
+
+def add_quiet(parser: argparse.ArgumentParser) -> None:
+    """``--quiet``: no progress bars (they are shown by default, on stderr)."""
+    parser.add_argument("--quiet", action="store_true", help="no progress bars")
 
 
 def run_cli(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | None = None) -> int:

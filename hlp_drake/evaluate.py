@@ -6,7 +6,6 @@
 
 from __future__ import annotations
 
-import argparse
 import csv
 import io
 import json
@@ -20,7 +19,7 @@ from functools import partial
 from tqdm import tqdm
 
 from hlp_drake.atomic import write_text_atomic
-from hlp_drake.cli import run_cli
+from hlp_drake.cli import add_quiet, make_parser, run_cli
 from hlp_drake.dataset.dataset import Dataset
 from hlp_drake.evaluation import METRICS, PAPER_TABLE_I, evaluate_split, subject_splits, summarise
 from hlp_drake.features import training_data
@@ -61,7 +60,7 @@ def predictions_csv(results) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m hlp_drake.evaluate", description=__doc__.split("\n")[0])
+    parser = make_parser("python -m hlp_drake.evaluate", __doc__)
     parser.add_argument("--dataset", help="the archive or the unpacked dataset/ folder (default: $HLP_DATASET)")
     parser.add_argument("--splits", type=int, default=5, help="random subject splits (default 5)")
     parser.add_argument("--seed", type=int, default=0)
@@ -72,7 +71,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--predictions", help="CSV of every test trial's per-row decisions (80_20)")
     parser.add_argument("--png", help="learning curve (num_subjects protocol)")
     parser.add_argument("--workers", type=int, help="parallel splits (default: one per core)")
-    parser.add_argument("--quiet", action="store_true", help="no progress bars")
+    add_quiet(parser)
     args = parser.parse_args(argv)
     if args.splits < 1:
         parser.error("--splits must be at least 1")

@@ -1,45 +1,48 @@
-"""``python -m hlp_drake.run_scene``: plan a scene, solve IK and execute it in the Drake world.
+"""Plan a scene with the human-like planner (or the straight line), optimise it with the STO and run it in Drake.
 
     python -m hlp_drake.run_scene [--scene FILE | --kind vr|gen1|gen2|unstructured --seed N [--objects K]]
-        [--planner hlp|sto] [--meshcat] [--html FILE] [--json FILE] [--config WORLD.yaml]
+        [--planner hlp|sto] [--config SCENARIO.yaml] [--workers N] [--meshcat] [--html FILE]
+        [--contact-forces] [--json FILE] [--quiet]
 
-With no arguments it runs the bundled default scene with the bundled models.
+With no arguments it runs the bundled default scene with the bundled models. Each stage is printed
+as it happens (plan, IK, the optimiser's rollouts, the execution's simulated time), then a summary.
+Exit status: 0 on success, 1 when the run failed (the reason is printed), 2 on bad input.
 """
 
 from __future__ import annotations
 
-import argparse
 import json
+import sys
 import time
 from collections.abc import Sequence
-from pathlib import Path
+from dataclasses import replace
 
 from hlp_drake.atomic import write_text_atomic
-from hlp_drake.cli import run_cli
+from hlp_drake.cli import add_quiet, make_parser, run_cli
 from hlp_drake.errors import HlpError
 from hlp_drake.scene.generators import KINDS, generate_scene
-from hlp_drake.scene.io import load_scene
-from hlp_drake.scene.validation import validate_scene
+from hlp_drake.scene.io import DEFAULT_SCENE_FILE, load_scene
 
-DEFAULT_SCENE = Path(__file__).resolve().parent / "scenes" / "default.yaml"
+DEFAULT_SCENE = DEFAULT_SCENE_FILE
+PROG = "python -m hlp_drake.run_scene"
 
 
 def summary(result) -> str:
-    plan = result.plan
-    steps = " -> ".join(
-        k.action + (f" {k.element}" if k.action in ("gap", "move") else "") + (f" {k.direction}" if k.action == "move" else "")
-        for k in plan.keypoints) or "(none)"
     t = result.timings
     start = (result.optimisation or {}).get("start", 0)
     alternative = f", from the planner's alternative {start}" if start else ""
-    optimiser = (f"optimise {t['optimise_s']:.1f} s ({result.iterations} iterations, "
-                 f"{result.rollouts} rollouts{alternative})" if result.rollouts else "not optimised")
+    optimiser = (
+        f"optimise {t['optimise_s']:.1f} s ({result.iterations} iterations, "
+        f"{result.rollouts} rollouts{alternative})"
+        if result.rollouts
+        else "not optimised"
+    )
     grasp = {None: "not attempted", True: "held", False: "did not hold"}[result.grasp_held]
     lines = [
-        f"scene {result.scene.name}: {len(result.scene.obstacles)} obstacles, planner {result.planner}",
-        f"plan: {steps}",
-        (f"timings: plan {t['plan_s']:.3f} s, IK {t['ik_s']:.2f} s, {optimiser}, execute {t['execute_s']:.1f} s "
-         f"({result.simulated_s:.1f} s simulated), total {t['total_s']:.1f} s"),
+        (
+            f"timings: plan {t['plan_s']:.3f} s, IK {t['ik_s']:.2f} s, {optimiser}, execute {t['execute_s']:.1f} s "
+            f"({result.simulated_s:.1f} s simulated), total {t['total_s']:.1f} s"
+        ),
         f"objects moved: {', '.join(result.objects_moved) or 'none'}; dropped: {', '.join(result.objects_dropped) or 'none'}",
         "success" if result.success else f"failure: {result.failure_reason}",
         f"grasp: {grasp}",
@@ -47,47 +50,70 @@ def summary(result) -> str:
     return "\n".join(lines)
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m hlp_drake.run_scene", description=__doc__.split("\n")[0])
+def _parser():
+    parser = make_parser(PROG, __doc__)
     source = parser.add_mutually_exclusive_group()
-    source.add_argument("--scene", help="a scene file (YAML or JSON); default: the bundled default scene")
+    source.add_argument(
+        "--scene", metavar="FILE", help="a scene file (YAML or JSON); default: the bundled default scene"
+    )
     source.add_argument("--kind", choices=KINDS, help="generate a scene of this kind (with --seed)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the generated scene (default 0)")
-    parser.add_argument("--objects", type=int, help="number of obstacles (gen2 / unstructured)")
-    parser.add_argument("--planner", choices=("hlp", "sto"), default="hlp",
-                        help="initialise the trajectory optimiser with the human-like plan (hlp) or with "
-                             "the baseline's straight line (sto)")
-    parser.add_argument("--workers", type=int, help="rollout processes of the optimiser (default: the config's sto.workers)")
-    parser.add_argument("--config", help="world configuration YAML (WorldConfig)")
-    parser.add_argument("--meshcat", action="store_true", help="show the run live in MeshCat (prints the URL)")
-    parser.add_argument("--html", help="write a self-contained MeshCat recording of the run")
-    parser.add_argument("--json", help="write the result as JSON")
-    args = parser.parse_args(argv)
+    parser.add_argument("--objects", type=int, metavar="K", help="number of obstacles (gen2, unstructured)")
+    parser.add_argument(
+        "--planner",
+        choices=("hlp", "sto"),
+        help="initialise the optimiser with the human-like plan (hlp, the default) or the "
+        "baseline's straight line (sto)",
+    )
+    parser.add_argument(
+        "--config",
+        metavar="SCENARIO.yaml",
+        help="scenario settings (see hlp_drake.systems.Scenario); --scene or --kind replace its scene",
+    )
+    parser.add_argument(
+        "--workers", type=int, metavar="N", help="rollout processes (default: the scenario's, 2)"
+    )
+    parser.add_argument(
+        "--meshcat", action="store_true", help="show the run live in MeshCat (prints the URL)"
+    )
+    parser.add_argument("--html", metavar="FILE", help="write a self-contained MeshCat recording of the run")
+    parser.add_argument("--contact-forces", action="store_true", help="draw the contact forces in MeshCat")
+    parser.add_argument("--json", metavar="FILE", help="write the result as JSON")
+    add_quiet(parser)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    started = time.perf_counter()
+    args = _parser().parse_args(argv)
+    if args.workers is not None and args.workers < 1:
+        raise HlpError(f"--workers must be >= 1, got {args.workers}")
+    scene = None
     if args.kind is not None:
         scene = generate_scene(args.kind, args.seed, args.objects)
-    else:
+    elif args.scene is not None or args.config is None:
         scene = load_scene(args.scene or DEFAULT_SCENE)
-    validate_scene(scene)
+    if scene is not None:
+        _print(f"scene {scene.name}: {len(scene.obstacles)} obstacles, planner {args.planner or 'hlp'}")
 
-    from hlp_drake.systems.execution import plan_and_execute  # Drake is imported only here
-    from hlp_drake.systems.world_config import WorldConfig, load_world_config
+    from hlp_drake.systems.scenario import load_scenario  # Drake is imported from here on
 
-    config = load_world_config(args.config) if args.config else WorldConfig()
-    if args.workers is not None:
-        if args.workers < 1:
-            raise HlpError(f"--workers must be >= 1, got {args.workers}")
-        config.sto.workers = args.workers
-    meshcat = None
-    if args.meshcat or args.html:
-        from pydrake.geometry import Meshcat, MeshcatParams
-
-        meshcat = Meshcat(MeshcatParams(host="localhost"))
-        if args.meshcat:
-            print(f"MeshCat: {meshcat.web_url()}")
-    started = time.perf_counter()
-    result = plan_and_execute(scene, planner=args.planner, config=config, meshcat=meshcat, html=args.html)
+    scenario = load_scenario(args.config)
+    scenario = replace(
+        scenario,
+        scene=scene or scenario.scene,
+        planner=replace(scenario.planner, kind=args.planner or scenario.planner.kind),
+        optimiser=replace(scenario.optimiser, workers=args.workers or scenario.optimiser.workers),
+    )
+    if scene is None:
+        _print(
+            f"scene {scenario.scene.name}: {len(scenario.scene.obstacles)} obstacles, "
+            f"planner {scenario.planner.kind}"
+        )
+    result, meshcat = _run(scenario, args, started)
     print(summary(result))
     if args.html:
+        write_text_atomic(args.html, meshcat.StaticHtml())
         print(f"wrote {args.html}")
     if args.json:
         write_text_atomic(args.json, json.dumps(result.to_dict(), indent=2) + "\n")
@@ -100,6 +126,36 @@ def main(argv: Sequence[str] | None = None) -> int:
         except KeyboardInterrupt:
             pass
     return 0 if result.success else 1
+
+
+def _print(line: str) -> None:
+    print(line, flush=True)
+
+
+def _run(scenario, args, started: float):
+    """Plan and execute ``scenario`` on a rollout pool of its own, the stages printed as they come."""
+    from hlp_drake.run_progress import ProgressListener
+    from hlp_drake.systems.execution import plan_and_execute
+    from hlp_drake.systems.rollout_pool import RolloutPool
+
+    meshcat = None
+    if args.meshcat or args.html:
+        from pydrake.geometry import Meshcat, MeshcatParams
+
+        meshcat = Meshcat(MeshcatParams(host="localhost"))
+        if args.meshcat:
+            _print(f"MeshCat: {meshcat.web_url()}")
+    listener = ProgressListener(quiet=args.quiet, stream=sys.stderr)
+    workers = scenario.optimiser.workers
+    if workers > 1:
+        _print(f"starting {workers} rollout workers ...")
+    with RolloutPool(workers, on_rollout=listener.rollout) as pool:
+        if workers > 1:
+            _print(f"rollout workers ready ({pool.startup_s:.1f} s)")
+        result = plan_and_execute(
+            scenario, pool=pool, meshcat=meshcat, contact_forces=args.contact_forces, listener=listener
+        )
+    return result, meshcat
 
 
 if __name__ == "__main__":

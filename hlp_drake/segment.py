@@ -6,7 +6,6 @@
 
 from __future__ import annotations
 
-import argparse
 import csv
 import io
 import json
@@ -14,7 +13,7 @@ import time
 from collections.abc import Sequence
 
 from hlp_drake.atomic import write_text_atomic
-from hlp_drake.cli import run_cli
+from hlp_drake.cli import add_quiet, make_parser, run_cli
 from hlp_drake.dataset.dataset import Dataset
 from hlp_drake.errors import HlpError
 from hlp_drake.segmentation import (
@@ -53,7 +52,7 @@ def report(result: SegmentationResult, total: int, seconds: float) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m hlp_drake.segment", description=__doc__.split("\n")[0])
+    parser = make_parser("python -m hlp_drake.segment", __doc__)
     parser.add_argument("--dataset", help="the archive or the unpacked dataset/ folder (default: $HLP_DATASET)")
     parser.add_argument("--mode", choices=MODES, default=DEFAULT_MODE,
                         help="fixed: what the paper says (default); faithful: the released code, bugs included")
@@ -61,7 +60,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--json", help="also write the counts and every rejection as JSON")
     parser.add_argument("--trial", help="segment one trial, e.g. sub_01/T050 (with --png)")
     parser.add_argument("--png", help="picture of --trial's segmentation")
-    parser.add_argument("--progress", action="store_true", help="show a progress bar")
+    add_quiet(parser)
     args = parser.parse_args(argv)
     if args.trial is None and args.out is None:
         parser.error("give --out CSV (all trials) or --trial KEY --png FILE (one trial)")
@@ -81,7 +80,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"wrote {args.png}")
         return 0
     started = time.perf_counter()
-    result = segment_dataset(dataset, mode=args.mode, progress=args.progress)
+    result = segment_dataset(dataset, mode=args.mode, progress=not args.quiet)
     seconds = time.perf_counter() - started
     total = len(result.demonstrations) + len(result.rejections)
     write_text_atomic(args.out, demonstrations_csv(result))

@@ -5,11 +5,10 @@
 
 from __future__ import annotations
 
-import argparse
 import time
 from collections.abc import Sequence
 
-from hlp_drake.cli import run_cli
+from hlp_drake.cli import add_quiet, make_parser, run_cli
 from hlp_drake.dataset.dataset import Dataset
 from hlp_drake.errors import HlpError
 from hlp_drake.features import training_data
@@ -18,14 +17,14 @@ from hlp_drake.segmentation import DEFAULT_MODE, MODES, demonstration_records, s
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m hlp_drake.train", description=__doc__.split("\n")[0])
+    parser = make_parser("python -m hlp_drake.train", __doc__)
     parser.add_argument("--dataset", help="the archive or the unpacked dataset/ folder (default: $HLP_DATASET)")
     parser.add_argument("--mode", choices=MODES, default=DEFAULT_MODE)
     parser.add_argument("--preset", choices=sorted(PRESETS), default="strong",
                         help="strong (default, the bundled models) or paper (reference section 5)")
     parser.add_argument("--subjects", nargs="+", help="train on these subjects only (default: all)")
     parser.add_argument("--out", required=True, help="directory for models.json and models.npz")
-    parser.add_argument("--progress", action="store_true")
+    add_quiet(parser)
     args = parser.parse_args(argv)
     dataset = Dataset(args.dataset)
     if args.subjects:
@@ -34,7 +33,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise HlpError(f"unknown subjects: {', '.join(unknown)}")
     started = time.perf_counter()
     records = demonstration_records(dataset, args.subjects)
-    result = segment_dataset(dataset, mode=args.mode, records=records, progress=args.progress)
+    result = segment_dataset(dataset, mode=args.mode, records=records, progress=not args.quiet)
     data = training_data(result.demonstrations, mode=args.mode)
     segmented = time.perf_counter()
     models = DecisionModels(PRESETS[args.preset]).fit(data)

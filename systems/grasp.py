@@ -9,8 +9,8 @@ from pydrake.solvers import Solve
 
 from hlp_drake.systems.control_sequence import BASE_COLUMNS
 from hlp_drake.systems.robot import GRIPPER_CLOSED, GRIPPER_JOINTS, GRIPPER_MIMIC_JOINTS, TCP_FRAME
-from hlp_drake.systems.world import ik_solver_options, kinematic_robot, robot_position_names
-from hlp_drake.systems.world_config import WorldConfig
+from hlp_drake.systems.start_pose import ik_solver_options, kinematic_robot, robot_position_names
+from hlp_drake.systems.world_settings import GraspConfig
 
 _NAMES = robot_position_names()
 FINGER_COLUMNS = [_NAMES.index(name) for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS]
@@ -36,10 +36,9 @@ def lifted_configuration(q: np.ndarray, height: float, *, max_iterations: int = 
     return result.GetSolution(ik.q()) if result.is_success() else None
 
 
-def grasp_knots(q_end: np.ndarray, config: WorldConfig) -> tuple[np.ndarray, np.ndarray] | None:
+def grasp_knots(q_end: np.ndarray, grasp: GraspConfig) -> tuple[np.ndarray, np.ndarray] | None:
     """Times (after the reach's end) and robot positions of the grasp: close the fingers at the end
-    pose, lift the tcp by ``config.grasp.lift_height``, hold. None if the lift has no IK solution."""
-    grasp = config.grasp
+    pose, lift the tcp by ``grasp.lift_height``, hold. None if the lift has no IK solution."""
     closed = np.array(q_end, dtype=float)
     closed[FINGER_COLUMNS] = GRIPPER_CLOSED
     lifted = lifted_configuration(closed, grasp.lift_height) if grasp.lift_height > 0 else closed

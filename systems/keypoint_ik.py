@@ -1,226 +1,67 @@
 """``KeypointIk``: a high-level plan's keypoints -> robot keyframes (IK) -> a joint-space trajectory.
 
 Input ports:
-    ``plan`` (abstract, ``HighLevelPlan``): the plan for the scene the system was built for.
-    ``alternatives`` (abstract, tuple of ``HighLevelPlan``; optional): other plans for the scene.
+    ``plan`` (abstract, ``HighLevelPlan``): a robot plan for the scenario's scene (table and start).
+    ``alternatives`` (abstract, tuple of ``HighLevelPlan``; optional): other plans for it.
 
-Output ports (both computed only when ``plan`` changes; cached otherwise):
+Output ports (in Drake's cache, computed again only when their input changes):
     ``keyframes`` (abstract, ``Keyframes``): per keypoint the robot's 11 positions, a success flag and
         a message naming the keypoint when its IK failed.
     ``trajectory`` (abstract, ``PiecewisePolynomial``): a first-order hold of the robot's 11 positions
         from the start configuration through the successful keyframes (straight lines in joint space),
-        timed by ``WorldConfig.motion``; the gripper closed among the obstacles if
+        timed by the scenario's ``motion``; the gripper closed among the obstacles if
         ``motion.closed_among_obstacles``.
     ``alternative_trajectories`` (abstract, tuple of ``PiecewisePolynomial``): the same for each of
-        ``alternatives`` whose every keypoint's IK succeeds, in order; computed only when evaluated
-        (cached per input value).
+        ``alternatives`` whose every keypoint's IK succeeds, in order; computed only when evaluated.
 
-The positions are in the robot model instance's order (``world.robot_position_names()``: base x, y,
-yaw, the six UR5 joints, left finger, right (mimic) finger), the same in the world diagram's plant,
-so ``world.add_position_trajectory`` can play the trajectory.
-
-Each keypoint's IK (SNOPT) runs on a planning model built once here: the robot, the table and the
-scene's objects welded at their scene poses, with one private context. Constraints:
-
-* the tcp at the keypoint's (x, y) and ``config.ik.height`` above the table top (within
-  ``ik.position_tolerance``);
-* the approach axis (tcp +z) within ``ik.approach_tolerance`` of world +x and the finger axis (tcp
-  +y) within ``ik.roll_tolerance`` of horizontal: the horizontal grasp of the start configuration;
-* joint limits, the gripper kept open, the base within its workspace (its front at most
-  ``ik.base_under_table`` past the table's front edge, its centre within the table's width plus
-  ``ik.base_lateral_margin``);
-* at least ``ik.table_clearance`` between the robot and the table top and between the robot's own
-  links. Robot-object pairs are filtered out in the private context: pushing objects is allowed.
-
-The cost keeps each keyframe near the previous one. A keypoint is solved from up to ``ik.attempts``
-seeds (the previous keyframe; it with the base moved along with the tcp; the start posture moved
-to the keypoint; a continuation along the tcp's straight line) and checked by forward kinematics;
-a keypoint that fails is reported in ``Keyframes`` and skipped by the trajectory (the next keypoint
-is seeded from the last success).
+The positions are in the robot model instance's order (``robot_position_names()``: base x, y, yaw,
+the six UR5 joints, left finger, right (mimic) finger), the same in the world diagram's plant, so
+``add_position_trajectory`` can play the trajectory. The solves (``KeypointSolver``) work in a
+planning-model context kept in this system's Context (a cache entry), made once per Context.
 """
 
 from __future__ import annotations
 
-import math
-import time
-from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
-import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.geometry import CollisionFilterDeclaration, GeometrySet
-from pydrake.multibody.inverse_kinematics import InverseKinematics
-from pydrake.solvers import Solve
-from pydrake.systems.framework import LeafSystem
+from pydrake.systems.framework import Context, LeafSystem, ValueProducer
 from pydrake.trajectories import PiecewisePolynomial
 
-from hlp_drake.planner.plan import HighLevelPlan, PlanKeypoint
-from hlp_drake.scene.model import Scene
-from hlp_drake.systems.robot import (
-    ARM_JOINTS,
-    BASE_FOOTPRINT,
-    BASE_JOINTS,
-    GRIPPER_CLOSED,
-    GRIPPER_JOINTS,
-    GRIPPER_MIMIC_JOINTS,
-    TCP_FRAME,
-)
-from hlp_drake.systems.world import (
-    PlanningModel,
-    ik_solver_options,
-    robot_position_names,
-    start_configuration,
-    tcp_keypoint_height,
-)
-from hlp_drake.systems.world_config import WorldConfig
+from hlp_drake.planner.plan import HighLevelPlan
+from hlp_drake.systems.keyframes import Keyframes
+from hlp_drake.systems.keypoint_solver import KeypointSolver
 
-START_MATCH_TOLERANCE = 1e-3
-"""A "start" keypoint this close (m) to ``scene.start`` uses the start configuration without IK."""
-POSTURE_WEIGHT = 0.05
-"""Weight of the pull of the arm's joints towards their start posture, against 1 for the step."""
-FK_CHECK_FACTOR = 2.0
-"""A solution whose tcp is farther than this times ``ik.position_tolerance`` from its target fails."""
-CONTINUATION_STEPS = 4
-"""Steps of the continuation seed along the straight tcp line to a keypoint (``_continued``)."""
-GRASP_ACTIONS = ("approach", "target")
-"""Keypoint actions reached with the gripper open (``motion.closed_among_obstacles``)."""
-
-
-@dataclass(frozen=True)
-class Keyframes:
-    """The IK result of a plan.
-
-    Attributes:
-        keypoints: the plan's keypoints.
-        positions: (n, 11) robot positions per keypoint (for a failed keypoint: the solver's last
-            iterate, not to be executed).
-        success: per keypoint, whether its IK succeeded.
-        messages: per keypoint, "" on success, else why it failed (naming the keypoint).
-        tcp_positions: (n, 3) tcp positions of ``positions`` (forward kinematics).
-        start: the robot's 11 start positions.
-        problems: plan-level problems (no plan, wrong scene); empty normally.
-        solve_time_s: wall-clock time of all the solves.
-    """
-
-    keypoints: tuple[PlanKeypoint, ...]
-    positions: np.ndarray
-    success: tuple[bool, ...]
-    messages: tuple[str, ...]
-    tcp_positions: np.ndarray
-    start: np.ndarray
-    problems: tuple[str, ...] = ()
-    solve_time_s: float = 0.0
-    details: dict = field(default_factory=dict, compare=False)
-
-    @property
-    def ok(self) -> bool:
-        """True when there are keyframes, all succeeded, and the plan had no problem."""
-        return not self.problems and len(self.success) > 0 and all(self.success)
-
-    @property
-    def failures(self) -> list[str]:
-        """Every problem and failure message."""
-        return [*self.problems, *(m for m, ok in zip(self.messages, self.success) if not ok)]
-
-    @classmethod
-    def empty(cls, start: np.ndarray, problem: str | None = None) -> Keyframes:
-        n = len(start)
-        return cls(
-            keypoints=(),
-            positions=np.zeros((0, n)),
-            success=(),
-            messages=(),
-            tcp_positions=np.zeros((0, 3)),
-            start=np.array(start, dtype=float),
-            problems=() if problem is None else (problem,),
-        )
-
-
-def _grandparents(plant, robot) -> list[tuple]:
-    """(body, its parent's parent) for every body of model instance ``robot`` that has one."""
-    parent = {}
-    for index in plant.GetJointIndices(robot):
-        joint = plant.get_joint(index)
-        parent[joint.child_body().index()] = joint.parent_body().index()
-    return [(plant.get_body(child), plant.get_body(parent[p])) for child, p in parent.items() if p in parent]
-
-
-def _describe(index: int, keypoint: PlanKeypoint) -> str:
-    element = f" {keypoint.element}" if keypoint.element else ""
-    x, y = keypoint.position
-    return f"keypoint {index} ({keypoint.action}{element}) at ({x:.3f}, {y:.3f})"
+if TYPE_CHECKING:
+    from hlp_drake.systems.scenario import Scenario
 
 
 class KeypointIk(LeafSystem):
-    """Solves IK for a plan's keypoints on ``scene`` and times a joint trajectory through them.
+    """Solves IK for a plan's keypoints on ``scenario``'s table from its start, and times a joint
+    trajectory through them (see the module's docstring for the ports)."""
 
-    See the module's docstring for the ports and the constraints.
-
-    Args:
-        scene: the scene the plans are for (table and obstacles of the planning model, start).
-        config: IK and motion settings (``WorldConfig()`` by default).
-
-    Attributes:
-        num_solves: how many times the keyframes were computed (for checking the cache).
-    """
-
-    def __init__(self, scene: Scene, config: WorldConfig | None = None) -> None:
+    def __init__(self, scenario: Scenario) -> None:
         super().__init__()
-        self._scene = scene
-        self._config = WorldConfig() if config is None else config
-        self._model = PlanningModel(scene, self._config)
-        plant, robot = self._model.plant, self._model.robot
-        self._plant = plant
-        self._robot = robot
-        self._tcp = plant.GetFrameByName(TCP_FRAME, robot)
-        if plant.num_positions() != plant.num_positions(robot):
-            raise RuntimeError("the planning model must have no positions besides the robot's")
-        # Robot-object contact is allowed (objects may be pushed): hide those pairs from the IK's
-        # distance constraint in this private context only; the model keeps them for other queries.
-        scene_graph_context = self._model.scene_graph.GetMyMutableContextFromRoot(self._model.context)
-        # The distance constraint is then robot-vs-table and robot-vs-robot, less the links one joint
-        # apart (the plant's own filter) or two (by design within a few mm, e.g. forearm and wrist 2).
-        declaration = CollisionFilterDeclaration().ExcludeBetween(
-            GeometrySet(self._model.robot_geometries()), GeometrySet(self._model.object_geometries())
-        )
-        for body, grandparent in _grandparents(plant, robot):
-            declaration.ExcludeBetween(
-                GeometrySet(plant.GetCollisionGeometriesForBody(body)),
-                GeometrySet(plant.GetCollisionGeometriesForBody(grandparent)),
-            )
-        self._model.scene_graph.collision_filter_manager(scene_graph_context).Apply(declaration)
-        self._start = start_configuration(scene, plant, robot, config=self._config)
-        self._names = robot_position_names()
-        self._index = {name: plant.GetJointByName(name, robot).position_start() for name in self._names}
-        if list(self._index.values()) != list(range(len(self._names))):
-            raise RuntimeError(f"unexpected position order of the robot: {self._index}")
-        self._velocity_limits = np.array(
-            [plant.GetJointByName(name, robot).velocity_upper_limits()[0] for name in self._names]
-        )
-        self._lower = plant.GetPositionLowerLimits().copy()
-        self._upper = plant.GetPositionUpperLimits().copy()
-        ik = self._config.ik
-        table = scene.table
-        self._upper[self._index[BASE_JOINTS[0]]] = ik.base_under_table - BASE_FOOTPRINT[0] / 2.0
-        y_limit = table.width / 2.0 + ik.base_lateral_margin
-        self._lower[self._index[BASE_JOINTS[1]]] = -y_limit
-        self._upper[self._index[BASE_JOINTS[1]]] = y_limit
-        yaw = self._index[BASE_JOINTS[2]]
-        self._lower[yaw], self._upper[yaw] = -ik.base_max_yaw, ik.base_max_yaw
-        self._gripper = [self._index[name] for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS]
-        for i in self._gripper:  # keep the gripper as at the start (open)
-            self._lower[i] = self._upper[i] = self._start[i]
-        self._height = tcp_keypoint_height(scene, self._config)
-        self._options = ik_solver_options(ik.max_iterations)
-        self.num_solves = 0
-
-        empty_plan = HighLevelPlan(scene=scene.name, keypoints=(), reason="no plan given")
+        solver = KeypointSolver(scenario)
+        self._solver = solver
+        empty_plan = HighLevelPlan(scene=scenario.scene.name, keypoints=(), reason="no plan given")
         self._plan_port = self.DeclareAbstractInputPort(
             name="plan", model_value=AbstractValue.Make(empty_plan)
+        )
+        self._alternatives_port = self.DeclareAbstractInputPort(
+            name="alternatives", model_value=AbstractValue.Make(())
+        )
+        self._scratch = self.DeclareCacheEntry(
+            description="planning model context",
+            value_producer=ValueProducer(
+                allocate=lambda: AbstractValue.Make(solver.new_context()), calc=lambda context, value: None
+            ),
+            prerequisites_of_calc={self.nothing_ticket()},
         )
         plan_ticket = {self.input_port_ticket(self._plan_port.get_index())}
         self._keyframes_port = self.DeclareAbstractOutputPort(
             name="keyframes",
-            alloc=lambda: AbstractValue.Make(Keyframes.empty(self._start)),
+            alloc=lambda: AbstractValue.Make(Keyframes.empty(solver.start)),
             calc=self._calc_keyframes,
             prerequisites_of_calc=plan_ticket,
         )
@@ -230,8 +71,6 @@ class KeypointIk(LeafSystem):
             calc=self._calc_trajectory,
             prerequisites_of_calc=plan_ticket,
         )
-        self._alternatives_port = self.DeclareAbstractInputPort(
-            name="alternatives", model_value=AbstractValue.Make(()))
         self._alternative_trajectories_port = self.DeclareAbstractOutputPort(
             name="alternative_trajectories",
             alloc=lambda: AbstractValue.Make(()),
@@ -239,23 +78,16 @@ class KeypointIk(LeafSystem):
             prerequisites_of_calc={self.input_port_ticket(self._alternatives_port.get_index())},
         )
 
-    # --- Accessors ------------------------------------------------------------------------------
-
     @property
-    def scene(self) -> Scene:
-        return self._scene
-
-    @property
-    def planning_model(self) -> PlanningModel:
-        return self._model
-
-    @property
-    def start(self) -> np.ndarray:
-        """The robot's 11 start positions."""
-        return self._start.copy()
+    def solver(self) -> KeypointSolver:
+        """The IK and timing (to call directly, with a context of ``solver.new_context()``)."""
+        return self._solver
 
     def get_plan_input_port(self):
         return self._plan_port
+
+    def get_alternatives_input_port(self):
+        return self._alternatives_port
 
     def get_keyframes_output_port(self):
         return self._keyframes_port
@@ -263,218 +95,30 @@ class KeypointIk(LeafSystem):
     def get_trajectory_output_port(self):
         return self._trajectory_port
 
-    def get_alternatives_input_port(self):
-        return self._alternatives_port
-
     def get_alternative_trajectories_output_port(self):
         return self._alternative_trajectories_port
 
-    def tcp_position(self, q: np.ndarray) -> np.ndarray:
-        """World position of the tcp at robot positions ``q`` (uses the private context)."""
-        self._plant.SetPositions(self._model.plant_context, self._robot, q)
-        return self._tcp.CalcPoseInWorld(self._model.plant_context).translation().copy()
+    def _plant_context(self, context: Context) -> Context:
+        return self._solver.plant_context(self._scratch.Eval(context))
 
-    # --- Keyframes ------------------------------------------------------------------------------
-
-    def _calc_keyframes(self, context, output) -> None:
+    def _calc_keyframes(self, context: Context, output: AbstractValue) -> None:
         if not self._plan_port.HasValue(context):
-            output.set_value(Keyframes.empty(self._start, "no plan: the plan input port is not connected"))
+            output.set_value(
+                Keyframes.empty(self._solver.start, "no plan: the plan input port is not connected")
+            )
             return
-        output.set_value(self.solve(self._plan_port.Eval(context)))
+        output.set_value(self._solver.solve(self._plant_context(context), self._plan_port.Eval(context)))
 
-    def solve(self, plan: HighLevelPlan) -> Keyframes:
-        """The keyframes of ``plan``: what the ``keyframes`` port outputs (uncached when called directly)."""
-        self.num_solves += 1
-        if plan.scene and self._scene.name and plan.scene != self._scene.name:
-            return Keyframes.empty(
-                self._start, f"the plan is for scene {plan.scene!r}, this KeypointIk for {self._scene.name!r}"
-            )
-        if not plan.ok:
-            return Keyframes.empty(self._start, f"no plan: {plan.reason or 'fewer than two keypoints'}")
-        started = time.perf_counter()
-        positions, success, messages = [], [], []
-        previous = self._start
-        for index, keypoint in enumerate(plan.keypoints):
-            q, message = self._solve_keypoint(index, keypoint, previous)
-            positions.append(q)
-            success.append(message == "")
-            messages.append(message)
-            if message == "":
-                previous = q
-        positions = np.array(positions)
-        return Keyframes(
-            keypoints=tuple(plan.keypoints),
-            positions=positions,
-            success=tuple(success),
-            messages=tuple(messages),
-            tcp_positions=np.array([self.tcp_position(q) for q in positions]),
-            start=self._start.copy(),
-            solve_time_s=time.perf_counter() - started,
+    def _calc_trajectory(self, context: Context, output: AbstractValue) -> None:
+        output.set_value(
+            self._solver.trajectory(self._plant_context(context), self._keyframes_port.Eval(context))
         )
 
-    def _target(self, keypoint: PlanKeypoint) -> np.ndarray:
-        height = self._height if keypoint.height is None else self._scene.table.height + keypoint.height
-        return np.array([keypoint.position[0], keypoint.position[1], height], dtype=float)
-
-    def _shifted(self, reference: np.ndarray, target: np.ndarray) -> np.ndarray:
-        """``reference`` with the base moved by the tcp's offset to ``target`` (clipped to the bounds)."""
-        shifted = reference.copy()
-        shift = target - self.tcp_position(reference)
-        shifted[self._index[BASE_JOINTS[0]]] += shift[0]
-        shifted[self._index[BASE_JOINTS[1]]] += shift[1]
-        return np.clip(shifted, self._lower, self._upper)
-
-    def _continued(self, previous: np.ndarray, target: np.ndarray) -> np.ndarray | None:
-        """The posture reached by solving ``CONTINUATION_STEPS - 1`` evenly spaced points of the
-        straight tcp line from ``previous`` towards ``target`` (without the clearance constraint),
-        each from the last; None if one fails. A far keypoint may need the arm to unfold while the
-        base stops at its bounds, which SNOPT does not find in one solve from a folded seed (a
-        straight line from a Generalization II start)."""
-        q, start = previous.copy(), self.tcp_position(previous)
-        for fraction in np.linspace(0.0, 1.0, CONTINUATION_STEPS + 1)[1:-1]:
-            point = start + fraction * (target - start)
-            _, q, feasible = self._solve(*self._program(point, q, clearance=False), q)
-            if not feasible:
-                return None
-        return q
-
-    def _solve(self, program, variables, seed: np.ndarray) -> tuple:
-        """(SNOPT's result, the solution, whether it meets every constraint) from ``seed``. SNOPT
-        often stops at its iteration limit on a point that meets every constraint: such an iterate
-        counts when the constraints check out."""
-        result = Solve(program, seed, self._options)
-        solution = result.GetSolution(variables)
-        return result, solution, result.is_success() or program.CheckSatisfied(
-            program.GetAllConstraints(), solution, 1e-6)
-
-    def _program(self, target: np.ndarray, previous: np.ndarray, *, clearance: bool) -> tuple:
-        """The IK program of one keypoint: (program, decision variables)."""
-        ik_config = self._config.ik
-        tolerance = ik_config.position_tolerance
-        world = self._plant.world_frame()
-        ik = InverseKinematics(self._plant, self._model.plant_context, with_joint_limits=False)
-        q = ik.q()
-        prog = ik.get_mutable_prog()
-        prog.AddBoundingBoxConstraint(self._lower, self._upper, q)
-        ik.AddPositionConstraint(self._tcp, np.zeros(3), world, target - tolerance, target + tolerance)
-        ik.AddAngleBetweenVectorsConstraint(
-            world, [1.0, 0.0, 0.0], self._tcp, [0.0, 0.0, 1.0], 0.0, ik_config.approach_tolerance
-        )
-        ik.AddAngleBetweenVectorsConstraint(
-            world,
-            [0.0, 0.0, 1.0],
-            self._tcp,
-            [0.0, 1.0, 0.0],
-            math.pi / 2 - ik_config.roll_tolerance,
-            math.pi / 2 + ik_config.roll_tolerance,
-        )
-        if clearance:
-            ik.AddMinimumDistanceLowerBoundConstraint(
-                ik_config.table_clearance, ik_config.table_clearance + 0.05
-            )
-        prog.AddQuadraticErrorCost(np.eye(len(previous)), previous, q)
-        # A weak pull towards the start posture of the arm keeps it from folding up over many keypoints.
-        arm = [self._index[name] for name in ARM_JOINTS]
-        prog.AddQuadraticErrorCost(POSTURE_WEIGHT * np.eye(len(arm)), self._start[arm], q[arm])
-        return prog, q
-
-    def _solve_keypoint(
-        self, index: int, keypoint: PlanKeypoint, previous: np.ndarray
-    ) -> tuple[np.ndarray, str]:
-        """(positions, "") on success, else (the best iterate, the failure message).
-
-        Seeds, in order, up to ``ik.attempts``: the previous keyframe; the solution of the same
-        program without the clearance constraint (from the previous keyframe); the previous
-        keyframe with the base moved along with the tcp; the start posture moved likewise; the
-        end of a continuation along the straight tcp line (``_continued``), from which the keypoint
-        is solved with the cost pulling towards that posture instead of the previous keyframe.
-        """
-        target = self._target(keypoint)
-        start_distance = np.hypot(*np.subtract(keypoint.position, self._scene.start))
-        if keypoint.action == "start" and start_distance <= START_MATCH_TOLERANCE:
-            return self._start.copy(), ""
-        tolerance = self._config.ik.position_tolerance
-        prog, q = self._program(target, previous, clearance=True)
-        best, reasons = previous.copy(), []
-
-        def seeds():  # (seed, program, its variables)
-            yield previous.copy(), prog, q
-            loose, loose_q = self._program(target, previous, clearance=False)
-            result = Solve(loose, previous, self._options)
-            if result.is_success():
-                yield result.GetSolution(loose_q), prog, q
-            yield self._shifted(previous, target), prog, q
-            yield self._shifted(self._start, target), prog, q
-            continued = self._continued(previous, target)
-            if continued is not None:  # its last step: the cost pulls towards the last posture on the way
-                yield continued, *self._program(target, continued, clearance=True)
-
-        attempts = 0
-        for seed, program, variables in seeds():
-            if attempts == self._config.ik.attempts:
-                break
-            attempts += 1
-            result, solution, feasible = self._solve(program, variables, seed)  # the FK check follows
-            if not feasible:
-                best = solution
-                reasons.append(str(result.get_solution_result()).split(".")[-1])
-                continue
-            error = np.linalg.norm(self.tcp_position(solution) - target)
-            if error > FK_CHECK_FACTOR * tolerance * math.sqrt(3):
-                best = solution
-                reasons.append(f"tcp {error * 1000:.1f} mm off")
-                continue
-            return solution, ""
-        return best, (
-            f"{_describe(index, keypoint)}: IK failed after {attempts} attempt(s) "
-            f"(SNOPT: {', '.join(reasons)}); "
-            f"the tcp target {np.round(target, 3).tolist()} may be out of reach"
-        )
-
-    # --- Trajectory -----------------------------------------------------------------------------
-
-    def _calc_trajectory(self, context, output) -> None:
-        keyframes: Keyframes = self._keyframes_port.Eval(context)
-        output.set_value(self.trajectory(keyframes))
-
-    def _calc_alternative_trajectories(self, context, output) -> None:
+    def _calc_alternative_trajectories(self, context: Context, output: AbstractValue) -> None:
         plans = self._alternatives_port.Eval(context) if self._alternatives_port.HasValue(context) else ()
-        solved = (self.solve(plan) for plan in plans)
-        output.set_value(tuple(self.trajectory(keyframes) for keyframes in solved if keyframes.ok))
-
-    def _with_gripper(self, q: np.ndarray, opening: float) -> np.ndarray:
-        q = np.array(q, dtype=float)
-        q[self._gripper] = opening
-        return q
-
-    def trajectory(self, keyframes: Keyframes) -> PiecewisePolynomial:
-        """The first-order hold from the start through ``keyframes``' successful keyframes."""
-        motion = self._config.motion
-        knots, lifted = [self._start], [False]
-        for q, ok, keypoint in zip(keyframes.positions, keyframes.success, keyframes.keypoints):
-            if not ok:
-                continue
-            if motion.closed_among_obstacles and keypoint.action not in ("start", *GRASP_ACTIONS):
-                q = self._with_gripper(q, GRIPPER_CLOSED)
-            elif keypoint.action == "target" and np.any(knots[-1][self._gripper] != q[self._gripper]):
-                knots.append(self._with_gripper(knots[-1], q[self._gripper][0]))  # open before sliding on
-                lifted.append(lifted[-1])
-            if np.max(np.abs(q - knots[-1])) > 1e-9:
-                knots.append(q)
-                lifted.append(keypoint.height is not None)  # lifted clear of the objects
-        if len(knots) == 1:
-            knots.append(self._start)  # hold the start
-            lifted.append(False)
-        times = [0.0]
-        tcp = [self.tcp_position(q) for q in knots]
-        for i in range(1, len(knots)):
-            joint_time = np.max(
-                np.abs(knots[i] - knots[i - 1]) / (motion.joint_speed_fraction * self._velocity_limits)
-            )
-            speed = motion.transit_speed if lifted[i] or lifted[i - 1] else motion.tcp_speed
-            tcp_time = np.linalg.norm(tcp[i] - tcp[i - 1]) / speed
-            times.append(times[-1] + max(motion.min_segment_duration, float(joint_time), float(tcp_time)))
-        return PiecewisePolynomial.FirstOrderHold(times, np.column_stack(knots))
+        plant_context = self._plant_context(context)
+        solved = (self._solver.solve(plant_context, plan) for plan in plans)
+        output.set_value(tuple(self._solver.trajectory(plant_context, k) for k in solved if k.ok))
 
 
 __all__ = ["Keyframes", "KeypointIk"]

@@ -76,7 +76,7 @@ HOME_ARM_POSITIONS: tuple[float, ...] = (-0.2257, -0.9273, 1.9016, -0.9743, 1.34
 """Ready pose of the arm, elbow up: the tcp 0.81 m above the floor (0.06 m above a 0.75 m table top)
 and 1.10 m in front of the base's centre (on its centre line, 0.71 m ahead of the mount), pointing
 forward (+x) with the fingers opening sideways (y): the start posture for the default
-``WorldConfig().ik.start_reach``."""
+``Scenario().ik.start_reach``."""
 
 
 class JointLimits(NamedTuple):

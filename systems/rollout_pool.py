@@ -1,57 +1,64 @@
-"""``RolloutPool``: STO rollouts on one or several worker processes.
+"""``RolloutPool``: STO rollouts on one or several worker processes, owned and closed by the caller.
 
-Each worker process keeps pre-built ``SceneRollouts`` (one per scene and configuration, the latest
-few, each with its full and reduced ``RolloutWorld``s), so a rollout only swaps a trajectory and
-resets a context. With one worker the rollouts run in this process. The results are the same in both
-cases: a rollout is a pure function of the scene, the configuration and the sequence.
+The pool keeps pre-built ``SceneRollouts`` (one per scenario, keyed by ``Scenario.key``, the latest
+few, each with its full and reduced ``RolloutWorld``s): with one worker in the pool itself, with
+several in each worker process, which receives the scenario as YAML text once per task and builds
+its worlds on first use. A rollout then only swaps a trajectory and resets a context. The results
+are the same either way: a rollout is a pure function of the scenario and the sequence.
 """
 
 from __future__ import annotations
 
-import hashlib
 import multiprocessing
 import time
 from collections import OrderedDict
+from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
-from typing import Self
+from typing import TYPE_CHECKING, Self
 
-from hlp_drake.scene.model import Scene
 from hlp_drake.systems.control_sequence import ControlSequence
-from hlp_drake.systems.world_config import WorldConfig, dump_world_config, load_world_config
+from hlp_drake.systems.rollout_cost import RolloutOutcome
 
-_WORLDS_KEPT = 2
-_worlds: OrderedDict = OrderedDict()  # per process: key -> SceneRollouts
+if TYPE_CHECKING:
+    from hlp_drake.systems.scenario import Scenario
+    from hlp_drake.systems.scene_rollouts import SceneRollouts
 
-
-def _world_key(scene: Scene, config_yaml: str) -> str:
-    return hashlib.sha256(repr(scene).encode() + config_yaml.encode()).hexdigest()
-
-
-def _world(scene: Scene, config_yaml: str, config: WorldConfig | None = None):
-    """This process's ``SceneRollouts`` for ``scene`` and the configuration (built on first use)."""
-    from hlp_drake.systems.rollout import SceneRollouts
-
-    key = _world_key(scene, config_yaml)
-    if key not in _worlds:
-        _worlds[key] = SceneRollouts(scene, config if config is not None else load_world_config(overrides=config_yaml))
-        while len(_worlds) > _WORLDS_KEPT:
-            _worlds.popitem(last=False)
-    _worlds.move_to_end(key)
-    return _worlds[key]
+WORLDS_KEPT = 2
+"""Scenarios whose rollout worlds a pool (or a worker process) keeps."""
 
 
-def forget_worlds() -> None:
-    """Drop this process's pre-built rollout worlds (so the next optimisation builds its own, as a
-    first run would: comparisons must not hand one planner the worlds another one built)."""
-    _worlds.clear()
+class _Worlds:
+    """``SceneRollouts`` by scenario key, the latest ``WORLDS_KEPT``, built on first use."""
+
+    def __init__(self) -> None:
+        self._kept: OrderedDict[str, SceneRollouts] = OrderedDict()
+
+    def get(self, key: str, make: Callable[[], Scenario]) -> SceneRollouts:
+        from hlp_drake.systems.scene_rollouts import SceneRollouts
+
+        if key not in self._kept:
+            self._kept[key] = SceneRollouts(make())
+            while len(self._kept) > WORLDS_KEPT:
+                self._kept.popitem(last=False)
+        self._kept.move_to_end(key)
+        return self._kept[key]
+
+    def clear(self) -> None:
+        self._kept.clear()
 
 
-def _rollout_task(scene: Scene, config_yaml: str, times, knots):
-    return _world(scene, config_yaml).rollout(ControlSequence(times, knots))
+_worker_worlds = _Worlds()  # in a worker process: its worlds, for the pool that spawned it
+
+
+def _rollout_task(key: str, scenario_yaml: str, times, knots) -> RolloutOutcome:
+    from hlp_drake.systems.scenario import load_scenario
+
+    world = _worker_worlds.get(key, lambda: load_scenario(data=scenario_yaml))
+    return world.rollout(ControlSequence(times, knots))
 
 
 def _warm_up(delay: float) -> int:
-    import hlp_drake.systems.rollout  # noqa: F401  (imports Drake once per worker)
+    import hlp_drake.systems.scene_rollouts  # noqa: F401  (imports Drake once per worker)
 
     time.sleep(delay)
     return multiprocessing.current_process().pid
@@ -60,36 +67,56 @@ def _warm_up(delay: float) -> int:
 class RolloutPool:
     """Rolls out control sequences on ``workers`` processes (1: in this process).
 
-    Use as a context manager, or call ``close()``; one pool can serve many scenes in turn.
+    Use as a context manager, or call ``close()``; one pool can serve many scenarios in turn.
+
+    Args:
+        workers: rollout processes (1: roll out here).
+        on_rollout: called with every rollout's outcome as it arrives (e.g. to show progress).
+
+    Attributes:
+        startup_s: how long starting the worker processes took, s.
     """
 
-    def __init__(self, workers: int = 1) -> None:
+    def __init__(
+        self, workers: int = 1, *, on_rollout: Callable[[RolloutOutcome], None] | None = None
+    ) -> None:
         if workers < 1:
             raise ValueError(f"workers must be >= 1, got {workers}")
         self.workers = int(workers)
         self.startup_s = 0.0
+        self._on_rollout = on_rollout
+        self._worlds = _Worlds()
         self._executor: ProcessPoolExecutor | None = None
         if self.workers > 1:
             started = time.perf_counter()
-            self._executor = ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("spawn"))
+            self._executor = ProcessPoolExecutor(
+                self.workers, mp_context=multiprocessing.get_context("spawn")
+            )
             # Start every worker (and import Drake there) now, not inside the first optimisation.
             list(self._executor.map(_warm_up, [0.2] * self.workers))
             self.startup_s = time.perf_counter() - started
 
-    def world(self, scene: Scene, config: WorldConfig):
-        """This process's pre-built ``SceneRollouts`` for ``scene`` (for start checks and in-process rollouts)."""
-        return _world(scene, dump_world_config(config), config)
+    def world(self, scenario: Scenario) -> SceneRollouts:
+        """This pool's pre-built ``SceneRollouts`` for ``scenario`` (for start checks and in-process rollouts)."""
+        return self._worlds.get(scenario.key, lambda: scenario)
 
-    def rollouts(self, scene: Scene, config: WorldConfig, sequences: list[ControlSequence]) -> list:
+    def rollouts(self, scenario: Scenario, sequences: list[ControlSequence]) -> list[RolloutOutcome]:
         """The ``RolloutOutcome`` of every sequence, in order."""
-        config_yaml = dump_world_config(config)
         if self._executor is None:
-            world = _world(scene, config_yaml, config)
-            return [world.rollout(sequence) for sequence in sequences]
-        futures = [self._executor.submit(_rollout_task, scene, config_yaml, s.times, s.knots) for s in sequences]
-        return [future.result() for future in futures]
+            world = self.world(scenario)
+            return [self._arrived(world.rollout(sequence)) for sequence in sequences]
+        key, text = scenario.key, scenario.yaml
+        futures = [self._executor.submit(_rollout_task, key, text, s.times, s.knots) for s in sequences]
+        return [self._arrived(future.result()) for future in futures]
+
+    def _arrived(self, outcome: RolloutOutcome) -> RolloutOutcome:
+        if self._on_rollout is not None:
+            self._on_rollout(outcome)
+        return outcome
 
     def close(self) -> None:
+        """Stop the worker processes and drop the worlds."""
+        self._worlds.clear()
         if self._executor is not None:
             self._executor.shutdown(cancel_futures=True)
             self._executor = None

@@ -4,7 +4,7 @@ Everything is built programmatically (no model files). The table is a box ``leng
 table_thickness`` whose top surface is at the table's height, welded to the world; it has no legs,
 so the robot's base may drive under its top. Every scene object becomes a model instance and a
 body, both named after the object, with a box or cylinder for collision and illustration. The
-objects' masses follow a density, clipped to a range (``SceneModelConfig``).
+objects' masses follow a density, clipped to a range (``BodiesConfig``).
 
 Contact (point contact, see the project's Drake notes section F): every collision geometry gets an
 explicit stiffness and dissipation, and each object carries small contact spheres in its corners
@@ -27,7 +27,7 @@ from pydrake.multibody.tree import ModelInstanceIndex, RigidBody, SpatialInertia
 from pydrake.systems.framework import Context
 
 from hlp_drake.scene.model import Scene, SceneObject
-from hlp_drake.systems.world_config import ContactConfig, SceneModelConfig, WorldConfig
+from hlp_drake.systems.world_settings import BodiesConfig, ContactConfig
 
 TABLE_NAME = "table"
 TABLE_COLOR = np.array([0.55, 0.40, 0.25, 1.0])
@@ -57,7 +57,7 @@ class SceneModels:
         return tuple(self.objects)
 
 
-def object_mass(obj: SceneObject, config: SceneModelConfig) -> float:
+def object_mass(obj: SceneObject, config: BodiesConfig) -> float:
     """The object's mass, kg: its volume times the density, clipped to the configured range."""
     sx, sy, height = obj.size
     volume = math.pi * (sx / 2.0) ** 2 * height if obj.shape == "cylinder" else sx * sy * height
@@ -104,7 +104,8 @@ def _support_points(obj: SceneObject, contact: ContactConfig) -> list[np.ndarray
 def _add_object(
     plant: MultibodyPlant,
     obj: SceneObject,
-    config: WorldConfig,
+    contact: ContactConfig,
+    bodies: BodiesConfig,
     *,
     color: np.ndarray,
     support_spheres: bool = True,
@@ -113,7 +114,7 @@ def _add_object(
     if obj.shape not in ("box", "cylinder"):
         raise ValueError(f"object {obj.name!r} has unknown shape {obj.shape!r}")
     instance = plant.AddModelInstance(obj.name)
-    mass = object_mass(obj, config.scene)
+    mass = object_mass(obj, bodies)
     if obj.shape == "box":
         shape = Box(sx, sy, height)
         unit_inertia = UnitInertia.SolidBox(sx, sy, height)
@@ -121,11 +122,11 @@ def _add_object(
         shape = Cylinder(sx / 2.0, height)
         unit_inertia = UnitInertia.SolidCylinder(sx / 2.0, height, [0.0, 0.0, 1.0])
     body = plant.AddRigidBody(obj.name, instance, SpatialInertia(mass, np.zeros(3), unit_inertia))
-    properties = _contact_properties(config.contact, config.contact.object_friction)
+    properties = _contact_properties(contact, contact.object_friction)
     plant.RegisterCollisionGeometry(body, RigidTransform(), shape, f"{obj.name}_collision", properties)
     plant.RegisterVisualGeometry(body, RigidTransform(), shape, f"{obj.name}_visual", color)
-    sphere = Sphere(config.contact.corner_sphere_radius) if config.contact.corner_sphere_radius > 0 else None
-    for index, centre in enumerate(_support_points(obj, config.contact) if support_spheres else []):
+    sphere = Sphere(contact.corner_sphere_radius) if contact.corner_sphere_radius > 0 else None
+    for index, centre in enumerate(_support_points(obj, contact) if support_spheres else []):
         plant.RegisterCollisionGeometry(
             body, RigidTransform(centre), sphere, f"{obj.name}_support_{index}", properties
         )
@@ -135,22 +136,25 @@ def _add_object(
 def add_scene(
     plant: MultibodyPlant,
     scene: Scene,
-    config: WorldConfig | None = None,
     *,
+    contact: ContactConfig | None = None,
+    bodies: BodiesConfig | None = None,
     weld_objects: bool = False,
     welded_objects: Iterable[str] = (),
+    with_objects: bool = True,
 ) -> SceneModels:
     """Add ``scene``'s table and objects to ``plant`` (not yet finalized).
 
     Args:
         plant: the plant; it must be registered with a SceneGraph for the geometry.
         scene: the scene.
-        config: contact and model settings (``WorldConfig()`` by default).
+        contact, bodies: contact materials and body settings (a ``Scenario``'s; the defaults by default).
         weld_objects: weld the objects to the world at their scene poses (a planning model) instead
             of leaving them free.
         welded_objects: names of objects to weld at their scene poses while the others stay free
             (objects a motion cannot reach, to shrink a simulation's contact problem); they get no
             support spheres (they rest on nothing, and their shape holds the spheres anyway).
+        with_objects: False adds the table only (``SceneModels.objects`` is then empty).
 
     Returns:
         The model instances; the objects' free-body default poses are their scene poses.
@@ -159,7 +163,8 @@ def add_scene(
         ValueError: an object's name is taken by another model instance of the plant, the plant
             is finalized, or ``welded_objects`` names an object the scene does not have.
     """
-    config = WorldConfig() if config is None else config
+    contact = ContactConfig() if contact is None else contact
+    bodies = BodiesConfig() if bodies is None else bodies
     if plant.is_finalized():
         raise ValueError("add_scene needs a plant that is not finalized yet")
     names = [obj.name for obj in scene.objects]
@@ -173,7 +178,7 @@ def add_scene(
         if plant.HasModelInstanceNamed(name):
             raise ValueError(f"the plant already has a model instance named {name!r}")
     table = scene.table
-    thickness = config.scene.table_thickness
+    thickness = bodies.table_thickness
     table_instance = plant.AddModelInstance(TABLE_NAME)
     box = Box(table.length, table.width, thickness)
     table_body = plant.AddRigidBody(
@@ -186,15 +191,15 @@ def add_scene(
         table_body.body_frame(),
         RigidTransform([table.length / 2.0, 0.0, table.height - thickness / 2.0]),
     )
-    properties = _contact_properties(config.contact, config.contact.table_friction)
+    properties = _contact_properties(contact, contact.table_friction)
     plant.RegisterCollisionGeometry(table_body, RigidTransform(), box, "table_top_collision", properties)
     plant.RegisterVisualGeometry(table_body, RigidTransform(), box, "table_top_visual", TABLE_COLOR)
 
     objects: dict[str, ModelInstanceIndex] = {}
-    for obj in scene.objects:
+    for obj in scene.objects if with_objects else ():
         color = TARGET_COLOR if obj is scene.target else OBSTACLE_COLOR
         instance, body = _add_object(
-            plant, obj, config, color=color, support_spheres=weld_objects or obj.name not in welded
+            plant, obj, contact, bodies, color=color, support_spheres=weld_objects or obj.name not in welded
         )
         objects[obj.name] = instance
         X_WO = object_pose(obj, table.height)

@@ -1,6 +1,6 @@
 """The simulated world: the mobile UR5, a scene's table and free objects, and the robot's PD control.
 
-``make_world_diagram(scene, config)`` returns a Diagram named ``world`` with these exported ports:
+``make_world_diagram(scenario)`` returns a Diagram named ``world`` with these exported ports:
 
 Input:
     ``robot.desired_state`` (20): desired positions then velocities of the robot's 10 actuated joints
@@ -18,24 +18,18 @@ Outputs:
 
 The plant is the subsystem ``plant`` (``world.GetSubsystemByName("plant")``) and the SceneGraph
 ``scene_graph``; the robot is the model instance ``ROBOT_MODEL_NAME``. The default context has the
-robot in ``start_configuration(scene, ...)`` and every object at rest on the table at its scene pose.
-
-Frames and start pose: the world frame is the scene's (z up, x into the table from the middle of its
-front edge). The robot's base starts in front of the table facing +x; at the start the gripper
-points along +x (horizontal approach), fingers opening along y, its tcp above ``scene.start`` at
-``config.ik.height`` above the table top (``scene.start_yaw`` is not used: the gripper faces +x).
+robot in ``start_configuration`` (``hlp_drake.systems.start_pose``) and every object at rest on the
+table at its scene pose.
 """
 
 from __future__ import annotations
 
-import functools
-import math
 from collections.abc import Iterable
+from typing import TYPE_CHECKING
 
 import numpy as np
 from pydrake.geometry import (
     Meshcat,
-    MeshcatParams,
     MeshcatVisualizer,
     MeshcatVisualizerParams,
     ProximityProperties,
@@ -43,188 +37,33 @@ from pydrake.geometry import (
     RoleAssign,
     SceneGraph,
 )
-from pydrake.math import RotationMatrix
-from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.multibody.meshcat import ContactVisualizer, ContactVisualizerParams
-from pydrake.multibody.plant import (
-    AddMultibodyPlant,
-    AddMultibodyPlantSceneGraph,
-    CoulombFriction,
-    MultibodyPlant,
-)
+from pydrake.multibody.plant import AddMultibodyPlant, CoulombFriction, MultibodyPlant
 from pydrake.multibody.tree import JointActuatorIndex, ModelInstanceIndex, PdControllerGains
-from pydrake.solvers import SnoptSolver, Solve, SolverOptions
 from pydrake.systems.controllers import InverseDynamics
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import MatrixGain, TrajectorySource
 from pydrake.trajectories import Trajectory
 
-from hlp_drake.errors import HlpError
-from hlp_drake.scene.model import Scene
-from hlp_drake.systems.robot import (
-    ARM_JOINTS,
-    BASE_FOOTPRINT,
-    BASE_JOINTS,
-    GRIPPER_JOINTS,
-    GRIPPER_MIMIC_JOINTS,
-    GRIPPER_OPEN,
-    HOME_ARM_POSITIONS,
-    ROBOT_MODEL_NAME,
-    TCP_FRAME,
-    add_robot,
-)
-from hlp_drake.systems.scene_models import SceneModels, add_scene
-from hlp_drake.systems.world_config import ControlConfig, WorldConfig
+from hlp_drake.systems.robot import ARM_JOINTS, BASE_JOINTS, GRIPPER_JOINTS, ROBOT_MODEL_NAME, add_robot
+from hlp_drake.systems.scene_models import add_scene
+from hlp_drake.systems.start_pose import robot_position_names, start_configuration
+from hlp_drake.systems.world_settings import ContactConfig, ControlConfig
+
+if TYPE_CHECKING:
+    from hlp_drake.systems.scenario import Scenario
 
 GRIPPER_BODIES = ("gripper_base_link", "left_finger_link", "right_finger_link")
 WRIST_JOINTS = ARM_JOINTS[3:]
 DESIRED_STATE_PORT = "robot.desired_state"
 
 
-def robot_position_names() -> tuple[str, ...]:
-    """The joints of the robot's 11 positions, in model-instance order: the 10 actuated, then the mimic."""
-    return BASE_JOINTS + ARM_JOINTS + GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS
-
-
-# --- Start pose ---------------------------------------------------------------------------------------
-
-
-def robot_base_pose(scene: Scene, config: WorldConfig | None = None) -> tuple[float, float, float]:
-    """(x, y, yaw) of the base at the start: in front of the table, facing +x, behind ``scene.start``.
-
-    The base's centre stands ``config.ik.start_reach`` behind the start point on its line, but never
-    closer to the table than ``config.ik.start_base_clearance`` (its front edge then stays at
-    x <= -clearance, outside the table's footprint).
-    """
-    config = WorldConfig() if config is None else config
-    start_x, start_y = scene.start
-    x = min(start_x - config.ik.start_reach, -(BASE_FOOTPRINT[0] / 2.0 + config.ik.start_base_clearance))
-    return (float(x), float(start_y), 0.0)
-
-
-def tcp_rotation(approach_yaw: float = 0.0) -> RotationMatrix:
-    """The gripper's keypoint orientation: tcp +z horizontal at heading ``approach_yaw`` (0: +x),
-    tcp +y horizontal (fingers open sideways), tcp +x pointing down."""
-    c, s = math.cos(approach_yaw), math.sin(approach_yaw)
-    z = np.array([c, s, 0.0])
-    y = np.array([-s, c, 0.0])
-    return RotationMatrix(np.column_stack([np.cross(y, z), y, z]))
-
-
-def tcp_keypoint_height(scene: Scene, config: WorldConfig) -> float:
-    """World z of the tcp at the keypoints."""
-    return scene.table.height + config.ik.height
-
-
-@functools.lru_cache(maxsize=1)
-def kinematic_robot() -> tuple[MultibodyPlant, ModelInstanceIndex]:
-    """A robot-only continuous plant for kinematics (built once, shared; do not modify it)."""
-    plant = MultibodyPlant(time_step=0.0)
-    instance = add_robot(plant)
-    plant.Finalize()
-    return plant, instance
-
-
-def _to_plant_order(
-    plant: MultibodyPlant, instance: ModelInstanceIndex, values: dict[str, float]
-) -> np.ndarray:
-    """The robot's positions in ``plant``'s own order for ``instance``, from joint names."""
-    starts = np.arange(plant.num_positions())
-    instance_starts = plant.GetPositionsFromArray(instance, starts)
-    local = {int(index): i for i, index in enumerate(instance_starts)}
-    q = np.zeros(len(instance_starts))
-    for name, value in values.items():
-        q[local[plant.GetJointByName(name, instance).position_start()]] = value
-    return q
-
-
-def ik_solver_options(max_iterations: int) -> SolverOptions:
-    options = SolverOptions()
-    snopt = SnoptSolver().solver_id()
-    options.SetOption(snopt, "Major iterations limit", int(max_iterations))
-    options.SetOption(snopt, "Iterations limit", int(50 * max_iterations))
-    return options
-
-
-def start_configuration(
-    scene: Scene,
-    plant: MultibodyPlant,
-    instance: ModelInstanceIndex,
-    *,
-    config: WorldConfig | None = None,
-) -> np.ndarray:
-    """The robot's 11 start positions, in ``plant``'s order for ``instance`` (as ``SetPositions`` takes them).
-
-    The base stands at ``robot_base_pose(scene, config)``; the arm (solved by IK on a robot-only
-    kinematic model, seeded and regularised towards the ready pose ``HOME_ARM_POSITIONS``) puts the
-    tcp above ``scene.start`` at ``config.ik.height`` above the table top, pointing along +x with
-    the fingers opening along y; the gripper is open.
-
-    Raises:
-        HlpError: the start point is out of the arm's reach from that base pose.
-    """
-    config = WorldConfig() if config is None else config
-    base = robot_base_pose(scene, config)
-    arm = _start_arm(
-        round(base[0] - scene.start[0], 9),
-        round(tcp_keypoint_height(scene, config), 9),
-        config.ik.max_iterations,
-    )
-    if arm is None:
-        raise HlpError(
-            f"scene {scene.name or '<unnamed>'}: the arm cannot put the tcp above the start "
-            f"{tuple(scene.start)} at height {tcp_keypoint_height(scene, config):.3f} m "
-            f"from the base pose {base}"
-        )
-    values = dict(zip(BASE_JOINTS + ARM_JOINTS, (*base, *arm)))
-    values.update({name: GRIPPER_OPEN for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS})
-    return _to_plant_order(plant, instance, values)
-
-
-@functools.lru_cache(maxsize=64)
-def _start_arm(base_offset_x: float, tcp_z: float, max_iterations: int) -> tuple[float, ...] | None:
-    """Arm angles putting the tcp ``-base_offset_x`` ahead of the base at height ``tcp_z`` (cached)."""
-    plant, instance = kinematic_robot()
-    context = plant.CreateDefaultContext()
-    ik = InverseKinematics(plant, context, with_joint_limits=True)
-    q = ik.q()
-    seed = _to_plant_order(
-        plant,
-        instance,
-        {
-            **dict(zip(BASE_JOINTS + ARM_JOINTS, (0.0, 0.0, 0.0, *HOME_ARM_POSITIONS))),
-            **{name: GRIPPER_OPEN for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS},
-        },
-    )
-    fixed = np.full(len(seed), True)
-    for name in ARM_JOINTS:
-        fixed[plant.GetJointByName(name, instance).position_start()] = False
-    prog = ik.get_mutable_prog()
-    prog.AddBoundingBoxConstraint(seed[fixed], seed[fixed], q[fixed])
-    tcp = plant.GetFrameByName(TCP_FRAME, instance)
-    target = np.array([-base_offset_x, 0.0, tcp_z])
-    ik.AddPositionConstraint(tcp, np.zeros(3), plant.world_frame(), target - 1e-4, target + 1e-4)
-    ik.AddOrientationConstraint(plant.world_frame(), tcp_rotation(0.0), tcp, RotationMatrix(), 1e-3)
-    prog.AddQuadraticErrorCost(np.eye(int(np.sum(~fixed))), seed[~fixed], q[~fixed])
-    result = Solve(prog, seed, ik_solver_options(max_iterations))
-    if not result.is_success():
-        return None
-    solution = result.GetSolution(q)
-    return tuple(
-        float(solution[plant.GetJointByName(name, instance).position_start()]) for name in ARM_JOINTS
-    )
-
-
-# --- Diagram ------------------------------------------------------------------------------------------
-
-
 def _set_robot_contact(
-    plant: MultibodyPlant, scene_graph: SceneGraph, instance: ModelInstanceIndex, config: WorldConfig
+    plant: MultibodyPlant, scene_graph: SceneGraph, instance: ModelInstanceIndex, contact: ContactConfig
 ) -> None:
     """Give every robot collision geometry the configured stiffness and dissipation, and the gripper
     its friction (the other links keep the model's friction)."""
     inspector = scene_graph.model_inspector()
-    contact = config.contact
     for body_index in plant.GetBodyIndices(instance):
         body = plant.get_body(body_index)
         for geometry in plant.GetCollisionGeometriesForBody(body):
@@ -327,33 +166,33 @@ def _add_gravity_compensation(
 
 
 def make_world_diagram(
-    scene: Scene,
-    config: WorldConfig | None = None,
+    scenario: Scenario,
     *,
     meshcat: Meshcat | None = None,
+    contact_forces: bool = False,
     welded_objects: Iterable[str] = (),
 ) -> Diagram:
-    """Build the world for ``scene``: see the module's docstring for the ports.
+    """Build the world of ``scenario`` (its scene, plant, contact, bodies, controller and start pose):
+    see the module's docstring for the ports.
 
     Args:
-        scene: the table, start, target and obstacles.
-        config: plant, contact, model and control settings (``WorldConfig()`` by default).
-        meshcat: if given, illustration geometry and contact forces are drawn there.
+        meshcat: if given, the illustration geometry is drawn there ...
+        contact_forces: ... and, if this is set, the contact forces (1 cm per 5 N).
         welded_objects: names of scene objects welded to the world at their scene poses instead of
             free (a reduced model: they neither move nor join the contact problem with the table);
             ``state`` then holds only the free objects' states.
     """
-    config = WorldConfig() if config is None else config
+    scene = scenario.scene
     builder = DiagramBuilder()
-    plant, scene_graph = AddMultibodyPlant(config.plant, builder)
+    plant, scene_graph = AddMultibodyPlant(scenario.plant, builder)
     instance = add_robot(plant)
-    _set_robot_contact(plant, scene_graph, instance, config)
-    _set_pd_gains(plant, instance, config.control)
-    add_scene(plant, scene, config, welded_objects=welded_objects)
+    _set_robot_contact(plant, scene_graph, instance, scenario.contact)
+    _set_pd_gains(plant, instance, scenario.controller)
+    add_scene(plant, scene, contact=scenario.contact, bodies=scenario.bodies, welded_objects=welded_objects)
     plant.Finalize()
-    plant.SetDefaultPositions(instance, start_configuration(scene, plant, instance, config=config))
+    plant.SetDefaultPositions(instance, start_configuration(scene, scenario.ik, plant, instance))
 
-    if config.control.gravity_compensation:
+    if scenario.controller.gravity_compensation:
         _add_gravity_compensation(builder, plant, instance)
     builder.ExportInput(plant.get_desired_state_input_port(instance), DESIRED_STATE_PORT)
     builder.ExportOutput(plant.get_state_output_port(instance), "robot.state")
@@ -365,7 +204,10 @@ def make_world_diagram(
         MeshcatVisualizer.AddToBuilder(
             builder, scene_graph, meshcat, MeshcatVisualizerParams(role=Role.kIllustration)
         )
-        ContactVisualizer.AddToBuilder(builder, plant, meshcat, ContactVisualizerParams())
+        if contact_forces:
+            ContactVisualizer.AddToBuilder(
+                builder, plant, meshcat, ContactVisualizerParams(newtons_per_meter=500.0, radius=0.002)
+            )
     diagram = builder.Build()
     diagram.set_name("world")
     return diagram
@@ -396,68 +238,12 @@ def add_position_trajectory(
     return source
 
 
-def start_meshcat(config: WorldConfig) -> Meshcat | None:
-    """A MeshCat server on localhost when ``config.meshcat`` is on, else None."""
-    return Meshcat(MeshcatParams(host="localhost")) if config.meshcat else None
-
-
-# --- Planning model -----------------------------------------------------------------------------------
-
-
-class PlanningModel:
-    """Robot + table + objects welded at their scene poses, for kinematics (IK, distance queries).
-
-    A continuous plant (no dynamics) with its SceneGraph in a Diagram, and one context, created here.
-
-    Attributes:
-        diagram, plant, scene_graph: the model.
-        robot: the robot's model instance.
-        scene_models: the table's and objects' model instances.
-        context, plant_context: the model's own context and the plant's part of it.
-    """
-
-    def __init__(self, scene: Scene, config: WorldConfig | None = None) -> None:
-        config = WorldConfig() if config is None else config
-        builder = DiagramBuilder()
-        plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-        self.robot = add_robot(plant)
-        self.scene_models: SceneModels = add_scene(plant, scene, config, weld_objects=True)
-        plant.Finalize()
-        self.diagram = builder.Build()
-        self.diagram.set_name("planning_model")
-        self.plant: MultibodyPlant = plant
-        self.scene_graph: SceneGraph = scene_graph
-        self.context = self.diagram.CreateDefaultContext()
-        self.plant_context = plant.GetMyMutableContextFromRoot(self.context)
-
-    def robot_geometries(self) -> list:
-        return [
-            geometry
-            for body in self.plant.GetBodyIndices(self.robot)
-            for geometry in self.plant.GetCollisionGeometriesForBody(self.plant.get_body(body))
-        ]
-
-    def object_geometries(self) -> list:
-        return [
-            geometry
-            for instance in self.scene_models.objects.values()
-            for body in self.plant.GetBodyIndices(instance)
-            for geometry in self.plant.GetCollisionGeometriesForBody(self.plant.get_body(body))
-        ]
-
-
 __all__ = [
     "DESIRED_STATE_PORT",
-    "PlanningModel",
     "actuated_state_selector",
     "add_position_trajectory",
     "desired_state_from_robot_state",
     "make_world_diagram",
-    "robot_base_pose",
     "robot_position_names",
-    "start_configuration",
-    "start_meshcat",
-    "tcp_keypoint_height",
-    "tcp_rotation",
     "world_plant",
 ]

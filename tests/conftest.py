@@ -70,7 +70,9 @@ def dataset(dataset_path: Path):
     return Dataset(dataset_path, progress=False)
 
 
-def run_module(module: str, *args: str, cwd: Path | None = None, env: dict | None = None) -> subprocess.CompletedProcess:
+def run_module(
+    module: str, *args: str, cwd: Path | None = None, env: dict | None = None
+) -> subprocess.CompletedProcess:
     """Run ``python -m module args`` in a subprocess and capture its output."""
     return subprocess.run(
         [sys.executable, "-m", module, *args],

@@ -27,8 +27,10 @@ from hlp_drake.experiments.cli import main
 from hlp_drake.experiments.results import COLUMNS, read_results, results_csv, write_durable
 from hlp_drake.experiments.summary import summarise
 
+# fmt: off
 REQUIRED_COLUMNS = ["scene", "objects", "planner", "success", "failure_reason", "init_s", "optimise_s",
                     "total_s", "rollouts", "objects_moved", "objects_dropped"]
+# fmt: on
 OUTPUTS = ("results.csv", "config.json", "run.json", "summary.md", "summary.json", "success.png", "times.png")
 
 
@@ -37,11 +39,19 @@ def cheap_job(job: Job) -> dict:
     rng = random.Random(f"{job.scene}/{job.planner}")
     scene = job.make_scene()
     success = rng.random() < (0.9 if job.planner == "hlp" else 0.7)
-    return make_row(job, success=success, failure_reason=None if success else "the target is out of reach",
-                    plan_s=rng.uniform(0.01, 0.1), ik_s=rng.uniform(0.1, 0.5),
-                    optimise_s=rng.uniform(0.5, 2.0) * (1 if job.planner == "hlp" else 10),
-                    execute_s=rng.uniform(2, 4), rollouts=rng.randint(8, 80), iterations=rng.randint(1, 10),
-                    objects_moved=rng.randint(0, len(scene.obstacles)), objects_dropped=int(not success))
+    return make_row(
+        job,
+        success=success,
+        failure_reason=None if success else "the target is out of reach",
+        plan_s=rng.uniform(0.01, 0.1),
+        ik_s=rng.uniform(0.1, 0.5),
+        optimise_s=rng.uniform(0.5, 2.0) * (1 if job.planner == "hlp" else 10),
+        execute_s=rng.uniform(2, 4),
+        rollouts=rng.randint(8, 80),
+        iterations=rng.randint(1, 10),
+        objects_moved=rng.randint(0, len(scene.obstacles)),
+        objects_dropped=int(not success),
+    )
 
 
 class RecordingJob:
@@ -102,10 +112,13 @@ def assert_well_formed(path: Path) -> list[dict[str, str]]:
 def test_csv_has_the_columns_one_row_per_scene_and_planner_sorted(tmp_path):
     summary = run_experiment(settings("gen2", scenes=2, objects=(4, 3)), tmp_path, job=cheap_job)
     rows = assert_well_formed(tmp_path / "results.csv")
-    assert list(rows[0])[:len(REQUIRED_COLUMNS)] == REQUIRED_COLUMNS and list(rows[0])[-1] == "execute_s"
+    assert list(rows[0])[: len(REQUIRED_COLUMNS)] == REQUIRED_COLUMNS and list(rows[0])[-1] == "execute_s"
     assert [(r["scene"], r["objects"], r["seed"], r["planner"]) for r in rows] == [
         (f"gen2-{n}-{seed}", str(n), str(seed), planner)
-        for n in (3, 4) for seed in (10, 11) for planner in ("hlp", "sto")]
+        for n in (3, 4)
+        for seed in (10, 11)
+        for planner in ("hlp", "sto")
+    ]
     for row in rows:
         assert row["success"] in ("true", "false")
         assert (row["failure_reason"] == "") == (row["success"] == "true")
@@ -177,7 +190,8 @@ def test_local_pool_gives_the_same_results_as_in_process(tmp_path):
 
 def test_dask_gives_the_same_results_as_local(tmp_path):
     distributed = pytest.importorskip(
-        "distributed", reason='dask.distributed is not installed: pip install "hlp_drake[cluster]"')
+        "distributed", reason='dask.distributed is not installed: pip install "hlp_drake[cluster]"'
+    )
     run_experiment(settings(scenes=2), tmp_path / "local", job=cheap_job)
     run_experiment(settings(scenes=2, workers=2, executor="dask"), tmp_path / "dask", job=cheap_job)
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, dashboard_address=None) as cluster:
@@ -199,18 +213,21 @@ def test_a_different_run_in_the_directory_is_refused_unless_fresh(tmp_path, caps
     assert {name: (tmp_path / name).read_bytes() for name in OUTPUTS} == before
     assert run_cli(lambda a: main(a, job=cheap_job), [*argv, "--fresh"]) == 0
     assert [r["scene"] for r in read_rows(tmp_path / "results.csv")] == ["gen1-20"] * 2 + ["gen1-21"] * 2
-    with pytest.raises(HlpError, match="world config"):
+    with pytest.raises(HlpError, match="scenario"):
         run_experiment(settings(seed=20, config_yaml="motion: {tcp_speed: 0.05}"), tmp_path, job=cheap_job)
 
 
-@pytest.mark.parametrize("argv", [
-    ["gen1", "--scenes", "0"],
-    ["gen2", "--objects", "5", "0"],
-    ["gen3"],
-    ["gen1", "--workers", "0"],
-    ["gen1", "--scenes", "many"],
-    ["gen1", "--scheduler", "tcp://127.0.0.1:8786"],
-])
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["gen1", "--scenes", "0"],
+        ["gen2", "--objects", "5", "0"],
+        ["gen3"],
+        ["gen1", "--workers", "0"],
+        ["gen1", "--scenes", "many"],
+        ["gen1", "--scheduler", "tcp://127.0.0.1:8786"],
+    ],
+)
 def test_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, capsys, argv):
     out = tmp_path / "out"
     assert run_cli(lambda a: main(a, job=never_called), [*argv, "--out", str(out)]) == 2
@@ -240,11 +257,15 @@ def test_summary_matches_the_csv_and_shows_the_paper_numbers(tmp_path):
             assert stats["total_s"] == pytest.approx(group.total_s.mean(), abs=1e-4)
             assert stats["init_s"] + stats["optimise_s"] == pytest.approx(stats["total_s"], abs=2e-4)
             assert stats["paper"]["total_s"] is None
-        means = {p: frame[(frame.objects == condition["objects"]) & (frame.planner == p)].total_s.mean()
-                 for p in ("hlp", "sto")}
+        means = {
+            p: frame[(frame.objects == condition["objects"]) & (frame.planner == p)].total_s.mean()
+            for p in ("hlp", "sto")
+        }
         assert condition["hlp_to_sto_total"] == pytest.approx(means["hlp"] / means["sto"], rel=1e-3)
-    papers = {c["objects"]: tuple(c["planners"][p]["paper"]["success_pct"] for p in ("hlp", "sto"))
-              for c in summary["conditions"]}
+    papers = {
+        c["objects"]: tuple(c["planners"][p]["paper"]["success_pct"] for p in ("hlp", "sto"))
+        for c in summary["conditions"]
+    }
     assert papers == {5: (93.0, 96.0), 9: (95.0, 98.0)}
     markdown = (tmp_path / "summary.md").read_text()
     assert "| 5 objects | HLP | 4 |" in markdown and "(93)" in markdown and "n/a" in markdown
@@ -254,11 +275,32 @@ def test_summary_matches_the_csv_and_shows_the_paper_numbers(tmp_path):
 
 
 def test_gen1_summary_has_table_ii_paper_figures():
-    rows = [{"scene": f"gen1-{i}", "objects": 6, "planner": p, "success": i != 0, "failure_reason": None,
-             "init_s": 0.5, "optimise_s": 1.0 if p == "hlp" else 10.0, "total_s": 1.5 if p == "hlp" else 10.5,
-             "execute_s": 3.0} for i in range(4) for p in ("hlp", "sto")]
-    rows.append({**rows[0], "scene": "gen1-4", "success": False, "failure_reason": "crashed: RuntimeError: x",
-                 "init_s": float("nan"), "optimise_s": float("nan"), "total_s": float("nan")})
+    rows = [
+        {
+            "scene": f"gen1-{i}",
+            "objects": 6,
+            "planner": p,
+            "success": i != 0,
+            "failure_reason": None,
+            "init_s": 0.5,
+            "optimise_s": 1.0 if p == "hlp" else 10.0,
+            "total_s": 1.5 if p == "hlp" else 10.5,
+            "execute_s": 3.0,
+        }
+        for i in range(4)
+        for p in ("hlp", "sto")
+    ]
+    rows.append(
+        {
+            **rows[0],
+            "scene": "gen1-4",
+            "success": False,
+            "failure_reason": "crashed: RuntimeError: x",
+            "init_s": float("nan"),
+            "optimise_s": float("nan"),
+            "total_s": float("nan"),
+        }
+    )
     (condition,) = summarise("gen1", rows)["conditions"]
     hlp, sto = condition["planners"]["hlp"], condition["planners"]["sto"]
     assert hlp["paper"] == {"success_pct": 94.0, "init_s": 0.59, "optimise_s": 0.97, "total_s": 1.56}
@@ -279,8 +321,20 @@ def test_durable_write_leaves_the_old_file_when_it_fails(tmp_path, monkeypatch):
 
 
 def test_cli_fast_public_api(tmp_path, capsys):
-    argv = ["gen2", "--scenes", "2", "--objects", "3", "--seed", "5", "--workers", "1", "--quiet",
-            "--out", str(tmp_path)]
+    argv = [
+        "gen2",
+        "--scenes",
+        "2",
+        "--objects",
+        "3",
+        "--seed",
+        "5",
+        "--workers",
+        "1",
+        "--quiet",
+        "--out",
+        str(tmp_path),
+    ]
     assert run_cli(lambda a: main(a, job=cheap_job), argv) == 0
     printed = capsys.readouterr().out
     assert "Table III" in printed and "| 3 objects | HLP | 2 |" in printed and "summary.md" in printed
@@ -288,15 +342,26 @@ def test_cli_fast_public_api(tmp_path, capsys):
     assert run["command"].startswith("python -m hlp_drake.experiments gen2 --scenes 2")
     assert run["seeds"] == {"first": 5, "last": 6, "scenes": 2} and run["status"] == "complete"
     assert run["software"]["drake"] and run["software"]["numpy"] and run["machine"]["cpu_count"]
-    assert "sto:" in run["world_config"]
+    assert "optimiser:" in run["scenario"] and "scene:" in run["scenario"]
 
 
 def test_cli_end_to_end_with_the_real_planners(tmp_path):
-    config = tmp_path / "world.yaml"  # a small optimiser budget keeps the test's time bounded
-    config.write_text("sto:\n  max_iterations: 2\n  samples: 2\n  time_budget_s: 10.0\n  workers: 1\n")
+    config = tmp_path / "scenario.yaml"  # a small optimiser budget keeps the test's time bounded
+    config.write_text("optimiser:\n  max_iterations: 2\n  samples: 2\n  time_budget_s: 10.0\n  workers: 1\n")
     out = tmp_path / "out"
-    result = run_module("hlp_drake.experiments", "gen1", "--scenes", "1", "--workers", "1", "--quiet",
-                        "--config", str(config), "--out", str(out))
+    result = run_module(
+        "hlp_drake.experiments",
+        "gen1",
+        "--scenes",
+        "1",
+        "--workers",
+        "1",
+        "--quiet",
+        "--config",
+        str(config),
+        "--out",
+        str(out),
+    )
     assert result.returncode == 0, result.stderr
     rows = assert_well_formed(out / "results.csv")
     assert [(r["scene"], r["planner"]) for r in rows] == [("gen1-0", "hlp"), ("gen1-0", "sto")]
@@ -304,7 +369,7 @@ def test_cli_end_to_end_with_the_real_planners(tmp_path):
         assert not row["failure_reason"].startswith("crashed"), row["failure_reason"]
         assert float(row["init_s"]) > 0 and float(row["execute_s"]) > 0 and int(row["objects"]) == 6
         assert int(row["iterations"]) <= 2
-    assert "max_iterations: 2" in json.loads((out / "run.json").read_text())["world_config"]
+    assert "max_iterations: 2" in json.loads((out / "run.json").read_text())["scenario"]
     assert "Table II" in result.stdout and (out / "times.png").exists()
 
 
@@ -339,23 +404,20 @@ def test_rows_finishing_in_any_order_are_written_sorted(tmp_path):
 def test_a_drake_check_failing_in_a_job_is_that_jobs_crash_and_a_real_exit_is_not(monkeypatch):
     from hlp_drake.experiments.runner import run_job
     from hlp_drake.systems import execution
-    from hlp_drake.systems.world_config import WorldConfig, dump_world_config
+    from hlp_drake.systems.scenario import Scenario
 
-    job = Job("gen1", 0, 6, "gen1-0", "hlp", dump_world_config(WorldConfig()))
+    job = Job("gen1", 0, 6, "gen1-0", "hlp", Scenario().updated("optimiser: {workers: 1}").yaml)
 
-    from hlp_drake.systems import rollout_pool
-
-    rollout_pool._worlds["left by an earlier job"] = object()
-
-    def failing_check(*args, **kwargs):
-        assert not rollout_pool._worlds  # each job starts without another job's rollout worlds
+    def failing_check(scenario, *, pool, **kwargs):
+        assert scenario.scene.name == "gen1-0" and scenario.planner.kind == "hlp" and pool.workers == 1
         raise SystemExit("Failure at plant.h:1 in SetPositions(): condition 'AllFinite(q)' failed.")
 
     monkeypatch.setattr(execution, "plan_and_execute", failing_check)
     row = run_job(job)
     assert row["success"] is False and row["rollouts"] == 0
-    assert row["failure_reason"] == ("crashed: SystemExit: Failure at plant.h:1 in SetPositions(): "
-                                     "condition 'AllFinite(q)' failed.")
+    assert row["failure_reason"] == (
+        "crashed: SystemExit: Failure at plant.h:1 in SetPositions(): condition 'AllFinite(q)' failed."
+    )
 
     def exiting(*args, **kwargs):
         raise SystemExit(3)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -13,11 +14,22 @@ from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene, SceneObject, Table
 from hlp_drake.systems.keypoint_ik import Keyframes, KeypointIk
 from hlp_drake.systems.robot import BASE_FOOTPRINT, GRIPPER_CLOSED, GRIPPER_OPEN, TCP_FRAME
-from hlp_drake.systems.world import make_world_diagram, start_configuration, world_plant
-from hlp_drake.systems.world_config import WorldConfig
+from hlp_drake.systems.scenario import Scenario
+from hlp_drake.systems.start_pose import start_configuration
+from hlp_drake.systems.world import make_world_diagram, world_plant
 from hlp_drake.taskspace import TaskSpace
 
-CONFIG = WorldConfig()
+CONFIG = Scenario()
+
+
+def ik_for(scene: Scene, scenario: Scenario = CONFIG) -> KeypointIk:
+    return KeypointIk(replace(scenario, scene=scene))
+
+
+def solve(system: KeypointIk, plan: HighLevelPlan) -> Keyframes:
+    """The keyframes of ``plan``, solved directly (in a context of its own)."""
+    solver = system.solver
+    return solver.solve(solver.plant_context(solver.new_context()), plan)
 
 
 @pytest.fixture(scope="module")
@@ -27,7 +39,7 @@ def scene() -> Scene:
 
 @pytest.fixture(scope="module")
 def system(scene) -> KeypointIk:
-    return KeypointIk(scene, CONFIG)
+    return ik_for(scene)
 
 
 def gap_centres(scene: Scene) -> list[tuple[float, float]]:
@@ -78,7 +90,7 @@ def test_keyframes_put_the_tcp_on_every_waypoint(system, scene, solved):
     assert keyframes.success == (True,) * 3 and keyframes.messages == ("",) * 3
     assert keyframes.positions.shape == (3, 11)
     # Forward kinematics on the world's own plant, independent of the IK's planning model.
-    plant, robot = world_plant(make_world_diagram(scene, CONFIG))
+    plant, robot = world_plant(make_world_diagram(replace(CONFIG, scene=scene)))
     context = plant.CreateDefaultContext()
     tcp = plant.GetFrameByName(TCP_FRAME, robot)
     height = scene.table.height + CONFIG.ik.height
@@ -94,18 +106,19 @@ def test_keyframes_put_the_tcp_on_every_waypoint(system, scene, solved):
 
 def test_keyframes_respect_joint_limits_and_keep_the_gripper_open(system, solved):
     keyframes, _ = solved
-    plant = system.planning_model.plant
+    plant = system.solver.planning_model.plant
     lower, upper = plant.GetPositionLowerLimits(), plant.GetPositionUpperLimits()
     assert np.all(keyframes.positions >= lower - 1e-6) and np.all(keyframes.positions <= upper + 1e-6)
-    np.testing.assert_allclose(keyframes.positions[:, 9:], np.tile(system.start[9:], (3, 1)), atol=1e-9)
+    np.testing.assert_allclose(
+        keyframes.positions[:, 9:], np.tile(system.solver.start[9:], (3, 1)), atol=1e-9
+    )
     assert np.all(keyframes.positions[:, 0] < 0.0)  # the arm's mount stays in front of the table
 
 
 def test_trajectory_starts_at_the_start_and_passes_through_the_keyframes(system, scene, solved):
     keyframes, trajectory = solved
-    start = start_configuration(
-        scene, system.planning_model.plant, system.planning_model.robot, config=CONFIG
-    )
+    model = system.solver.planning_model
+    start = start_configuration(scene, CONFIG.ik, model.plant, model.robot)
     assert trajectory.start_time() == 0.0
     np.testing.assert_allclose(trajectory.value(0.0).ravel(), start, atol=1e-12)
     np.testing.assert_allclose(keyframes.positions[0], start, atol=1e-12)  # the "start" keypoint
@@ -124,7 +137,8 @@ def test_trajectory_starts_at_the_start_and_passes_through_the_keyframes(system,
     middle = 0.5 * (breaks[0] + breaks[1])
     np.testing.assert_allclose(
         trajectory.value(middle).ravel(),
-        0.5 * (trajectory.value(breaks[0]) + trajectory.value(breaks[1])).ravel(), atol=1e-9,
+        0.5 * (trajectory.value(breaks[0]) + trajectory.value(breaks[1])).ravel(),
+        atol=1e-9,
     )
 
 
@@ -151,9 +165,8 @@ def test_gripper_closes_among_the_obstacles_and_opens_before_the_target(system, 
     # The fingers' speed limit times the pace: no faster than the trajectory allows for any joint.
     assert breaks[3] - breaks[2] >= GRIPPER_OPEN / (CONFIG.motion.joint_speed_fraction * 0.075) - 1e-9
 
-    config = WorldConfig()
-    config.motion.closed_among_obstacles = False
-    _, open_all = evaluate(KeypointIk(scene, config), plan)
+    config = replace(CONFIG, motion=replace(CONFIG.motion, closed_among_obstacles=False))
+    _, open_all = evaluate(ik_for(scene, config), plan)
     assert len(open_all.get_segment_times()) == len(plan.keypoints)
     for t in open_all.get_segment_times():
         np.testing.assert_allclose(fingers(open_all, t), [GRIPPER_OPEN] * 2)
@@ -192,47 +205,50 @@ def test_unreachable_waypoint_is_reported_for_that_keypoint(system, scene):
     )
 
 
-def test_outputs_are_cached_until_the_plan_changes(scene):
-    system = KeypointIk(scene, CONFIG)
+def test_outputs_are_cached_until_the_plan_changes(system, scene):
     context = system.CreateDefaultContext()
     port = system.get_input_port(0)
     port.FixValue(context, through_gaps(scene, to_target=False))
-    first = system.GetOutputPort("keyframes").Eval(context)
-    system.GetOutputPort("trajectory").Eval(context)
-    second = system.GetOutputPort("keyframes").Eval(context)
-    system.GetOutputPort("trajectory").Eval(context)
-    assert system.num_solves == 1 and second is first
+    keyframes = system.GetOutputPort("keyframes")
+    first = keyframes.Eval(context)
+    trajectory = system.GetOutputPort("trajectory").Eval(context)
+    assert keyframes.Eval(context) is first and system.GetOutputPort("trajectory").Eval(context) is trajectory
     shorter = HighLevelPlan(scene=scene.name, keypoints=through_gaps(scene, to_target=False).keypoints[:2])
     port.FixValue(context, shorter)
-    assert len(system.GetOutputPort("keyframes").Eval(context).positions) == 2
-    assert system.num_solves == 2
+    assert len(keyframes.Eval(context).positions) == 2
+    assert system.num_abstract_states() == 0 and system.num_discrete_state_groups() == 0  # only Drake's cache
 
 
-def test_alternative_trajectories_are_solved_only_when_asked_for_and_like_the_plan(scene):
-    system = KeypointIk(scene, CONFIG)
+def test_alternative_trajectories_are_solved_only_when_asked_for_and_like_the_plan(system, scene):
     context = system.CreateDefaultContext()
+    port = system.GetOutputPort("alternative_trajectories")
     main, other = through_gaps(scene, to_target=True), through_gaps(scene, to_target=False)
     system.GetInputPort("plan").FixValue(context, main)
     system.GetInputPort("alternatives").FixValue(
-        context, (other, HighLevelPlan(scene=scene.name, keypoints=(), reason="no plan"), main))
+        context, (other, HighLevelPlan(scene=scene.name, keypoints=(), reason="no plan"), main)
+    )
     trajectory = system.GetOutputPort("trajectory").Eval(context)
-    assert system.num_solves == 1  # the alternatives are not solved for the plan's trajectory
-    alternatives = system.GetOutputPort("alternative_trajectories").Eval(context)
-    assert system.num_solves == 4 and len(alternatives) == 2  # the plan-less one has no trajectory
-    system.GetOutputPort("alternative_trajectories").Eval(context)
-    assert system.num_solves == 4  # cached
+    assert port.cache_entry().is_out_of_date(
+        context
+    )  # the alternatives are not solved for the plan's trajectory
+    alternatives = port.Eval(context)
+    assert len(alternatives) == 2  # the plan-less one has no trajectory
+    assert not port.cache_entry().is_out_of_date(context) and port.Eval(context) is alternatives  # cached
     _, expected = evaluate(system, other)
     for got, want in ((alternatives[0], expected), (alternatives[1], trajectory)):
         np.testing.assert_allclose(got.get_segment_times(), want.get_segment_times())
-        np.testing.assert_allclose(got.vector_values(got.get_segment_times()),
-                                   want.vector_values(want.get_segment_times()), atol=1e-9)
+        np.testing.assert_allclose(
+            got.vector_values(got.get_segment_times()),
+            want.vector_values(want.get_segment_times()),
+            atol=1e-9,
+        )
 
 
 def test_no_plan_and_wrong_scene_are_problems_not_successes(system, scene):
     keyframes, trajectory = evaluate(system, HighLevelPlan(scene=scene.name, keypoints=(), reason="no gap"))
     assert not keyframes.ok and "no gap" in keyframes.problems[0]
     np.testing.assert_allclose(
-        trajectory.value(trajectory.end_time()).ravel(), system.start
+        trajectory.value(trajectory.end_time()).ravel(), system.solver.start
     )  # holds the start
     other = HighLevelPlan(scene="another-scene", keypoints=through_gaps(scene, to_target=False).keypoints)
     keyframes, _ = evaluate(system, other)
@@ -261,12 +277,12 @@ def test_ik_reaches_the_target_of_generated_and_vr_scenes(kind, seed):
     """The target keypoint (0.53-0.86 m deep on 0.70-0.80 m tables) is reached straight from the start
     and through the rows' gaps."""
     scene = generate_scene(kind, seed)
-    system = KeypointIk(scene, CONFIG)
+    system = ik_for(scene)
     target = PlanKeypoint("target", scene.target.position, element=scene.target.name)
     direct = HighLevelPlan(scene=scene.name, keypoints=(PlanKeypoint("start", scene.start), target))
     height = scene.table.height + CONFIG.ik.height
     for plan in (direct, through_gaps(scene, to_target=True)):
-        assert_reaches(system.solve(plan), plan, height)
+        assert_reaches(solve(system, plan), plan, height)
 
 
 @pytest.mark.parametrize("kind, seed, objects", [("gen2", 17, 5), ("gen1", 41, None)])
@@ -274,15 +290,13 @@ def test_a_far_target_straight_from_the_start_is_reached_by_continuation(kind, s
     """Targets 0.83 m (gen2 seed 17, 0.19 m to the side) and 0.86 m (gen1 seed 41) deep: from the
     start's folded arm the base stops at its bound and SNOPT ends at its iteration limit from every
     other seed; solving points along the straight tcp line first reaches them."""
-    from dataclasses import replace
-
     scene = generate_scene(kind, seed, objects)
     target = PlanKeypoint("target", scene.target.position, element=scene.target.name)
     direct = HighLevelPlan(scene=scene.name, keypoints=(PlanKeypoint("start", scene.start), target))
     height = scene.table.height + CONFIG.ik.height
-    assert_reaches(KeypointIk(scene, CONFIG).solve(direct), direct, height)
+    assert_reaches(solve(ik_for(scene), direct), direct, height)
     without = replace(CONFIG, ik=replace(CONFIG.ik, attempts=4))  # the seeds before the continuation
-    failed = KeypointIk(scene, without).solve(direct)
+    failed = solve(ik_for(scene, without), direct)
     assert not failed.ok and "IK failed after 4 attempt(s)" in failed.failures[0]
 
 
@@ -296,7 +310,7 @@ def test_tcp_reaches_0_95_m_past_the_front_edge_and_the_edge_itself(height):
         target=SceneObject("target", "cylinder", 0.95, 0.0, (0.05, 0.05, 0.1)),
         name=f"reach-{height}",
     )
-    system = KeypointIk(scene, CONFIG)
+    system = ik_for(scene)
     plan = HighLevelPlan(
         scene=scene.name,
         keypoints=(
@@ -305,7 +319,7 @@ def test_tcp_reaches_0_95_m_past_the_front_edge_and_the_edge_itself(height):
             PlanKeypoint("gap", (0.0, 0.0), element="edge"),
         ),
     )
-    keyframes = system.solve(plan)
+    keyframes = solve(system, plan)
     assert_reaches(keyframes, plan, height + CONFIG.ik.height)
     # The base stays outside the table's footprint.
     assert np.all(keyframes.positions[:, 0] + BASE_FOOTPRINT[0] / 2.0 <= CONFIG.ik.base_under_table + 1e-6)
@@ -314,12 +328,15 @@ def test_tcp_reaches_0_95_m_past_the_front_edge_and_the_edge_itself(height):
 def test_transit_keypoints_are_reached_at_their_height_and_timed_at_the_transit_speed(system, scene):
     gap = gap_centres(scene)[0]
     height = 0.25
-    plan = HighLevelPlan(scene=scene.name, keypoints=(
-        PlanKeypoint("start", scene.start),
-        PlanKeypoint("transit", scene.start, height=height),
-        PlanKeypoint("transit", gap, height=height),
-        PlanKeypoint("gap", gap, row=0, element="0"),
-    ))
+    plan = HighLevelPlan(
+        scene=scene.name,
+        keypoints=(
+            PlanKeypoint("start", scene.start),
+            PlanKeypoint("transit", scene.start, height=height),
+            PlanKeypoint("transit", gap, height=height),
+            PlanKeypoint("gap", gap, row=0, element="0"),
+        ),
+    )
     keyframes, trajectory = evaluate(system, plan)
     assert keyframes.ok, keyframes.failures
     z = keyframes.tcp_positions[:, 2] - scene.table.height
@@ -337,11 +354,35 @@ def test_transit_keypoints_are_reached_at_their_height_and_timed_at_the_transit_
 def test_keyframes_keep_the_robot_clear_of_itself(system, scene, solved):
     """The IK's distance constraint includes the robot's own links (all but adjacent ones)."""
     keyframes, _ = solved
-    model = system.planning_model
+    model = system.solver.planning_model
     robot = set(model.robot_geometries())
+    context = system.solver.new_context()
     for q in keyframes.positions:
-        model.plant.SetPositions(model.plant_context, model.robot, q)
-        query = model.scene_graph.get_query_output_port().Eval(model.scene_graph.GetMyContextFromRoot(model.context))
-        pairs = [p for p in query.ComputeSignedDistancePairwiseClosestPoints(0.05) if p.id_A in robot and p.id_B in robot]
+        model.plant.SetPositions(system.solver.plant_context(context), model.robot, q)
+        query = model.scene_graph.get_query_output_port().Eval(
+            model.scene_graph.GetMyContextFromRoot(context)
+        )
+        pairs = [
+            p
+            for p in query.ComputeSignedDistancePairwiseClosestPoints(0.05)
+            if p.id_A in robot and p.id_B in robot
+        ]
         assert pairs, "the robot's self pairs should be checked"
         assert min(p.distance for p in pairs) >= CONFIG.ik.table_clearance - 1e-4
+
+
+def test_a_persons_plan_wired_straight_into_ik_is_refused_not_executed(system):
+    """A person's "move" keypoints are the obstacles' centres; only RobotPlanTransfer's plan is solved."""
+    from hlp_drake.learners.bundled import default_models
+    from hlp_drake.planner import plan as human_plan
+    from hlp_drake.systems.push_transfer import robot_plan
+    from hlp_drake.systems.transfer_geometry import gripper_geometry, push_rules
+
+    scene = generate_scene("gen1", 3)
+    person = human_plan(scene, default_models())
+    assert any(k.action == "move" for k in person.keypoints)
+    system = ik_for(scene)
+    refused = solve(system, person)
+    assert not refused.ok and "RobotPlanTransfer" in refused.problems[0]
+    robot = robot_plan(person, scene, push_rules(CONFIG.transfer, gripper_geometry()))
+    assert solve(system, robot).ok and person.details.get("robot_plan") is None

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 from dataclasses import replace
@@ -14,23 +15,46 @@ from conftest import run_module
 
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.planner import plan
-from hlp_drake.planner.transfer import robot_alternatives, robot_plan
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import scene_to_dict
-from hlp_drake.systems.planning import make_planning_diagram
+from hlp_drake.systems.planning_diagram import make_planning_diagram
+from hlp_drake.systems.push_transfer import ROBOT_ACTIONS, robot_alternatives, robot_plan
+from hlp_drake.systems.scenario import Scenario
+from hlp_drake.systems.transfer_geometry import TransferConfig, gripper_geometry, push_rules
 from hlp_drake.taskspace import DIRECTION_VECTORS, TaskSpace
+
+RULES = push_rules(TransferConfig(), gripper_geometry())
+
+
+def test_the_transfers_clearances_are_the_robot_models_sizes_plus_the_margins():
+    geometry = gripper_geometry()  # the tcp 14 cm ahead of the flange, the fingertips 2 cm ahead of it
+    sizes = {"tcp_offset": 0.14, "fingertip_reach": 0.02, "finger_half_width": 0.055, "wrist_radius": 0.045}
+    assert dataclasses.asdict(geometry) == sizes
+    clearances = {
+        "forward_clearance": 0.05,
+        "sideways_clearance": 0.075,
+        "corridor_half_width": 0.08,
+        "way_clearance": 0.055,
+        "transit_clearance": 0.07,
+        "arm_shadow_length": 0.35,
+        "arm_shadow_half_width": 0.06,
+    }
+    assert {name: getattr(RULES, name) for name in clearances} == clearances
+    wider = push_rules(TransferConfig(sideways_margin=0.03), geometry)
+    assert wider.sideways_clearance == 0.085 and wider.forward_clearance == RULES.forward_clearance
 
 
 def test_push_transfer_puts_the_tcp_behind_the_obstacle():
     scene = generate_scene("vr", 0)
     human = plan(scene, default_models())
-    robot = robot_plan(human, scene)
+    robot = robot_plan(human, scene, RULES)
     space = TaskSpace(scene)
     assert [k.action for k in robot.keypoints if k.action != "transit"] == [k.action for k in human.keypoints]
+    assert {k.action for k in robot.keypoints} <= set(ROBOT_ACTIONS)
     lifted = max(o.size[2] for o in scene.objects) + 0.07
     transits = [i for i, k in enumerate(robot.keypoints) if k.action == "transit"]
     for i in transits[1::2]:  # lifted above the previous waypoint, then above the next one
-        before, up, over, after = robot.keypoints[i - 2:i + 2]
+        before, up, over, after = robot.keypoints[i - 2 : i + 2]
         assert (up.position, over.position) == (before.position, after.position)
         assert up.height == over.height == pytest.approx(lifted)
     for k in robot.keypoints:
@@ -47,25 +71,26 @@ def test_push_transfer_puts_the_tcp_behind_the_obstacle():
 def test_robot_alternatives_are_the_next_distinct_candidates_in_rank_order():
     scene = generate_scene("gen2", 39, 9)
     human = plan(scene, default_models())
-    chosen = robot_plan(human, scene)
-    candidates = [robot_plan(replace(human, keypoints=c.keypoints), scene).keypoints
-                  for c in human.alternatives]
-    alternatives = robot_alternatives(human, scene, 3)
+    chosen = robot_plan(human, scene, RULES)
+    candidates = [
+        robot_plan(replace(human, keypoints=c.keypoints), scene, RULES).keypoints for c in human.alternatives
+    ]
+    alternatives = robot_alternatives(human, scene, RULES, 3)
     assert len(alternatives) == 3 and all(a.ok for a in alternatives)
     found = [a.keypoints for a in alternatives]
     assert len({chosen.keypoints, *found}) == 4  # distinct from the chosen plan and from each other
     ranks = [candidates.index(k) for k in found]
     assert ranks == sorted(ranks)  # best first, the first of equal robot plans
-    assert all(k in (chosen.keypoints, *found) for k in candidates[:ranks[-1]])  # none skipped
-    assert robot_alternatives(human, scene, 1) == alternatives[:1]
-    assert robot_alternatives(human, scene, 0) == ()
-    assert robot_alternatives(replace(human, keypoints=(), reason="no plan"), scene, 3) == ()
+    assert all(k in (chosen.keypoints, *found) for k in candidates[: ranks[-1]])  # none skipped
+    assert robot_alternatives(human, scene, RULES, 1) == alternatives[:1]
+    assert robot_alternatives(human, scene, RULES, 0) == ()
+    assert robot_alternatives(replace(human, keypoints=(), reason="no plan"), scene, RULES, 3) == ()
 
 
 def test_planning_diagram_swaps_the_planner_block():
     scene = generate_scene("vr", 2)
     for planner, expected in (("hlp", None), ("sto", ["start", "target"])):
-        diagram = make_planning_diagram(scene, planner=planner)
+        diagram = make_planning_diagram(Scenario(scene=scene).updated(f"planner: {{kind: {planner}}}"))
         context = diagram.CreateDefaultContext()
         diagram.GetInputPort("scene").FixValue(context, scene)
         actions = [k.action for k in diagram.GetOutputPort("plan").Eval(context).keypoints]
@@ -76,18 +101,55 @@ def test_planning_diagram_swaps_the_planner_block():
         assert len(keyframes.success) == len(actions)
 
 
-def test_run_scene_end_to_end_json(tmp_path):
-    out = tmp_path / "run.json"
-    result = run_module("hlp_drake.run_scene", "--kind", "vr", "--seed", "1", "--workers", "1", "--json", str(out))
+def recorded(html: str) -> bytes:
+    """The MeshCat commands a static HTML recording replays (its base64 data URLs, decoded)."""
+    import base64
+    import re
+
+    return b"".join(base64.b64decode(b) for b in re.findall(r"base64,([A-Za-z0-9+/=]+)\"\)", html))
+
+
+def test_run_scene_end_to_end_json_and_html(tmp_path):
+    out, html = tmp_path / "run.json", tmp_path / "run.html"
+    result = run_module(
+        "hlp_drake.run_scene",
+        "--kind",
+        "vr",
+        "--seed",
+        "1",
+        "--workers",
+        "1",
+        "--json",
+        str(out),
+        "--html",
+        str(html),
+    )
     assert result.returncode in (0, 1), result.stderr
+    # The recording opens framed on the table, with both plans as paths and the robot plan's markers,
+    # and no contact forces unless asked for.
+    commands = recorded(html.read_text())
+    for path in (
+        b"/Cameras/default",
+        b"/drake/plan/path",
+        b"/drake/robot_plan/path",
+        b"/drake/robot_plan/00_start",
+    ):
+        assert path in commands, path
+    assert b"contact_forces" not in commands and b"animation" in commands
     report = json.loads(out.read_text())
     assert report["planner"] == "hlp" and report["robot_actuated_dofs"] == 10
     assert set(report["timings"]) >= {"plan_s", "ik_s", "optimise_s", "total_s"}
-    assert [k["action"] for k in report["plan"]["keypoints"]][::len(report["plan"]["keypoints"]) - 1] == [
-        "start", "target"]
+    assert [k["action"] for k in report["plan"]["keypoints"]][:: len(report["plan"]["keypoints"]) - 1] == [
+        "start",
+        "target",
+    ]
     assert isinstance(report["objects_moved"], list) and isinstance(report["objects_dropped"], list)
     assert report["success"] == (result.returncode == 0) == (report["failure_reason"] is None)
     assert ("success" if report["success"] else "failure:") in result.stdout
+    assert report["rollouts"] >= 1 and report["timings"]["optimise_s"] > 0
+    assert report["optimisation"]["final_cost"] <= report["optimisation"]["initial_cost"]
+    for stage in ("plan: start -> ", "IK: ", "optimise: ", "execute: "):  # each stage, as it happens
+        assert stage in result.stdout, stage
 
 
 def test_run_scene_bad_scene_file_is_one_line(tmp_path):
@@ -97,7 +159,11 @@ def test_run_scene_bad_scene_file_is_one_line(tmp_path):
     result = run_module("hlp_drake.run_scene", "--scene", str(bad), "--json", str(out))
     assert result.returncode == 2
     lines = result.stderr.strip().splitlines()
-    assert len(lines) >= 1 and all(line.startswith("error: ") for line in lines) and "Traceback" not in result.stderr
+    assert (
+        len(lines) >= 1
+        and all(line.startswith("error: ") for line in lines)
+        and "Traceback" not in result.stderr
+    )
     assert not out.exists()
     scene = generate_scene("vr", 1)
     overlapping = tmp_path / "overlap.yaml"
@@ -110,20 +176,6 @@ def test_run_scene_bad_scene_file_is_one_line(tmp_path):
     assert result.returncode == 2 and "overlap" in result.stderr and not out.exists()
 
 
-def test_run_scene_without_arguments_runs_the_bundled_default(tmp_path):
-    out = tmp_path / "default.json"
-    result = run_module("hlp_drake.run_scene", "--json", str(out), cwd=tmp_path)
-    assert result.returncode == 0, result.stdout + result.stderr
-    report = json.loads(out.read_text())
-    assert report["success"] and report["scene"].startswith("default") and report["objects_dropped"] == []
-    assert any(k["action"] == "move" for k in report["plan"]["keypoints"])
-    # The optimiser ran (on 2 worker processes by default) and the grasp was tried and held.
-    assert report["rollouts"] >= 1 and report["iterations"] >= 0 and report["timings"]["optimise_s"] > 0
-    assert report["optimisation"]["success"] and report["optimisation"]["final_cost"] <= report["optimisation"]["initial_cost"]
-    assert report["grasp_held"] is True
-    assert "rollouts" in result.stdout and "grasp: held" in result.stdout
-
-
 def test_run_scene_rejects_a_bad_worker_count(tmp_path):
     out = tmp_path / "run.json"
     result = run_module("hlp_drake.run_scene", "--workers", "0", "--json", str(out))
@@ -132,7 +184,9 @@ def test_run_scene_rejects_a_bad_worker_count(tmp_path):
 
 
 def test_pushes_stop_short_of_the_table_edge_and_the_other_objects():
-    from hlp_drake.planner.transfer import EDGE_MARGIN, OBJECT_MARGIN, push_travel
+    from hlp_drake.systems.push_transfer import push_travel
+
+    EDGE_MARGIN, OBJECT_MARGIN = RULES.edge_margin, RULES.object_margin
 
     scene = generate_scene("gen1", 13)
     space = TaskSpace(scene)
@@ -140,25 +194,33 @@ def test_pushes_stop_short_of_the_table_edge_and_the_other_objects():
     for name in scene_obstacle_names(scene):
         rect = space.rects[name]
         for unit in (np.array([0.0, 1.0]), np.array([0.0, -1.0]), np.array([1.0, 0.0])):
-            travel = push_travel(space, scene, name, unit, 1.0)
+            travel = push_travel(RULES, space, scene, name, unit, 1.0)
             assert 0.0 <= travel < 1.0  # a 1 m push never fits on these tables
             dx, dy = travel * unit
             assert x_min + EDGE_MARGIN <= rect.x_min + dx and rect.x_max + dx <= x_max - EDGE_MARGIN
             assert y_min + EDGE_MARGIN <= rect.y_min + dy and rect.y_max + dy <= y_max - EDGE_MARGIN
             for other, r in space.rects.items():
                 if other != name:
-                    apart = (rect.x_min + dx >= r.x_max + OBJECT_MARGIN or r.x_min >= rect.x_max + dx + OBJECT_MARGIN
-                             or rect.y_min + dy >= r.y_max + OBJECT_MARGIN or r.y_min >= rect.y_max + dy + OBJECT_MARGIN)
+                    apart = (
+                        rect.x_min + dx >= r.x_max + OBJECT_MARGIN
+                        or r.x_min >= rect.x_max + dx + OBJECT_MARGIN
+                        or rect.y_min + dy >= r.y_max + OBJECT_MARGIN
+                        or r.y_min >= rect.y_max + dy + OBJECT_MARGIN
+                    )
                     assert apart or travel == 0.0, (name, other, travel)
     # Unobstructed, the push goes as far as wanted.
     lone = scene_with_one_obstacle(scene)
     lone_space = TaskSpace(lone)
-    assert push_travel(lone_space, lone, lone.obstacles[0].name, np.array([0.0, 1.0]), 0.02) == pytest.approx(0.02)
+    assert push_travel(
+        RULES, lone_space, lone, lone.obstacles[0].name, np.array([0.0, 1.0]), 0.02
+    ) == pytest.approx(0.02)
 
 
 def test_pushes_stop_short_of_where_earlier_pushes_left_the_other_objects():
-    from hlp_drake.planner.transfer import OBJECT_MARGIN, push_travel
+    from hlp_drake.systems.push_transfer import push_travel
     from hlp_drake.taskspace import Rect
+
+    OBJECT_MARGIN = RULES.object_margin
 
     scene = generate_scene("gen1", 13)
     space = TaskSpace(scene)
@@ -168,11 +230,16 @@ def test_pushes_stop_short_of_where_earlier_pushes_left_the_other_objects():
     # Another object moved to 5 cm beyond the pushed one's left face: the push stops 1 cm short of it.
     moved = dict(space.rects)
     moved[other] = Rect(rect.x_min, rect.y_max + 0.05, rect.x_max, rect.y_max + 0.10)
-    travel = push_travel(space, scene, name, unit, 0.2, footprints=moved)
-    assert travel == pytest.approx(0.05 - OBJECT_MARGIN, abs=0.005 + 1e-9) and travel < 0.05 - OBJECT_MARGIN + 1e-9
+    travel = push_travel(RULES, space, scene, name, unit, 0.2, footprints=moved)
+    assert (
+        travel == pytest.approx(0.05 - OBJECT_MARGIN, abs=0.005 + 1e-9)
+        and travel < 0.05 - OBJECT_MARGIN + 1e-9
+    )
     # With every other object pushed far away, nothing but the table's edge limits it.
     cleared = {n: (r if n == name else Rect(-10.0, -10.0, -9.9, -9.9)) for n, r in space.rects.items()}
-    assert push_travel(space, scene, name, unit, 0.2, footprints=cleared) >= push_travel(space, scene, name, unit, 0.2)
+    assert push_travel(RULES, space, scene, name, unit, 0.2, footprints=cleared) >= push_travel(
+        RULES, space, scene, name, unit, 0.2
+    )
 
 
 def scene_obstacle_names(scene):
@@ -188,7 +255,9 @@ def scene_with_one_obstacle(scene):
 
 
 def test_a_push_with_no_room_to_move_the_obstacle_is_left_out():
-    from hlp_drake.planner.transfer import MIN_PUSH_TRAVEL, _robot_direction, _unit, _wanted, push_travel
+    from hlp_drake.systems.push_transfer import _robot_direction, _unit, _wanted, push_travel
+
+    MIN_PUSH_TRAVEL = RULES.min_push_travel
 
     # gen1 seed 27: the person's plan moves FailOnTouchObstacleMed back-left (for the robot a push
     # to the left), then pushes FailOnTouchObstacleLong-1 to the right; the first push has no room,
@@ -196,35 +265,39 @@ def test_a_push_with_no_room_to_move_the_obstacle_is_left_out():
     scene = generate_scene("gen1", 27)
     space = TaskSpace(scene)
     human = plan(scene, default_models())
-    robot = robot_plan(human, scene)
+    robot = robot_plan(human, scene, RULES)
     moves = [(k.element, k.direction) for k in human.keypoints if k.action == "move"]
     assert moves == [("FailOnTouchObstacleMed", "BL"), ("FailOnTouchObstacleLong-1", "RR")]
     name = moves[0][0]
-    direction = _robot_direction(space, scene, name, moves[0][1])
+    direction = _robot_direction(RULES, space, scene, name, moves[0][1])
     wanted = _wanted(space, name, direction)
-    assert wanted > MIN_PUSH_TRAVEL > push_travel(space, scene, name, _unit(direction), wanted)
+    assert wanted > MIN_PUSH_TRAVEL > push_travel(RULES, space, scene, name, _unit(direction), wanted)
     pushes = [k for k in robot.keypoints if k.action in ("move", "release")]
     assert [(k.action, k.element) for k in pushes] == [("move", moves[1][0]), ("release", moves[1][0])]
     assert np.hypot(*np.subtract(pushes[1].position, pushes[0].position)) >= MIN_PUSH_TRAVEL
 
 
 def test_an_obstacle_already_near_an_edge_can_be_pushed_along_it_but_not_towards_it():
-    from hlp_drake.planner.transfer import EDGE_MARGIN, push_travel
+    from hlp_drake.systems.push_transfer import push_travel
+
+    EDGE_MARGIN = RULES.edge_margin
 
     scene = generate_scene("gen1", 13)
     lone = scene_with_one_obstacle(scene)
     obstacle = lone.obstacles[0]
     half = TaskSpace(lone).rects[obstacle.name].width / 2
     y_max = lone.table.bounds[3]
-    near = replace(lone, obstacles=(replace(obstacle, y=y_max - half - EDGE_MARGIN / 2),))  # 1.5 cm from the edge
+    near = replace(
+        lone, obstacles=(replace(obstacle, y=y_max - half - EDGE_MARGIN / 2),)
+    )  # 1.5 cm from the edge
     space = TaskSpace(near)
-    assert push_travel(space, near, obstacle.name, np.array([1.0, 0.0]), 0.05) == pytest.approx(0.05)
-    assert push_travel(space, near, obstacle.name, np.array([0.0, 1.0]), 0.05) == 0.0
-    assert push_travel(space, near, obstacle.name, np.array([0.0, -1.0]), 0.05) == pytest.approx(0.05)
+    assert push_travel(RULES, space, near, obstacle.name, np.array([1.0, 0.0]), 0.05) == pytest.approx(0.05)
+    assert push_travel(RULES, space, near, obstacle.name, np.array([0.0, 1.0]), 0.05) == 0.0
+    assert push_travel(RULES, space, near, obstacle.name, np.array([0.0, -1.0]), 0.05) == pytest.approx(0.05)
 
 
 def test_a_backward_move_becomes_the_sideways_push_that_clears_the_corridor():
-    from hlp_drake.planner.transfer import _robot_direction
+    from hlp_drake.systems.push_transfer import _robot_direction
 
     scene = generate_scene("gen1", 14)
     space = TaskSpace(scene)
@@ -234,12 +307,14 @@ def test_a_backward_move_becomes_the_sideways_push_that_clears_the_corridor():
     long = space.rects["FailOnTouchObstacleLong"]
     assert long.center[1] < 0.0 < long.y_max
     for direction in ("BL", "BR", "BB"):
-        assert _robot_direction(space, scene, "FailOnTouchObstacleLong", direction) == "RR"
+        assert _robot_direction(RULES, space, scene, "FailOnTouchObstacleLong", direction) == "RR"
     # On the left of the line, with room on both sides, it goes left whatever the person's side.
-    assert {_robot_direction(space, scene, "FailOnTouchObstacleMed", d) for d in ("BL", "BR", "BB")} == {"LL"}
+    assert {
+        _robot_direction(RULES, space, scene, "FailOnTouchObstacleMed", d) for d in ("BL", "BR", "BB")
+    } == {"LL"}
     # Forward and sideways moves are kept.
-    assert _robot_direction(space, scene, "FailOnTouchObstacleLong", "LL") == "LL"
-    assert _robot_direction(space, scene, "FailOnTouchObstacleLong", "FR") == "FR"
+    assert _robot_direction(RULES, space, scene, "FailOnTouchObstacleLong", "LL") == "LL"
+    assert _robot_direction(RULES, space, scene, "FailOnTouchObstacleLong", "FR") == "FR"
 
 
 def _websocket_frames(url: str, *, seconds: float) -> bytes:
@@ -253,8 +328,12 @@ def _websocket_frames(url: str, *, seconds: float) -> bytes:
     host, port = url.removeprefix("ws://").split(":")
     with socket.create_connection((host, int(port)), timeout=seconds) as sock:
         key = base64.b64encode(os.urandom(16)).decode()
-        sock.sendall((f"GET / HTTP/1.1\r\nHost: {host}:{port}\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
-                      f"Sec-WebSocket-Key: {key}\r\nSec-WebSocket-Version: 13\r\n\r\n").encode())
+        sock.sendall(
+            (
+                f"GET / HTTP/1.1\r\nHost: {host}:{port}\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                f"Sec-WebSocket-Key: {key}\r\nSec-WebSocket-Version: 13\r\n\r\n"
+            ).encode()
+        )
         data, deadline = b"", time.monotonic() + seconds
         while time.monotonic() < deadline:
             sock.settimeout(max(deadline - time.monotonic(), 0.01))
@@ -271,17 +350,18 @@ def _websocket_frames(url: str, *, seconds: float) -> bytes:
     while i + 2 <= len(frames):
         length, i = frames[i + 1] & 0x7F, i + 2
         if length == 126:
-            length, i = int.from_bytes(frames[i:i + 2], "big"), i + 2
+            length, i = int.from_bytes(frames[i : i + 2], "big"), i + 2
         elif length == 127:
-            length, i = int.from_bytes(frames[i:i + 8], "big"), i + 8
-        payloads += frames[i:i + length]
+            length, i = int.from_bytes(frames[i : i + 8], "big"), i + 8
+        payloads += frames[i : i + length]
         i += length
     return payloads
 
 
 def test_run_scene_meshcat_serves_the_run_live(tmp_path):
     """``--meshcat``: the URL is printed, the viewer page is served, a browser's WebSocket receives
-    the robot, the objects and the plan's keypoints, and Ctrl-C ends the run cleanly."""
+    the robot, the objects, the plans' path lines and the robot plan's keypoints, and Ctrl-C ends
+    the run cleanly."""
     import signal
     import subprocess
     import sys
@@ -290,21 +370,35 @@ def test_run_scene_meshcat_serves_the_run_live(tmp_path):
     out = tmp_path / "run.json"
     process = subprocess.Popen(
         [sys.executable, "-m", "hlp_drake.run_scene", "--meshcat", "--workers", "1", "--json", str(out)],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-        env={**os.environ, "DRAKE_ALLOW_NETWORK": "meshcat"})
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "DRAKE_ALLOW_NETWORK": "meshcat"},
+    )
     try:
         lines = []
         for line in process.stdout:
             lines.append(line)
             if "keeps serving" in line:
                 break
-        url = next((line.split("MeshCat: ")[1].strip() for line in lines if line.startswith("MeshCat: ")), None)
+        url = next(
+            (line.split("MeshCat: ")[1].strip() for line in lines if line.startswith("MeshCat: ")), None
+        )
         if url is None:
-            pytest.skip(f"MeshCat did not start here: {process.stderr.read() if process.poll() is not None else lines}")
+            pytest.skip(
+                f"MeshCat did not start here: {process.stderr.read() if process.poll() is not None else lines}"
+            )
         page = urllib.request.urlopen(url, timeout=10).read()
         assert b"<title>Drake MeshCat</title>" in page
         scene_tree = _websocket_frames(url.replace("http://", "ws://"), seconds=3.0)
-        for path in (b"/drake/plan/00_start", b"/drake/plan/", b"mobile_ur5", b"Target", b"table"):
+        for path in (
+            b"/drake/robot_plan/00_start",
+            b"/drake/robot_plan/path",
+            b"/drake/plan/path",
+            b"mobile_ur5",
+            b"Target",
+            b"table",
+        ):
             assert path in scene_tree, path
         process.send_signal(signal.SIGINT)
         assert process.wait(timeout=30) == 0
@@ -316,47 +410,75 @@ def test_run_scene_meshcat_serves_the_run_live(tmp_path):
 
 def test_transit_goes_over_the_objects_where_the_arm_can_come_down():
     from hlp_drake.planner.plan import PlanKeypoint
-    from hlp_drake.planner.transfer import ARM_SHADOW_LENGTH, transit
+    from hlp_drake.systems.push_transfer import transit
     from hlp_drake.taskspace import Rect
+
+    ARM_SHADOW_LENGTH = RULES.arm_shadow_length
 
     previous = PlanKeypoint("release", (0.30, -0.20), row=0, element="a")
     push = PlanKeypoint("move", (0.60, 0.20), row=1, element="b", direction="RR")
     # Nothing under the arm at the push start: up, across, and straight down onto it.
     beside = [Rect(0.10, -0.50, 0.15, -0.40), Rect(0.40, 0.27, 0.45, 0.35), Rect(0.62, 0.15, 0.70, 0.25)]
-    up, over = transit(previous, push, 0.25, beside)
+    up, over = transit(RULES, previous, push, 0.25, beside)
     assert (up.position, over.position) == (previous.position, push.position)
     assert up.action == over.action == "transit" and up.height == over.height == 0.25
     assert (over.row, over.element) == (push.row, push.element)
     # An object under the wrist there: no transit, the push start is reached at push height.
-    assert transit(previous, push, 0.25, [*beside, Rect(0.40, 0.25, 0.45, 0.30)]) == []
-    assert transit(previous, push, 0.25, [Rect(0.60 - ARM_SHADOW_LENGTH - 0.05, 0.1, 0.60 - ARM_SHADOW_LENGTH + 0.01, 0.3)]) == []
-    assert len(transit(previous, push, 0.25, [Rect(0.60 - ARM_SHADOW_LENGTH - 0.05, 0.1, 0.60 - ARM_SHADOW_LENGTH - 0.01, 0.3)])) == 2
+    assert transit(RULES, previous, push, 0.25, [*beside, Rect(0.40, 0.25, 0.45, 0.30)]) == []
+    assert (
+        transit(
+            RULES,
+            previous,
+            push,
+            0.25,
+            [Rect(0.60 - ARM_SHADOW_LENGTH - 0.05, 0.1, 0.60 - ARM_SHADOW_LENGTH + 0.01, 0.3)],
+        )
+        == []
+    )
+    assert (
+        len(
+            transit(
+                RULES,
+                previous,
+                push,
+                0.25,
+                [Rect(0.60 - ARM_SHADOW_LENGTH - 0.05, 0.1, 0.60 - ARM_SHADOW_LENGTH - 0.01, 0.3)],
+            )
+        )
+        == 2
+    )
 
 
 def test_a_way_that_would_pass_over_an_object_goes_over_it():
-    from hlp_drake.planner.transfer import PATH_CLEARANCE, crosses, transit_height
+    from hlp_drake.systems.push_transfer import crosses, transit_height
     from hlp_drake.taskspace import Rect
 
+    PATH_CLEARANCE = RULES.path_clearance
+
     box = Rect(0.40, 0.00, 0.50, 0.10)
-    assert crosses((0.30, 0.05), (0.60, 0.05), [box])  # straight through
-    assert crosses((0.30, 0.10 + PATH_CLEARANCE - 0.005), (0.60, 0.10 + PATH_CLEARANCE - 0.005), [box])
-    assert not crosses((0.30, 0.10 + PATH_CLEARANCE + 0.005), (0.60, 0.10 + PATH_CLEARANCE + 0.005), [box])
-    assert not crosses((0.30, 0.05), (0.60, 0.05), [])
+    assert crosses(RULES, (0.30, 0.05), (0.60, 0.05), [box])  # straight through
+    assert crosses(RULES, (0.30, 0.10 + PATH_CLEARANCE - 0.005), (0.60, 0.10 + PATH_CLEARANCE - 0.005), [box])
+    assert not crosses(
+        RULES, (0.30, 0.10 + PATH_CLEARANCE + 0.005), (0.60, 0.10 + PATH_CLEARANCE + 0.005), [box]
+    )
+    assert not crosses(RULES, (0.30, 0.05), (0.60, 0.05), [])
     # gen2 seed 12, 9 obstacles: from where obstacle_4's push ends, the way to the next gap would
     # sweep the gripper through obstacle_5 at push height; the robot plan goes over it instead.
     scene = generate_scene("gen2", 12, 9)
     space = TaskSpace(scene)
-    keypoints = robot_plan(plan(scene, default_models()), scene).keypoints
+    keypoints = robot_plan(plan(scene, default_models()), scene, RULES).keypoints
     i = next(i for i, k in enumerate(keypoints) if k.action == "release" and k.element == "obstacle_4")
-    release, up, over, gap = keypoints[i:i + 4]
-    assert crosses(release.position, gap.position, [space.rects["obstacle_5"]])
+    release, up, over, gap = keypoints[i : i + 4]
+    assert crosses(RULES, release.position, gap.position, [space.rects["obstacle_5"]])
     assert (up.action, over.action, gap.action) == ("transit", "transit", "gap")
     assert (up.position, over.position) == (release.position, gap.position)
-    assert up.height == over.height == pytest.approx(transit_height(scene))
+    assert up.height == over.height == pytest.approx(transit_height(RULES, scene))
 
 
 def test_a_push_that_would_leave_the_obstacle_in_the_way_goes_another_way():
-    from hlp_drake.planner.transfer import WAY_CLEARANCE, chosen_push, crosses, robot_push
+    from hlp_drake.systems.push_transfer import chosen_push, crosses, robot_push
+
+    WAY_CLEARANCE = RULES.way_clearance
 
     # gen1 seed 19: the person moves FailOnTouchObstacleLong-1 forwards, over the table; pushed
     # forwards it would end up across the way to the target (and shove the target off the table).
@@ -364,50 +486,61 @@ def test_a_push_that_would_leave_the_obstacle_in_the_way_goes_another_way():
     space = TaskSpace(scene)
     human = plan(scene, default_models())
     i = next(i for i, k in enumerate(human.keypoints) if k.action == "move")
-    move, rest = human.keypoints[i], human.keypoints[i + 1:]
+    move, rest = human.keypoints[i], human.keypoints[i + 1 :]
     assert (move.element, move.direction) == ("FailOnTouchObstacleLong-1", "FF")
     ways = [k.position for k in rest if k.action in ("gap", "target")]
 
     def in_the_way(push):
         points = [push.end, *ways]
-        return any(crosses(a, b, [push.footprint], clearance=WAY_CLEARANCE) for a, b in pairwise(points))
+        return any(
+            crosses(RULES, a, b, [push.footprint], clearance=WAY_CLEARANCE) for a, b in pairwise(points)
+        )
 
-    forwards = robot_push(space, scene, move.element, "FF", space.rects)
+    forwards = robot_push(RULES, space, scene, move.element, "FF", space.rects)
     assert forwards.travel > 0.0 and in_the_way(forwards)
-    push = chosen_push(space, scene, move, rest, space.rects)
+    push = chosen_push(RULES, space, scene, move, rest, space.rects)
     assert push.direction in ("LL", "RR") and not in_the_way(push) and push.travel >= 0.01
     # Of the sideways pushes that clear the way, the one that moves the obstacle furthest.
-    sideways = [robot_push(space, scene, move.element, d, space.rects) for d in ("LL", "RR")]
+    sideways = [robot_push(RULES, space, scene, move.element, d, space.rects) for d in ("LL", "RR")]
     assert push.travel == max(p.travel for p in sideways if not in_the_way(p) and p.travel >= 0.01)
-    robot = robot_plan(human, scene)
+    robot = robot_plan(human, scene, RULES)
     assert [(k.action, k.direction) for k in robot.keypoints if k.action in ("move", "release")] == [
-        ("move", push.direction), ("release", push.direction)]
+        ("move", push.direction),
+        ("release", push.direction),
+    ]
     # Pushes already clear of the way keep the person's direction (gen1 seed 3: right, then left).
     scene = generate_scene("gen1", 3)
     human = plan(scene, default_models())
-    robot = robot_plan(human, scene)
-    assert [k.direction for k in robot.keypoints if k.action == "move"] == [
-        k.direction for k in human.keypoints if k.action == "move"] == ["RR", "LL"]
+    robot = robot_plan(human, scene, RULES)
+    assert (
+        [k.direction for k in robot.keypoints if k.action == "move"]
+        == [k.direction for k in human.keypoints if k.action == "move"]
+        == ["RR", "LL"]
+    )
 
 
 def test_the_gripper_slides_onto_the_target_along_its_approach_axis():
-    from hlp_drake.planner.transfer import APPROACH_GAP, GRIPPER_AHEAD, approach
+    from hlp_drake.systems.push_transfer import approach
     from hlp_drake.taskspace import Rect
+
+    APPROACH_GAP, GRIPPER_AHEAD = RULES.approach_gap, RULES.gripper_ahead
 
     target = Rect(0.70, -0.03, 0.76, 0.03)
     # Coming in 35 degrees off +x: a waypoint APPROACH_GAP behind the target's back face, in line.
-    (point,) = approach((0.50, -0.14), target, {"t": target}, "t")
+    (point,) = approach(RULES, (0.50, -0.14), target, {"t": target}, "t")
     assert point.action == "approach" and point.element == "t"
     assert point.position == pytest.approx((0.70 - APPROACH_GAP, 0.0))
     assert point.position[0] + GRIPPER_AHEAD < target.x_min  # the fingertips stop short of it
     # Already in line (within 15 degrees): none; an object where the gripper would be: none.
-    assert approach((0.40, 0.05), target, {"t": target}, "t") == []
+    assert approach(RULES, (0.40, 0.05), target, {"t": target}, "t") == []
     blocker = Rect(0.60, 0.04, 0.66, 0.10)
-    assert approach((0.50, -0.14), target, {"t": target, "b": blocker}, "t") == []
+    assert approach(RULES, (0.50, -0.14), target, {"t": target, "b": blocker}, "t") == []
     # In a plan: gen1 seed 18 comes to the target from a gap 9 cm to its side.
     scene = generate_scene("gen1", 18)
-    keypoints = robot_plan(plan(scene, default_models()), scene).keypoints
+    keypoints = robot_plan(plan(scene, default_models()), scene, RULES).keypoints
     before, last = keypoints[-2:]
     space = TaskSpace(scene)
     assert (before.action, last.action) == ("approach", "target")
-    assert before.position == pytest.approx((space.rects[scene.target.name].x_min - APPROACH_GAP, scene.target.y))
+    assert before.position == pytest.approx(
+        (space.rects[scene.target.name].x_min - APPROACH_GAP, scene.target.y)
+    )

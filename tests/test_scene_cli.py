@@ -17,7 +17,9 @@ def assert_one_line_error(result, text: str) -> None:
     assert "Traceback" not in result.stderr
 
 
-@pytest.mark.parametrize(("kind", "objects"), [("vr", None), ("gen1", None), ("gen2", 9), ("unstructured", 6)])
+@pytest.mark.parametrize(
+    ("kind", "objects"), [("vr", None), ("gen1", None), ("gen2", 9), ("unstructured", 6)]
+)
 def test_generate_validate_show(tmp_path, kind, objects):
     out = tmp_path / f"{kind}.yaml"
     args = ["generate", "--kind", kind, "--seed", "4", "--out", str(out)]
@@ -61,7 +63,8 @@ def test_malformed_and_missing_files(tmp_path):
 
 def test_failed_generation_writes_no_file(tmp_path):
     out = tmp_path / "crowded.yaml"
-    result = run_module("hlp_drake.scene", "generate", "--kind", "gen2", "--objects", "300", "--seed", "1",
-                        "--out", str(out))
+    result = run_module(
+        "hlp_drake.scene", "generate", "--kind", "gen2", "--objects", "300", "--seed", "1", "--out", str(out)
+    )
     assert_one_line_error(result, "could not place")
     assert list(tmp_path.iterdir()) == []

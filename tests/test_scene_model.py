@@ -76,7 +76,10 @@ def test_valid_scene_has_no_problems():
         (small_scene(start=(0.4, 0.2)), "start point lies inside obstacle 'box_a'"),
         (small_scene(start=(math.nan, 0.0)), "start must be 2 finite numbers"),
         (small_scene(table=Table(0.8, 0.0, 0.75)), "table: width must be a positive number"),
-        (small_scene(target=SceneObject("Target", "box", 0.7, 0.0, (0.06, 0.06, 0.12))), "must be a cylinder"),
+        (
+            small_scene(target=SceneObject("Target", "box", 0.7, 0.0, (0.06, 0.06, 0.12))),
+            "must be a cylinder",
+        ),
         (small_scene(target=None), "scene has no target"),
     ],
 )

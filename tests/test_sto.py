@@ -15,12 +15,22 @@ from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import load_scene
 from hlp_drake.scene.model import SceneObject
 from hlp_drake.systems.control_sequence import ControlSequence
-from hlp_drake.systems.planning import first_rollout, make_planning_diagram
-from hlp_drake.systems.rollout import BLOWN_UP_COST, RolloutSamples, RolloutWorld, SceneRollouts, rollout_cost
+from hlp_drake.systems.optimiser import mppi_weights, optimise, sample_base_noise
+from hlp_drake.systems.optimiser_system import StochasticTrajectoryOptimiser
+from hlp_drake.systems.planning_diagram import first_rollout, make_planning_diagram
+from hlp_drake.systems.rollout_cost import BLOWN_UP_COST, RolloutSamples, rollout_cost
 from hlp_drake.systems.rollout_pool import RolloutPool
-from hlp_drake.systems.sto import StochasticTrajectoryOptimiser, mppi_weights, optimise, sample_base_noise
-from hlp_drake.systems.world import tcp_keypoint_height
-from hlp_drake.systems.world_config import WorldConfig
+from hlp_drake.systems.rollout_world import RolloutWorld
+from hlp_drake.systems.scenario import Scenario
+from hlp_drake.systems.scene_rollouts import SceneRollouts
+from hlp_drake.systems.start_pose import tcp_keypoint_height
+from hlp_drake.systems.weld_schedule import Sweep
+
+
+def on(scene, data: str | None = None) -> Scenario:
+    """The default scenario on ``scene``, with the YAML settings ``data`` laid over it."""
+    scenario = Scenario(scene=scene)
+    return scenario if data is None else scenario.updated(data)
 
 
 @pytest.fixture(scope="module")
@@ -33,7 +43,7 @@ def trajectories(scene):
     """The initial (IK) trajectories of both planners on the default scene."""
     result = {}
     for planner in ("hlp", "sto"):
-        diagram = make_planning_diagram(scene, planner=planner)
+        diagram = make_planning_diagram(on(scene, f"planner: {{kind: {planner}}}"))
         context = diagram.CreateDefaultContext()
         diagram.GetInputPort("scene").FixValue(context, scene)
         result[planner] = diagram.GetOutputPort("trajectory").Eval(context)
@@ -42,7 +52,7 @@ def trajectories(scene):
 
 @pytest.fixture(scope="module")
 def world(scene):
-    return RolloutWorld(scene, WorldConfig())
+    return RolloutWorld(on(scene))
 
 
 def short(sequence: ControlSequence, horizon: float) -> ControlSequence:
@@ -72,7 +82,7 @@ def test_sequence_keeps_every_keyframe_and_bounds_the_step(trajectories):
 def test_base_velocity_is_integrated_and_the_start_stays():
     from hlp_drake.systems.control_sequence import BASE_COLUMNS
     from hlp_drake.systems.robot import BASE_JOINTS
-    from hlp_drake.systems.world import robot_position_names
+    from hlp_drake.systems.start_pose import robot_position_names
 
     assert tuple(robot_position_names()[i] for i in BASE_COLUMNS) == BASE_JOINTS
     sequence = ControlSequence(np.array([0.0, 0.5, 1.5]), np.zeros((3, 11)))
@@ -92,12 +102,16 @@ def test_base_velocity_is_integrated_and_the_start_stays():
 
 
 def test_noise_is_seeded_and_keeps_only_part_of_its_drift():
-    config = WorldConfig().sto
+    config = Scenario().optimiser
     sequence = ControlSequence(np.linspace(0.0, 4.0, 9), np.zeros((9, 11)))
     a = sample_base_noise(np.random.default_rng(3), sequence, config.noise, 6)
     b = sample_base_noise(np.random.default_rng(3), sequence, config.noise, 6)
     np.testing.assert_array_equal(a, b)
-    raw = np.random.default_rng(3).normal(size=(6, 8, 3)) * [config.noise.vx, config.noise.vy, config.noise.yaw_rate]
+    raw = np.random.default_rng(3).normal(size=(6, 8, 3)) * [
+        config.noise.vx,
+        config.noise.vy,
+        config.noise.yaw_rate,
+    ]
     end = np.einsum("knj,n->kj", a, sequence.steps)
     np.testing.assert_allclose(end, config.noise.end_fraction * np.einsum("knj,n->kj", raw, sequence.steps))
 
@@ -118,28 +132,38 @@ def synthetic_samples(scene, *, tcp_end, moved=None, force=0.0, blew_up=None):
     end = positions.copy()
     if moved is not None:
         end[moved[0]] += moved[1]
-    height = tcp_keypoint_height(scene, WorldConfig())
-    return RolloutSamples(np.array([0.0, 0.5]), np.stack([positions, end]),
-                          np.array([[0.0, 0.0, height], [*tcp_end, height]]), np.array([0.0, force]),
-                          np.array([False, False]), blew_up)
+    height = tcp_keypoint_height(scene, Scenario().ik)
+    return RolloutSamples(
+        np.array([0.0, 0.5]),
+        np.stack([positions, end]),
+        np.array([[0.0, 0.0, height], [*tcp_end, height]]),
+        np.array([0.0, force]),
+        np.array([False, False]),
+        blew_up,
+    )
 
 
 def test_cost_rewards_reaching_and_charges_falls_forces_and_blow_ups(scene):
-    config = WorldConfig()
-    height = tcp_keypoint_height(scene, config)
+    config = Scenario()
+    height = tcp_keypoint_height(scene, config.ik)
     kwargs = {"tcp_height": height, "effort": 0.0, "step_duration": 0.5}
     target = (scene.target.x, scene.target.y)
-    reached = rollout_cost(synthetic_samples(scene, tcp_end=target), scene, config.sto, **kwargs)
+    sto = config.optimiser
+    reached = rollout_cost(synthetic_samples(scene, tcp_end=target), scene, sto, **kwargs)
     assert reached.success and reached.failure_reason is None and reached.cost < 1.0
-    short_of = rollout_cost(synthetic_samples(scene, tcp_end=(target[0] - 0.2, target[1])), scene, config.sto, **kwargs)
+    short_of = rollout_cost(
+        synthetic_samples(scene, tcp_end=(target[0] - 0.2, target[1])), scene, sto, **kwargs
+    )
     assert not short_of.success and "pre-grasp" in short_of.failure_reason
-    assert short_of.terms["goal"] == pytest.approx(config.sto.cost.goal_weight * 0.2)
-    fell = rollout_cost(synthetic_samples(scene, tcp_end=target, moved=(1, [0.0, 5.0, -1.0])), scene, config.sto, **kwargs)
+    assert short_of.terms["goal"] == pytest.approx(sto.cost.goal_weight * 0.2)
+    fell = rollout_cost(
+        synthetic_samples(scene, tcp_end=target, moved=(1, [0.0, 5.0, -1.0])), scene, sto, **kwargs
+    )
     assert not fell.success and scene.obstacles[0].name in fell.failure_reason
     assert fell.terms["off_table"] > 0 and fell.terms["disturbance"] > 0
-    pushed = rollout_cost(synthetic_samples(scene, tcp_end=target, force=100.0), scene, config.sto, **kwargs)
-    assert pushed.terms["force"] == pytest.approx(config.sto.cost.force_weight * 40.0)
-    broken = rollout_cost(synthetic_samples(scene, tcp_end=target, blew_up="x sank"), scene, config.sto, **kwargs)
+    pushed = rollout_cost(synthetic_samples(scene, tcp_end=target, force=100.0), scene, sto, **kwargs)
+    assert pushed.terms["force"] == pytest.approx(sto.cost.force_weight * 40.0)
+    broken = rollout_cost(synthetic_samples(scene, tcp_end=target, blew_up="x sank"), scene, sto, **kwargs)
     assert broken.cost == BLOWN_UP_COST and not broken.success and "blew up" in broken.failure_reason
 
 
@@ -151,7 +175,7 @@ def test_rollouts_are_repeatable_and_the_hlp_initialisation_reaches_the_default_
     first, second = world.rollout(sequence), world.rollout(sequence)
     assert first.success, first.failure_reason
     assert first.cost == second.cost and first.terms == second.terms  # contexts are reset, not rebuilt
-    assert first.simulated_s == pytest.approx(sequence.duration + world.config.sto.settle_s)
+    assert first.simulated_s == pytest.approx(sequence.duration + world.scenario.optimiser.settle_s)
 
 
 def test_a_gripper_closed_among_the_obstacles_does_not_carry_one_into_the_target():
@@ -159,11 +183,9 @@ def test_a_gripper_closed_among_the_obstacles_does_not_carry_one_into_the_target
     (FailOnTouchObstacleShort) and carry it through both rows into the target, which falls off
     the table; closed there, the same plan passes at its first rollout."""
     scene = generate_scene("gen1", 15)
-    closed = first_rollout(scene, config=WorldConfig())
+    closed = first_rollout(on(scene))
     assert closed.success, closed.failure_reason
-    config = WorldConfig()
-    config.motion.closed_among_obstacles = False
-    opened = first_rollout(scene, config=config)
+    opened = first_rollout(on(scene, "motion: {closed_among_obstacles: false}"))
     assert not opened.success and opened.fallen == ("Target",), opened.failure_reason
 
 
@@ -172,21 +194,22 @@ def test_where_the_hlps_plan_fails_at_its_first_rollout_its_next_candidates_are_
     obstacle and knocks another off the table; of the next three distinct candidate plans, the
     second passes at its first rollout. The straight line has no candidates to try."""
     scene = generate_scene("gen2", 39, 9)
-    config = WorldConfig()
-    config.sto.max_iterations, config.sto.samples = 1, 2
+    config = on(scene, "optimiser: {max_iterations: 1, samples: 2}")
     results = {}
-    for planner in ("hlp", "sto"):
-        diagram = make_planning_diagram(scene, planner=planner, config=config)
-        context = diagram.CreateDefaultContext()
-        diagram.GetInputPort("scene").FixValue(context, scene)
-        transfer = diagram.GetSubsystemByName("robot_plan_transfer")
-        alternatives = transfer.GetOutputPort("robot_alternatives").Eval(
-            transfer.GetMyContextFromRoot(context))
-        results[planner] = (len(alternatives), diagram.GetOutputPort("optimisation").Eval(context))
+    with RolloutPool(1) as pool:
+        for planner in ("hlp", "sto"):
+            diagram = make_planning_diagram(config.updated(f"planner: {{kind: {planner}}}"), pool=pool)
+            context = diagram.CreateDefaultContext()
+            diagram.GetInputPort("scene").FixValue(context, scene)
+            transfer = diagram.GetSubsystemByName("robot_plan_transfer")
+            alternatives = transfer.GetOutputPort("robot_alternatives").Eval(
+                transfer.GetMyContextFromRoot(context)
+            )
+            results[planner] = (len(alternatives), diagram.GetOutputPort("optimisation").Eval(context))
     count, hlp = results["hlp"]
     assert count == 3
     assert hlp.success and hlp.start == 2 and hlp.iterations == 0 and hlp.rollouts == 1 + 3
-    assert "fell off the table" in first_rollout(scene, config=config).failure_reason
+    assert "fell off the table" in first_rollout(config).failure_reason
     assert results["sto"][0] == 0 and results["sto"][1].start == 0
 
 
@@ -198,16 +221,17 @@ def test_holding_still_fails_with_the_goal_cost(world, scene):
 
 
 def test_impossible_object_speed_counts_as_a_blow_up(scene, trajectories):
-    config = WorldConfig()
-    config.sto.max_object_speed = 1e-4  # any push now exceeds it
-    outcome = RolloutWorld(scene, config).rollout(ControlSequence.from_trajectory(trajectories["sto"], 0.5))
-    assert not outcome.success and outcome.cost == BLOWN_UP_COST and "over the table" in outcome.failure_reason
+    config = on(scene, "optimiser: {max_object_speed: 1.0e-4}")  # any push now exceeds it
+    outcome = RolloutWorld(config).rollout(ControlSequence.from_trajectory(trajectories["sto"], 0.5))
+    assert (
+        not outcome.success and outcome.cost == BLOWN_UP_COST and "over the table" in outcome.failure_reason
+    )
 
 
 def test_a_drake_internal_check_failing_mid_rollout_is_a_failure_and_the_world_goes_on(scene, trajectories):
     # Non-finite state (as after a blow-up) makes Drake's SetPositions check fail inside AdvanceTo;
     # pydrake raises that as SystemExit. The rollout reports it; the world is reusable after it.
-    world = RolloutWorld(scene, WorldConfig())
+    world = RolloutWorld(on(scene))
     sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 0.5)
     world.begin(sequence)
     state = world._context.get_mutable_discrete_state_vector()
@@ -216,29 +240,31 @@ def test_a_drake_internal_check_failing_mid_rollout_is_a_failure_and_the_world_g
     state.SetFromVector(x)
     problem = world.advance_to(0.1)
     assert re.fullmatch(r"the solver failed at t = 0\.0\d s: Failure at .*AllFinite.*", problem)
-    clean = RolloutWorld(scene, WorldConfig()).rollout(sequence)
+    clean = RolloutWorld(on(scene)).rollout(sequence)
     again = world.rollout(sequence)
     assert (again.cost, again.success, again.fallen) == (clean.cost, clean.success, clean.fallen)
 
 
 def test_only_drake_failures_count_as_simulation_failures():
-    from hlp_drake.systems.rollout import simulation_failure
+    from hlp_drake.systems.rollout_world import simulation_failure
 
     assert simulation_failure(RuntimeError("SAP failed\nmore")) == "SAP failed"
-    assert simulation_failure(SystemExit("Failure at x.h:1 in f(): condition 'c' failed.")).startswith("Failure at")
+    assert simulation_failure(SystemExit("Failure at x.h:1 in f(): condition 'c' failed.")).startswith(
+        "Failure at"
+    )
     with pytest.raises(SystemExit):
         simulation_failure(SystemExit(2))
 
 
 def test_two_workers_give_the_same_outcomes_as_one(scene, trajectories):
     base = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)
-    config = WorldConfig()
-    noise = sample_base_noise(np.random.default_rng(0), base, config.sto.noise, 3)
+    config = on(scene)
+    noise = sample_base_noise(np.random.default_rng(0), base, config.optimiser.noise, 3)
     sequences = [base.with_base_velocity(v) for v in noise]
-    local = [SceneRollouts(scene, config).rollout(s) for s in sequences]  # a fresh set of worlds for each
+    local = [SceneRollouts(config).rollout(s) for s in sequences]  # a fresh set of worlds for each
     with RolloutPool(2) as pool:
         assert pool.startup_s > 0
-        remote = pool.rollouts(scene, config, sequences)
+        remote = pool.rollouts(config, sequences)
     assert [o.cost for o in remote] == [o.cost for o in local]
     assert [o.welded for o in remote] == [o.welded for o in local] and all(o.welded for o in local)
 
@@ -250,15 +276,17 @@ PUSHING_HORIZON = 3.0
 
 
 def test_the_reduced_model_welds_only_objects_nothing_comes_near(scene, trajectories, world):
-    config = WorldConfig()
-    reduced = SceneRollouts(scene, config)
+    config = on(scene)
+    reduced = SceneRollouts(config)
     sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), PUSHING_HORIZON)
     full, samples = world.simulate(sequence), reduced.simulate(sequence)
     names = [obj.name for obj in scene.objects]
-    pushed = {n for n, d in zip(names, np.linalg.norm(full.positions[-1] - full.positions[0], axis=1)) if d > 0.01}
+    pushed = {
+        n for n, d in zip(names, np.linalg.norm(full.positions[-1] - full.positions[0], axis=1)) if d > 0.01
+    }
     assert len(pushed) == 2 and samples.welded and samples.switches > 0
     assert not pushed & set(samples.welded)  # a pushed object is never welded
-    approach = world.approach_times(sequence, config.sto.weld_clearance)
+    approach = Sweep(world).approach_times(sequence, config.optimiser.weld_clearance)
     assert all(approach[name] == math.inf for name in samples.welded)  # nor one the robot's sweep comes near
     np.testing.assert_allclose(samples.positions, full.positions, atol=1e-3)  # welded ones simply stay put
     a, b = reduced.rollout(sequence), world.rollout(sequence)
@@ -266,19 +294,21 @@ def test_the_reduced_model_welds_only_objects_nothing_comes_near(scene, trajecto
     assert a.cost == pytest.approx(b.cost, rel=1e-3)
     assert a.terms["disturbance"] == pytest.approx(b.terms["disturbance"], rel=1e-2)
     assert a.welded == samples.welded and b.welded == () and b.switches == 0
-    off = dataclasses.replace(config, sto=dataclasses.replace(config.sto, reduced_model=False))
-    assert SceneRollouts(scene, off).rollout(sequence).terms == b.terms  # off: the full model
+    off = config.updated("optimiser: {reduced_model: false}")
+    assert SceneRollouts(off).rollout(sequence).terms == b.terms  # off: the full model
 
 
 def test_an_object_pushed_towards_a_welded_one_frees_it_from_the_sample_before(scene, trajectories, world):
     sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), PUSHING_HORIZON)
     chained = "FailOnTouchObstacleMed-1"  # pushed by Long before the robot itself comes near it
-    alone = RolloutWorld(scene, WorldConfig(), welded_objects=[chained]).simulate(sequence)
+    alone = RolloutWorld(on(scene), welded_objects=[chained]).simulate(sequence)
     assert alone.touched == (chained,) and alone.times[-1] < 2.5  # no world to go on with: it stops there
-    config = WorldConfig()
-    config.sto.weld_clearance, config.sto.weld_lookahead = 0.01, 0.0  # the schedule frees late...
-    assert world.approach_times(sequence, config.sto.weld_clearance)[chained] > alone.times[-1] + 0.1
-    samples = SceneRollouts(scene, config).simulate(sequence)  # ...so the check during the rollout must
+    config = on(scene, "optimiser: {weld_clearance: 0.01, weld_lookahead: 0.0}")  # the schedule frees late...
+    assert (
+        Sweep(world).approach_times(sequence, config.optimiser.weld_clearance)[chained]
+        > alone.times[-1] + 0.1
+    )
+    samples = SceneRollouts(config).simulate(sequence)  # ...so the check during the rollout must
     assert chained not in samples.welded and samples.switches >= 2 and samples.touched == ()
     np.testing.assert_allclose(samples.positions, world.simulate(sequence).positions, atol=1e-3)
     with pytest.raises(ValueError, match=chained):
@@ -287,7 +317,7 @@ def test_an_object_pushed_towards_a_welded_one_frees_it_from_the_sample_before(s
 
 def test_a_rollout_carried_over_to_another_world_goes_on_exactly(scene, trajectories, world):
     sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 2.0)
-    other = RolloutWorld(scene, WorldConfig())
+    other = RolloutWorld(on(scene))
     world.begin(sequence)
     world.advance_to(2.0)
     end = world.states()
@@ -304,12 +334,11 @@ def test_a_rollout_carried_over_to_another_world_goes_on_exactly(scene, trajecto
 
 
 def test_optimiser_is_seeded_monotone_and_stops_at_its_iteration_budget(scene, trajectories):
-    config = WorldConfig()
-    config.sto.max_iterations, config.sto.samples, config.sto.update = 2, 2, "mppi"
+    config = on(scene, "optimiser: {max_iterations: 2, samples: 2, update: mppi}")
     initial = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)  # too short to reach
     with RolloutPool(1) as pool:
-        first = optimise(scene, initial, config, pool=pool)
-        second = optimise(scene, initial, config, pool=pool)
+        first = optimise(config, initial, pool)
+        second = optimise(config, initial, pool)
     assert not first.success and "after 2 iterations" in first.failure_reason
     assert first.iterations == 2 and first.rollouts == 1 + 2 * (2 + 1)  # mppi rolls its mean out too
     assert all(b <= a for a, b in zip(first.costs, first.costs[1:]))
@@ -318,17 +347,16 @@ def test_optimiser_is_seeded_monotone_and_stops_at_its_iteration_budget(scene, t
 
 
 def test_optimiser_respects_its_time_budget(scene, trajectories):
-    config = WorldConfig()
-    config.sto.time_budget_s = 1e-3
+    config = on(scene, "optimiser: {time_budget_s: 1.0e-3}")
     initial = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)
-    result = optimise(scene, initial, config)
+    with RolloutPool(1) as pool:
+        result = optimise(config, initial, pool)
     assert not result.success and result.iterations == 0 and result.rollouts == 1
     assert "time budget" in result.failure_reason
 
 
 def test_a_failed_initial_rollout_goes_on_from_the_planners_first_passing_alternative(scene, trajectories):
-    config = WorldConfig()
-    config.sto.max_iterations, config.sto.samples = 1, 1
+    config = on(scene, "optimiser: {max_iterations: 1, samples: 1}")
     stuck = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)  # fails: too short
     reaching = ControlSequence.from_trajectory(trajectories["hlp"], 0.5)  # passes
     calls = []
@@ -338,69 +366,87 @@ def test_a_failed_initial_rollout_goes_on_from_the_planners_first_passing_altern
         return [stuck, reaching, reaching]
 
     with RolloutPool(1) as pool:
-        passed = optimise(scene, reaching, config, pool=pool, alternatives=alternatives)
+        passed = optimise(config, reaching, pool, alternatives=alternatives)
         assert passed.success and passed.start == 0 and passed.rollouts == 1 and not calls  # not needed
-        result = optimise(scene, stuck, config, pool=pool, alternatives=alternatives)
+        result = optimise(config, stuck, pool, alternatives=alternatives)
         assert calls == [1]
         assert result.success and result.iterations == 0 and result.start == 2  # the first that passes
         assert result.rollouts == 1 + 3 and result.sequence is not stuck
         assert result.to_dict()["start"] == 2 and result.costs[-1] < result.costs[0]
-        config.sto.alternatives = 1  # only the first alternative: it fails too, and costs no less
-        capped = optimise(scene, stuck, config, pool=pool, alternatives=alternatives)
+        one = config.updated(
+            "optimiser: {alternatives: 1}"
+        )  # only the first: it fails too, and costs no less
+        capped = optimise(one, stuck, pool, alternatives=alternatives)
         assert not capped.success and capped.start == 0 and capped.rollouts == 1 + 1 + 1
-        config.sto.alternatives = 0
-        never = optimise(scene, stuck, config, pool=pool, alternatives=lambda: pytest.fail("called"))
+        none = config.updated("optimiser: {alternatives: 0}")
+        never = optimise(none, stuck, pool, alternatives=lambda: pytest.fail("called"))
         assert never.rollouts == 1 + 1
 
 
 def test_a_start_in_collision_fails_without_rollouts(scene, trajectories):
-    blocker = SceneObject(name="Blocker", shape="box", x=float(scene.start[0]) + 0.03, y=float(scene.start[1]),
-                          size=(0.04, 0.16, 0.12))  # wider than the open fingers
+    blocker = SceneObject(
+        name="Blocker",
+        shape="box",
+        x=float(scene.start[0]) + 0.03,
+        y=float(scene.start[1]),
+        size=(0.04, 0.16, 0.12),
+    )  # wider than the open fingers
     blocked = dataclasses.replace(scene, obstacles=(*scene.obstacles, blocker))
     initial = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)
-    config = WorldConfig()
-    config.sto.max_iterations = 1
-    result = optimise(blocked, initial, config)
+    with RolloutPool(1) as pool:
+        result = optimise(on(blocked, "optimiser: {max_iterations: 1}"), initial, pool)
     assert not result.success and result.rollouts == 0
     assert result.failure_reason == "the robot starts in collision with Blocker"
 
 
 def test_optimiser_block_ports_and_cache(scene, trajectories):
-    config = WorldConfig()
-    config.sto.max_iterations = 1
-    block = StochasticTrajectoryOptimiser(scene, config)
-    context = block.CreateDefaultContext()
-    empty = block.get_result_output_port().Eval(context)
-    assert not empty.success and empty.failure_reason == "no initial trajectory"
-    block.get_input_port(0).FixValue(context, trajectories["hlp"])
-    result = block.GetOutputPort("result").Eval(context)
-    trajectory = block.GetOutputPort("trajectory").Eval(context)
-    block.GetOutputPort("result").Eval(context)
-    assert block.num_optimisations == 1
-    assert result.success and result.iterations == 0  # the HLP initialisation already succeeds here
-    assert isinstance(trajectory, PiecewisePolynomial)
-    assert trajectory.end_time() == pytest.approx(trajectories["hlp"].end_time())
-    block.GetInputPort("alternative_trajectories").FixValue(context, (trajectories["hlp"],))
-    again = block.GetOutputPort("result").Eval(context)  # a new input value: optimised again
-    assert block.num_optimisations == 2 and again.success and again.start == 0
+    with RolloutPool(1) as pool:
+        block = StochasticTrajectoryOptimiser(on(scene, "optimiser: {max_iterations: 1}"), pool)
+        assert [block.get_input_port(i).get_name() for i in range(block.num_input_ports())] == [
+            "scene",
+            "initial_trajectory",
+            "alternative_trajectories",
+        ]
+        context = block.CreateDefaultContext()
+        empty = block.get_result_output_port().Eval(context)
+        assert not empty.success and empty.failure_reason == "no initial trajectory"
+        block.GetInputPort("initial_trajectory").FixValue(context, trajectories["hlp"])
+        with pytest.raises(RuntimeError, match="connect or fix its 'scene' input"):
+            block.GetOutputPort("result").Eval(context)
+        block.get_scene_input_port().FixValue(context, scene)
+        result = block.GetOutputPort("result").Eval(context)
+        trajectory = block.GetOutputPort("trajectory").Eval(context)
+        assert block.GetOutputPort("result").Eval(context) is result  # cached
+        assert result.success and result.iterations == 0  # the HLP initialisation already succeeds here
+        assert isinstance(trajectory, PiecewisePolynomial)
+        assert trajectory.end_time() == pytest.approx(trajectories["hlp"].end_time())
+        block.GetInputPort("alternative_trajectories").FixValue(context, (trajectories["hlp"],))
+        again = block.GetOutputPort("result").Eval(context)  # a new input value: optimised again
+        assert again is not result and again.success and again.start == 0
 
 
 def test_an_unreachable_target_fails_with_a_reason_and_no_rollouts(scene):
     from hlp_drake.systems.execution import plan_and_execute
 
     far = dataclasses.replace(scene.target, x=scene.table.length + 1.5)
-    config = WorldConfig()
-    config.sto.workers = 1
-    result = plan_and_execute(dataclasses.replace(scene, target=far), planner="sto", config=config)
-    assert not result.success and result.failure_reason.startswith("IK failed") and "Target" in result.failure_reason
+    with RolloutPool(1) as pool:
+        unreachable = on(dataclasses.replace(scene, target=far))  # (an invalid scene: built, not loaded)
+        straight = dataclasses.replace(
+            unreachable, planner=dataclasses.replace(unreachable.planner, kind="sto")
+        )
+        result = plan_and_execute(straight, pool=pool)
+    assert (
+        not result.success
+        and result.failure_reason.startswith("IK failed")
+        and "Target" in result.failure_reason
+    )
     assert result.rollouts == 0 and result.grasp_held is None
 
 
-def test_forgetting_the_worlds_makes_the_next_run_build_its_own(scene):
-    from hlp_drake.systems.rollout_pool import forget_worlds
-
-    pool = RolloutPool(1)
-    kept = pool.world(scene, WorldConfig())
-    assert pool.world(scene, WorldConfig()) is kept
-    forget_worlds()
-    assert pool.world(scene, WorldConfig()) is not kept
+def test_a_pool_keeps_its_worlds_by_scenario_until_it_is_closed(scene):
+    with RolloutPool(1) as pool:
+        kept = pool.world(on(scene))
+        assert pool.world(on(scene)) is kept  # an equal scenario: the same key, the same worlds
+        assert pool.world(on(scene, "optimiser: {samples: 3}")) is not kept
+    with RolloutPool(1) as other:  # worlds belong to their pool
+        assert other.world(on(scene)) is not kept

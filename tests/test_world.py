@@ -1,4 +1,4 @@
-"""The simulated world: config loading, scene models, the world diagram, resting and pushed objects."""
+"""The simulated world: scenario loading, scene models, the world diagram, resting and pushed objects."""
 
 from __future__ import annotations
 
@@ -17,7 +17,9 @@ from pydrake.trajectories import PiecewisePolynomial
 from hlp_drake.errors import HlpError
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene, SceneObject, Table
+from hlp_drake.systems.planning_model import PlanningModel
 from hlp_drake.systems.robot import ACTUATED_JOINTS, BASE_FOOTPRINT, TCP_FRAME
+from hlp_drake.systems.scenario import Scenario, load_scenario
 from hlp_drake.systems.scene_models import (
     add_scene,
     fallen_objects,
@@ -29,18 +31,14 @@ from hlp_drake.systems.scene_models import (
     set_object_poses,
     tilted_objects,
 )
+from hlp_drake.systems.start_pose import robot_base_pose, robot_position_names, start_configuration
 from hlp_drake.systems.world import (
     DESIRED_STATE_PORT,
-    PlanningModel,
     add_position_trajectory,
     desired_state_from_robot_state,
     make_world_diagram,
-    robot_base_pose,
-    robot_position_names,
-    start_configuration,
     world_plant,
 )
-from hlp_drake.systems.world_config import WorldConfig, dump_world_config, load_world_config
 
 KINDS = ("vr", "gen1", "gen2")
 OUTPUTS = {"robot.state", "state", "body_poses", "contact_results", "query_object"}
@@ -57,72 +55,93 @@ def scenes() -> dict[str, Scene]:
 
 @pytest.fixture(scope="module")
 def worlds(scenes):
-    return {kind: make_world_diagram(scene) for kind, scene in scenes.items()}
+    return {kind: make_world_diagram(Scenario(scene=scene)) for kind, scene in scenes.items()}
 
 
 def resting_z(scene: Scene) -> dict[str, float]:
     return {obj.name: scene.table.height + obj.height / 2.0 for obj in scene.objects}
 
 
-# --- Config -------------------------------------------------------------------------------------
+# --- Scenario -----------------------------------------------------------------------------------
 
 
-def test_default_config_uses_sap_point_contact_and_stiff_materials():
-    config = load_world_config()
-    assert config.plant.time_step == pytest.approx(0.002)
-    assert config.plant.discrete_contact_approximation == "sap"
-    assert config.plant.contact_model == "point"
-    assert config.contact.stiffness >= 1e6 and config.contact.corner_sphere_radius > 0
-    assert config.control.gravity_compensation
-    assert 0.1 <= config.scene.object_min_mass < config.scene.object_max_mass <= 0.5
+def test_default_scenario_uses_sap_point_contact_and_stiff_materials():
+    scenario = load_scenario()
+    assert scenario.plant.time_step == pytest.approx(0.002)
+    assert scenario.plant.discrete_contact_approximation == "sap"
+    assert scenario.plant.contact_model == "point"
+    assert scenario.contact.stiffness >= 1e6 and scenario.contact.corner_sphere_radius > 0
+    assert scenario.controller.gravity_compensation
+    assert 0.1 <= scenario.bodies.object_min_mass < scenario.bodies.object_max_mass <= 0.5
+    assert scenario.scene.name.startswith("default") and scenario.planner.kind == "hlp"
 
 
-def test_config_loads_from_yaml_and_overrides(tmp_path):
-    path = tmp_path / "world.yaml"
+def test_scenario_loads_from_yaml_and_overrides_and_reads_back_its_own_yaml(tmp_path):
+    path = tmp_path / "scenario.yaml"
     path.write_text(
-        "plant:\n  time_step: 0.005\ncontrol:\n  arm: {kp: 3000.0, kd: 200.0}\nmotion:\n  tcp_speed: 0.2\n"
+        "plant:\n  time_step: 0.005\ncontroller:\n  arm: {kp: 3000.0, kd: 200.0}\nmotion:\n  tcp_speed: 0.2\n"
     )
-    config = load_world_config(path, overrides="motion: {tcp_speed: 0.15}\nmeshcat: true\n")
-    assert config.plant.time_step == 0.005
-    assert config.plant.discrete_contact_approximation == "sap"  # untouched defaults stay
-    assert (config.control.arm.kp, config.control.arm.kd) == (3000.0, 200.0)
-    assert config.control.wrist == WorldConfig().control.wrist
-    assert config.motion.tcp_speed == 0.15 and config.meshcat
-    assert dump_world_config(load_world_config(overrides=dump_world_config(config))) == dump_world_config(
-        config
-    )
+    scenario = load_scenario(path, data="motion: {tcp_speed: 0.15}\nplanner: {kind: sto}\n")
+    assert scenario.plant.time_step == 0.005
+    assert scenario.plant.discrete_contact_approximation == "sap"  # untouched defaults stay
+    assert (scenario.controller.arm.kp, scenario.controller.arm.kd) == (3000.0, 200.0)
+    assert scenario.controller.wrist == Scenario().controller.wrist
+    assert scenario.motion.tcp_speed == 0.15 and scenario.planner.kind == "sto"
+    again = load_scenario(data=scenario.yaml)
+    assert again.yaml == scenario.yaml and again.key == scenario.key != Scenario().key
+    assert again.scene == scenario.scene and again.optimiser == scenario.optimiser
     (tmp_path / "empty.yaml").write_text("# nothing to change\n")
-    assert dump_world_config(load_world_config(tmp_path / "empty.yaml")) == dump_world_config(WorldConfig())
+    assert load_scenario(tmp_path / "empty.yaml").key == Scenario().key
+
+
+def test_a_scenarios_scene_is_read_whole_in_the_scene_file_format(tmp_path):
+    from hlp_drake.scene.io import scene_to_text
+
+    scene = generate_scene("gen1", 5)
+    text = "scene:\n" + "".join(f"  {line}\n" for line in scene_to_text(scene).splitlines())
+    scenario = load_scenario(data=text + "optimiser: {samples: 3}\n")
+    assert scenario.scene == scene and scenario.optimiser.samples == 3
+    with pytest.raises(HlpError) as info:  # a scene is whole: no field of the default scene is kept
+        load_scenario(data="scene: {name: partial, start: [0.1, 0.0]}\n")
+    assert info.value.problems == (
+        "overrides: scene: missing field 'table'",
+        "overrides: scene: missing field 'target'",
+    )
 
 
 @pytest.mark.parametrize(
     "text, problem",
     [
-        ("plant: [0.002,\n", "invalid YAML"),
-        ("plant: {time_stp: 0.002}\n", "time_stp"),
-        ("control: {arm: {kp: fast}}\n", "fast"),
-        ("ik: 3\n", "structure"),
+        ("plant: [0.002,\n", "not valid YAML at line 2"),
+        ("plant: {time_stp: 0.002}\n", "plant: unknown field 'time_stp'"),
+        ("controller: {arm: {kp: fast}}\n", "controller.arm.kp: expected a number, got 'fast'"),
+        ("ik: 3\n", "ik: expected a mapping, got int"),
         ("plant: {discrete_contact_approximation: tamsi}\n", "SAP"),
-        ("plant: {time_step: 0.0}\n", "time_step"),
-        ("scene: {object_min_mass: 1.0, object_max_mass: 0.5}\n", "object_max_mass"),
-        ("sto: {update: annealing}\n", "sto.update"),
-        ("sto: {samples: 0}\n", "sto.samples"),
-        ("sto: {noise: {end_fraction: 1.5}}\n", "sto.noise.end_fraction"),
-        ("sto: {weld_clearance: 0.0}\n", "sto.weld_clearance"),
-        ("sto: {weld_margin: 0.5}\n", "sto.weld_margin"),
+        ("plant: {time_step: 0.0}\n", "plant.time_step must be > 0"),
+        ("bodies: {object_min_mass: 1.0, object_max_mass: 0.5}\n", "object_max_mass"),
+        (
+            "optimiser: {update: annealing}\n",
+            "optimiser.update: expected one of greedy, mppi, got 'annealing'",
+        ),
+        ("optimiser: {samples: 0}\n", "optimiser.samples"),
+        ("optimiser: {noise: {end_fraction: 1.5}}\n", "optimiser.noise.end_fraction"),
+        ("optimiser: {weld_clearance: 0.0}\n", "optimiser.weld_clearance"),
+        ("optimiser: {weld_margin: 0.5}\n", "optimiser.weld_margin"),
+        ("transfer: {travel_step: 0.0}\n", "transfer.travel_step"),
+        ("planner: {kind: astar}\n", "planner.kind: expected one of hlp, sto, got 'astar'"),
+        ("scene: {table: 3}\n", "scene.table: expected a mapping"),
         ("grasp: {lift_s: 0.0}\n", "grasp.lift_s"),
     ],
 )
-def test_bad_config_file_raises_a_one_line_hlp_error_naming_the_file(tmp_path, text, problem):
-    path = tmp_path / "bad_world.yaml"
+def test_bad_scenario_file_raises_one_line_hlp_errors_naming_the_file_and_field(tmp_path, text, problem):
+    path = tmp_path / "bad_scenario.yaml"
     path.write_text(text)
     with pytest.raises(HlpError) as info:
-        load_world_config(path)
-    message = str(info.value)
-    assert "bad_world.yaml" in message and problem in message
-    assert "\n" not in message
+        load_scenario(path)
+    assert any(problem in p for p in info.value.problems), info.value.problems
+    assert all(p.startswith(str(path)) and "\n" not in p for p in info.value.problems)
     with pytest.raises(HlpError, match=r"missing\.yaml"):
-        load_world_config(tmp_path / "missing.yaml")
+        load_scenario(tmp_path / "missing.yaml")
 
 
 # --- Scene models -------------------------------------------------------------------------------
@@ -137,12 +156,12 @@ def test_scene_objects_are_free_bodies_named_after_the_scene(scenes):
     plant.Finalize()
     assert models.names == tuple(obj.name for obj in scene.objects)
     assert plant.num_positions() == 7 * len(scene.objects)  # free bodies only; the table is welded
-    config = WorldConfig()
+    bodies = Scenario().bodies
     for obj in scene.objects:
         body = object_body(plant, obj.name)
         assert body.is_floating_base_body() if hasattr(body, "is_floating_base_body") else body.is_floating()
-        assert body.default_mass() == pytest.approx(object_mass(obj, config.scene))
-        assert config.scene.object_min_mass <= body.default_mass() <= config.scene.object_max_mass
+        assert body.default_mass() == pytest.approx(object_mass(obj, bodies))
+        assert bodies.object_min_mass <= body.default_mass() <= bodies.object_max_mass
     context = plant.CreateDefaultContext()
     poses = object_planar_poses(plant, context, scene)
     for obj in scene.objects:
@@ -200,17 +219,18 @@ def test_chosen_objects_can_be_welded(scenes):
     poses = object_planar_poses(plant, context, scene)
     for obj in scene.objects:
         np.testing.assert_allclose(poses[obj.name], (obj.x, obj.y, obj.yaw), atol=1e-12)
-    world = make_world_diagram(scene, welded_objects=welded)
+    world = make_world_diagram(Scenario(scene=scene), welded_objects=welded)
     assert world_plant(world)[0].num_positions() == 11 + 7 * (len(scene.objects) - len(welded))
     with pytest.raises(ValueError, match="Nowhere"):
         add_scene(MultibodyPlant(time_step=0.0), scene, welded_objects=["Nowhere"])
 
 
-def test_planning_model_welds_the_objects(scenes):
-    model = PlanningModel(scenes["gen1"])
-    assert model.plant.num_positions() == 11
-    assert len(model.object_geometries()) > len(scenes["gen1"].objects)  # boxes + corner spheres
-    assert model.plant.time_step() == 0.0
+def test_planning_model_welds_the_objects_or_leaves_them_out(scenes):
+    model = PlanningModel(Scenario(scene=scenes["gen1"]))
+    assert model.plant.num_positions() == 11 and model.plant.time_step() == 0.0
+    assert set(model.scene_models.objects) == {o.name for o in scenes["gen1"].objects}
+    bare = PlanningModel(Scenario(scene=scenes["gen1"]), with_objects=False)
+    assert bare.plant.num_positions() == 11 and not bare.scene_models.objects
 
 
 # --- World diagram ------------------------------------------------------------------------------
@@ -235,7 +255,9 @@ def test_world_diagram_builds_with_named_ports(worlds, scenes, kind):
     context = world.CreateDefaultContext()
     plant_context = plant.GetMyContextFromRoot(context)
     np.testing.assert_allclose(
-        plant.GetPositions(plant_context, robot), start_configuration(scene, plant, robot), atol=1e-12
+        plant.GetPositions(plant_context, robot),
+        start_configuration(scene, Scenario().ik, plant, robot),
+        atol=1e-12,
     )
     poses = object_planar_poses(plant, plant_context, scene)
     for obj in scene.objects:
@@ -248,8 +270,8 @@ def test_world_diagram_builds_with_named_ports(worlds, scenes, kind):
 @pytest.mark.parametrize("kind", KINDS)
 def test_robot_starts_in_front_of_the_table_with_the_tcp_above_the_start(worlds, scenes, kind):
     world, scene = worlds[kind], scenes[kind]
-    config = WorldConfig()
-    x, y, yaw = robot_base_pose(scene)
+    config = Scenario()
+    x, y, yaw = robot_base_pose(scene, config.ik)
     assert x + BASE_FOOTPRINT[0] / 2.0 <= -config.ik.start_base_clearance + 1e-12  # front edge off the table
     assert yaw == 0.0 and y == scene.start[1]
     plant, robot = world_plant(world)
@@ -303,7 +325,7 @@ def push_scene() -> Scene:
 
 def test_a_box_pushed_by_the_gripper_slides_and_stays_on_the_table():
     scene = push_scene()
-    world = make_world_diagram(scene)
+    world = make_world_diagram(Scenario(scene=scene))
     builder = DiagramBuilder()
     builder.AddSystem(world)
     plant, robot = world_plant(world)
@@ -336,15 +358,16 @@ def test_a_box_pushed_by_the_gripper_slides_and_stays_on_the_table():
 
 def test_world_with_a_yaml_config_and_without_gravity_compensation(tmp_path):
     path = tmp_path / "coarse.yaml"
-    path.write_text("plant: {time_step: 0.005}\ncontrol: {gravity_compensation: false}\n")
-    config = load_world_config(path)
+    path.write_text("plant: {time_step: 0.005}\ncontroller: {gravity_compensation: false}\n")
     scene = replace(push_scene(), obstacles=())
-    world = make_world_diagram(scene, config)
+    world = make_world_diagram(replace(load_scenario(path), scene=scene))
     plant, _ = world_plant(world)
     assert plant.time_step() == 0.005
     names = {system.get_name() for system in world.GetSystems()}
     assert "gravity_compensation" not in names
-    assert "gravity_compensation" in {s.get_name() for s in make_world_diagram(scene).GetSystems()}
+    assert "gravity_compensation" in {
+        s.get_name() for s in make_world_diagram(Scenario(scene=scene)).GetSystems()
+    }
 
 
 def test_meshcat_visualisation_is_optional(monkeypatch):
@@ -356,7 +379,7 @@ def test_meshcat_visualisation_is_optional(monkeypatch):
     except RuntimeError as error:  # no free port in a sandbox
         pytest.skip(f"MeshCat cannot start here: {error}")
     scene = replace(push_scene(), obstacles=())
-    world = make_world_diagram(scene, meshcat=meshcat)
+    world = make_world_diagram(Scenario(scene=scene), meshcat=meshcat, contact_forces=True)
     simulator = Simulator(world)
     simulator.AdvanceTo(0.05)
-    assert meshcat.HasPath("/drake/visualizer")
+    assert meshcat.HasPath("/drake/visualizer") and meshcat.HasPath("/drake/contact_forces")

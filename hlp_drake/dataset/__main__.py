@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 from collections.abc import Sequence
 from typing import Any
 
 from hlp_drake.atomic import write_text_atomic
-from hlp_drake.cli import run_cli
+from hlp_drake.cli import make_parser, run_cli
 from hlp_drake.dataset.dataset import Dataset
 from hlp_drake.dataset.records import CATEGORIES
 
@@ -45,7 +44,7 @@ def format_summary(summary: dict[str, Any]) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m hlp_drake.dataset", description=__doc__)
+    parser = make_parser("python -m hlp_drake.dataset", __doc__)
     commands = parser.add_subparsers(dest="command", required=True)
     summary = commands.add_parser("summary", help="trial and success counts per category")
     summary.add_argument("--dataset", help="the archive or the unpacked dataset/ folder (default: $HLP_DATASET)")

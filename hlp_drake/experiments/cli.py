@@ -1,7 +1,7 @@
-"""``python -m hlp_drake.experiments {gen1,gen2}``: the paper's Generalization I and II experiments.
+"""The paper's Generalization I and II experiments (Tables II and III), resumable, local or on dask.
 
     python -m hlp_drake.experiments {gen1,gen2} [--scenes 100] [--objects 5 7 9] [--seed S]
-        [--workers N] [--executor local|dask] [--scheduler ADDRESS] [--config WORLD.yaml] [--fresh]
+        [--workers N] [--executor local|dask] [--scheduler ADDRESS] [--config SCENARIO.yaml] [--fresh]
         [--quiet] --out DIR
 
 Every scene is planned and executed with both planners (HLP and STO's straight line); scene i has
@@ -19,8 +19,8 @@ import shlex
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import NoReturn
 
+from hlp_drake.cli import add_quiet, make_parser
 from hlp_drake.errors import HlpError
 from hlp_drake.experiments.executors import EXECUTORS
 from hlp_drake.experiments.experiment import DERIVED, RESULTS, ExperimentSettings, run_experiment
@@ -30,30 +30,43 @@ from hlp_drake.experiments.summary import summary_markdown
 PROG = "python -m hlp_drake.experiments"
 
 
-class _Parser(argparse.ArgumentParser):
-    """An argument parser whose usage errors are one-line ``HlpError``s (exit 2 through ``run_cli``)."""
-
-    def error(self, message: str) -> NoReturn:
-        raise HlpError(f"{message} (see {self.prog} --help)")
-
-
 def _parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog=PROG, description="The paper's Generalization I and II experiments (Tables II and III).",
-                     epilog=__doc__.split("\n\n", 2)[2], formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = make_parser(PROG, __doc__)
     parser.add_argument("kind", choices=KINDS, help="gen1: Table II; gen2: Table III")
-    parser.add_argument("--scenes", type=int, default=100, metavar="N", help="scenes per condition (default 100)")
-    parser.add_argument("--objects", type=int, nargs="+", default=[5, 7, 9], metavar="K",
-                        help="gen2's object counts, one condition each (default 5 7 9; gen1 ignores it: 6)")
+    parser.add_argument(
+        "--scenes", type=int, default=100, metavar="N", help="scenes per condition (default 100)"
+    )
+    parser.add_argument(
+        "--objects",
+        type=int,
+        nargs="+",
+        default=[5, 7, 9],
+        metavar="K",
+        help="gen2's object counts, one condition each (default 5 7 9; gen1 ignores it: 6)",
+    )
     parser.add_argument("--seed", type=int, default=0, metavar="S", help="scene i has seed S + i (default 0)")
     parser.add_argument("--workers", type=int, metavar="N", help="jobs at a time (default: one per core)")
-    parser.add_argument("--executor", choices=EXECUTORS, default="local",
-                        help="local (default): this process or a process pool; dask: a dask cluster")
-    parser.add_argument("--scheduler", metavar="ADDRESS",
-                        help="dask scheduler address (default: a LocalCluster of --workers processes)")
-    parser.add_argument("--config", metavar="WORLD.yaml", help="world configuration YAML (WorldConfig)")
+    parser.add_argument(
+        "--executor",
+        choices=EXECUTORS,
+        default="local",
+        help="local (default): this process or a process pool; dask: a dask cluster",
+    )
+    parser.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="dask scheduler address (default: a LocalCluster of --workers processes)",
+    )
+    parser.add_argument(
+        "--config",
+        metavar="SCENARIO.yaml",
+        help="scenario settings (see hlp_drake.systems.Scenario); each job has its own scene",
+    )
     parser.add_argument("--fresh", action="store_true", help="discard DIR's earlier results and start over")
-    parser.add_argument("--quiet", action="store_true", help="no progress bar")
-    parser.add_argument("--out", required=True, metavar="DIR", help="output directory (resumes the run there)")
+    add_quiet(parser)
+    parser.add_argument(
+        "--out", required=True, metavar="DIR", help="output directory (resumes the run there)"
+    )
     return parser
 
 
@@ -65,12 +78,19 @@ def main(argv: Sequence[str] | None = None, *, job: JobFunction = run_job) -> in
         try:
             config_yaml = Path(args.config).read_text(encoding="utf-8")
         except FileNotFoundError:
-            raise HlpError(f"{args.config}: world config file not found") from None
+            raise HlpError(f"{args.config}: scenario file not found") from None
         except (OSError, UnicodeDecodeError) as error:
-            raise HlpError(f"{args.config}: cannot read the world config: {error}") from None
+            raise HlpError(f"{args.config}: cannot read the scenario: {error}") from None
     settings = ExperimentSettings(
-        kind=args.kind, scenes=args.scenes, objects=tuple(args.objects), seed=args.seed, workers=args.workers,
-        executor=args.executor, scheduler=args.scheduler, config_yaml=config_yaml, fresh=args.fresh,
+        kind=args.kind,
+        scenes=args.scenes,
+        objects=tuple(args.objects),
+        seed=args.seed,
+        workers=args.workers,
+        executor=args.executor,
+        scheduler=args.scheduler,
+        config_yaml=config_yaml,
+        fresh=args.fresh,
         progress=not args.quiet,
     )
     command = f"{PROG} {shlex.join(sys.argv[1:] if argv is None else argv)}"

@@ -26,8 +26,9 @@ def require_dask() -> ModuleType:
     try:
         import distributed
     except ImportError:
-        raise HlpError(f"--executor dask needs dask.distributed, which is not installed: {CLUSTER_EXTRA}") \
-            from None
+        raise HlpError(
+            f"--executor dask needs dask.distributed, which is not installed: {CLUSTER_EXTRA}"
+        ) from None
     return distributed
 
 
@@ -48,8 +49,14 @@ def check_executor(executor: str, scheduler: str | None) -> None:
         connect(distributed, scheduler).close()
 
 
-def run_jobs(job_function: JobFunction, jobs: Sequence[Job], *, executor: str = "local", workers: int = 1,
-             scheduler: str | None = None) -> Iterator[tuple[Job, Row]]:
+def run_jobs(
+    job_function: JobFunction,
+    jobs: Sequence[Job],
+    *,
+    executor: str = "local",
+    workers: int = 1,
+    scheduler: str | None = None,
+) -> Iterator[tuple[Job, Row]]:
     """Run ``job_function`` on every job; yield ``(job, row)`` as each finishes.
 
     Args:
@@ -67,8 +74,9 @@ def run_jobs(job_function: JobFunction, jobs: Sequence[Job], *, executor: str = 
         yield from _in_process_pool(job_function, jobs, workers)
 
 
-def _in_process_pool(job_function: JobFunction, jobs: Sequence[Job],
-                     workers: int) -> Iterator[tuple[Job, Row]]:
+def _in_process_pool(
+    job_function: JobFunction, jobs: Sequence[Job], workers: int
+) -> Iterator[tuple[Job, Row]]:
     spawn = multiprocessing.get_context("spawn")  # fresh interpreters: never fork a process holding Drake
     pool = ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=spawn)
     try:
@@ -93,13 +101,17 @@ def _terminate_workers(pool: ProcessPoolExecutor) -> None:
         process.terminate()
 
 
-def _on_dask(job_function: JobFunction, jobs: Sequence[Job], workers: int,
-             scheduler: str | None) -> Iterator[tuple[Job, Row]]:
+def _on_dask(
+    job_function: JobFunction, jobs: Sequence[Job], workers: int, scheduler: str | None
+) -> Iterator[tuple[Job, Row]]:
     distributed = require_dask()
     with contextlib.ExitStack() as stack:
         if scheduler is None:
-            cluster = stack.enter_context(distributed.LocalCluster(
-                n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None))
+            cluster = stack.enter_context(
+                distributed.LocalCluster(
+                    n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None
+                )
+            )
             client = stack.enter_context(distributed.Client(cluster))
         else:
             client = stack.enter_context(connect(distributed, scheduler))

@@ -1,6 +1,6 @@
 """Run a whole experiment into a directory, resumably: jobs -> ``results.csv`` -> summary and plots.
 
-The directory holds ``config.json`` (what the rows depend on: kind, first seed, world config),
+The directory holds ``config.json`` (what the rows depend on: kind, first seed, scenario settings),
 ``results.csv`` (rewritten atomically after every finished job), ``run.json`` (the run's settings,
 machine and software), ``summary.md``/``summary.json`` and ``success.png``/``times.png``.
 Scene i of a run has seed ``seed + i``. Rows already in ``results.csv`` are kept and not run again;
@@ -30,7 +30,7 @@ from hlp_drake.experiments.summary import summarise, write_summary
 
 RESULTS, CONFIG, RUN = "results.csv", "config.json", "run.json"
 DERIVED = ("summary.md", "summary.json", "success.png", "times.png")
-IDENTITY_LABELS = {"kind": "kind", "seed": "seed", "world_config": "world config"}
+IDENTITY_LABELS = {"kind": "kind", "seed": "seed", "scenario": "scenario"}
 START_OVER = "use --fresh to start over or choose another --out"
 
 
@@ -46,7 +46,8 @@ class ExperimentSettings:
             optimiser rolls out in its own process (``sto.workers = 1``: no nested pools).
         executor: "local" (this process, or a spawn process pool) or "dask".
         scheduler: the dask scheduler's address (None: start a ``LocalCluster`` of ``workers``).
-        config_yaml: the world config as YAML text (None: ``WorldConfig()``'s defaults).
+        config_yaml: the scenario settings as YAML text (None: ``Scenario()``'s defaults; its scene is
+            replaced by each job's).
         fresh: start over, discarding the directory's earlier results.
     """
 
@@ -89,14 +90,20 @@ class ExperimentSettings:
         return problems
 
 
-def world_config_yaml(text: str | None, *, single_process_rollouts: bool = False) -> str:
-    """``text`` (None: the defaults) validated and written out in full; optionally ``sto.workers = 1``."""
-    from hlp_drake.systems.world_config import dump_world_config, load_world_config
+def scenario_yamls(text: str | None, *, single_process_rollouts: bool = False) -> tuple[str, str]:
+    """The scenario of ``text`` (None: the defaults), read once and written out in full: as given
+    (the run's identity) and as the jobs run it (``optimiser.workers = 1`` if ``single_process_rollouts``)."""
+    from dataclasses import replace
 
-    config = load_world_config(overrides=text)
-    if single_process_rollouts:
-        config.sto.workers = 1
-    return dump_world_config(config)
+    from hlp_drake.systems.scenario import load_scenario
+
+    scenario = load_scenario(data=text, where="--config")
+    jobs = (
+        replace(scenario, optimiser=replace(scenario.optimiser, workers=1))
+        if single_process_rollouts
+        else scenario
+    )
+    return scenario.yaml, jobs.yaml
 
 
 def _check_directory(out: Path, identity: dict[str, Any], fresh: bool) -> None:
@@ -115,9 +122,11 @@ def _check_directory(out: Path, identity: dict[str, Any], fresh: bool) -> None:
             earlier = {}
         differs = [label for key, label in IDENTITY_LABELS.items() if earlier.get(key) != identity[key]]
         if differs:
-            raise HlpError(f"{out} holds a run with a different {', '.join(differs)} "
-                           f"({earlier.get('kind')} from seed {earlier.get('seed')}); "
-                           f"{START_OVER}")
+            raise HlpError(
+                f"{out} holds a run with a different {', '.join(differs)} "
+                f"({earlier.get('kind')} from seed {earlier.get('seed')}); "
+                f"{START_OVER}"
+            )
     elif (out / RESULTS).exists():
         raise HlpError(f"{out / RESULTS} exists without {CONFIG}; {START_OVER}")
 
@@ -144,17 +153,35 @@ def _measured_on(machine: dict[str, Any], settings: ExperimentSettings) -> str:
     return f"{where}, {at_once}{shared}"
 
 
-def _run_record(settings: ExperimentSettings, command: str | None, config_yaml: str, jobs: list[Job],
-                pending: list[Job], earlier: list[dict[str, Any]]) -> dict[str, Any]:
+def _run_record(
+    settings: ExperimentSettings,
+    command: str | None,
+    config_yaml: str,
+    jobs: list[Job],
+    pending: list[Job],
+    earlier: list[dict[str, Any]],
+) -> dict[str, Any]:
     return {
-        "command": command, "status": "running", "kind": settings.kind,
-        "seeds": {"first": settings.seed, "last": settings.seed + settings.scenes - 1,
-                  "scenes": settings.scenes},
-        "objects": sorted({job.objects for job in jobs}), "workers": settings.worker_count,
-        "executor": settings.executor, "scheduler": settings.scheduler,
+        "command": command,
+        "status": "running",
+        "kind": settings.kind,
+        "seeds": {
+            "first": settings.seed,
+            "last": settings.seed + settings.scenes - 1,
+            "scenes": settings.scenes,
+        },
+        "objects": sorted({job.objects for job in jobs}),
+        "workers": settings.worker_count,
+        "executor": settings.executor,
+        "scheduler": settings.scheduler,
         "jobs": {"total": len(jobs), "kept": len(jobs) - len(pending), "to_run": len(pending)},
-        "machine": machine_info(), "software": software_versions(), "git_commit": git_commit(),
-        "world_config": config_yaml, "start_time": utc_now(), "end_time": None, "wall_s": None,
+        "machine": machine_info(),
+        "software": software_versions(),
+        "git_commit": git_commit(),
+        "scenario": config_yaml,
+        "start_time": utc_now(),
+        "end_time": None,
+        "wall_s": None,
         "earlier_runs": earlier,
     }
 
@@ -168,28 +195,42 @@ def _prepare(out: Path, identity: dict[str, Any], fresh: bool) -> None:
     write_text_atomic(out / CONFIG, json.dumps(identity, indent=2) + "\n")
 
 
-def _run_pending(job: JobFunction, pending: list[Job], results: ResultsFile, settings: ExperimentSettings,
-                 total: int) -> None:
+def _run_pending(
+    job: JobFunction, pending: list[Job], results: ResultsFile, settings: ExperimentSettings, total: int
+) -> None:
     """Run ``pending`` on the settings' executor, saving each row as it finishes, with a progress bar."""
-    bar = tqdm(total=total, initial=total - len(pending), unit="job", dynamic_ncols=True,
-               desc=f"{settings.kind} ({settings.worker_count} at a time)", disable=not settings.progress)
-    finished = run_jobs(job, pending, executor=settings.executor, workers=settings.worker_count,
-                        scheduler=settings.scheduler)
+    bar = tqdm(
+        total=total,
+        initial=total - len(pending),
+        unit="job",
+        dynamic_ncols=True,
+        desc=f"{settings.kind} ({settings.worker_count} at a time)",
+        disable=not settings.progress,
+    )
+    finished = run_jobs(
+        job, pending, executor=settings.executor, workers=settings.worker_count, scheduler=settings.scheduler
+    )
     with bar, closing(finished):
         for done, row in finished:
             if row_key(row) != done.key:
                 raise ValueError(f"the job for {done.key} returned the row of {row_key(row)}")
             results.add(row)
-            bar.set_postfix_str(f"{done.scene} {done.planner}: {'success' if row['success'] else 'failure'}",
-                                refresh=False)
+            bar.set_postfix_str(
+                f"{done.scene} {done.planner}: {'success' if row['success'] else 'failure'}", refresh=False
+            )
             bar.update()
 
 
-def run_experiment(settings: ExperimentSettings, out: str | os.PathLike[str], *, job: JobFunction = run_job,
-                   command: str | None = None) -> dict[str, Any]:
+def run_experiment(
+    settings: ExperimentSettings,
+    out: str | os.PathLike[str],
+    *,
+    job: JobFunction = run_job,
+    command: str | None = None,
+) -> dict[str, Any]:
     """Run every job of ``settings`` not yet in ``out/results.csv``; write the summary and plots.
 
-    Every check (settings, world config, scene generation, the directory's earlier run) happens
+    Every check (settings, scenario, scene generation, the directory's earlier run) happens
     before anything is written. ``job`` must be a picklable module-level function for the process
     pool and dask executors.
 
@@ -205,10 +246,11 @@ def run_experiment(settings: ExperimentSettings, out: str | os.PathLike[str], *,
         raise HlpError(*problems)
     check_executor(settings.executor, settings.scheduler)
     out = Path(out)
-    config_yaml = world_config_yaml(settings.config_yaml)
-    jobs = make_jobs(settings.kind, range(settings.seed, settings.seed + settings.scenes), settings.objects,
-                     world_config_yaml(config_yaml, single_process_rollouts=settings.parallel))
-    identity = {"kind": settings.kind, "seed": settings.seed, "world_config": config_yaml}
+    config_yaml, job_yaml = scenario_yamls(settings.config_yaml, single_process_rollouts=settings.parallel)
+    jobs = make_jobs(
+        settings.kind, range(settings.seed, settings.seed + settings.scenes), settings.objects, job_yaml
+    )
+    identity = {"kind": settings.kind, "seed": settings.seed, "scenario": config_yaml}
     _check_directory(out, identity, settings.fresh)
     results = ResultsFile(out / RESULTS, [] if settings.fresh else read_results(out / RESULTS))
     earlier = _earlier_runs(out, settings.fresh)
@@ -227,8 +269,11 @@ def run_experiment(settings: ExperimentSettings, out: str | os.PathLike[str], *,
         record["status"] = "interrupted" if interrupted else f"failed: {type(error).__name__}"
         raise
     finally:
-        record.update(end_time=utc_now(), wall_s=round(time.perf_counter() - started, 3),
-                      jobs={**record["jobs"], "rows": len(results.rows)})
+        record.update(
+            end_time=utc_now(),
+            wall_s=round(time.perf_counter() - started, 3),
+            jobs={**record["jobs"], "rows": len(results.rows)},
+        )
         write_text_atomic(out / RUN, json.dumps(record, indent=2) + "\n")
     summary = summarise(settings.kind, results.rows.values(), _measured_on(record["machine"], settings))
     write_summary(out, summary)

@@ -24,14 +24,26 @@ def _label_bars(axes: plt.Axes, bars, values: list[float | None], label: Callabl
         if value is None:
             continue
         inside = bar.get_height() > 0.12 * top
-        axes.annotate(label(value), (bar.get_x() + bar.get_width() / 2, bar.get_height()),
-                      xytext=(0, -4 if inside else 3), textcoords="offset points", ha="center",
-                      va="top" if inside else "bottom", fontsize=8, color="white" if inside else "black",
-                      fontweight="bold" if inside else "normal")
+        axes.annotate(
+            label(value),
+            (bar.get_x() + bar.get_width() / 2, bar.get_height()),
+            xytext=(0, -4 if inside else 3),
+            textcoords="offset points",
+            ha="center",
+            va="top" if inside else "bottom",
+            fontsize=8,
+            color="white" if inside else "black",
+            fontweight="bold" if inside else "normal",
+        )
 
 
-def _grouped_bars(axes: plt.Axes, summary: dict[str, Any], field: str, label: Callable[[float], str],
-                  errors: Callable[[dict[str, Any]], tuple[float, float]] | None = None) -> None:
+def _grouped_bars(
+    axes: plt.Axes,
+    summary: dict[str, Any],
+    field: str,
+    label: Callable[[float], str],
+    errors: Callable[[dict[str, Any]], tuple[float, float]] | None = None,
+) -> None:
     """Bars of ``field`` per condition and planner (with ``errors``' (low, high) if given); paper values
     as black diamonds."""
     conditions = summary["conditions"]
@@ -47,14 +59,29 @@ def _grouped_bars(axes: plt.Axes, summary: dict[str, Any], field: str, label: Ca
         if errors is not None:
             bounds = np.array([errors(s) if s is not None else (np.nan, np.nan) for s in stats], float)
             yerr = np.clip(np.vstack([heights - bounds[:, 0], bounds[:, 1] - heights]), 0, None)
-        bars = axes.bar(x, heights, BAR_WIDTH * 0.95, color=COLOURS[planner], label=PLANNER_LABELS[planner],
-                        yerr=yerr, error_kw={"ecolor": "0.25", "capsize": 3, "lw": 1})
+        bars = axes.bar(
+            x,
+            heights,
+            BAR_WIDTH * 0.95,
+            color=COLOURS[planner],
+            label=PLANNER_LABELS[planner],
+            yerr=yerr,
+            error_kw={"ecolor": "0.25", "capsize": 3, "lw": 1},
+        )
         labelled.append((bars, ours))
         paper = [None if s is None else s["paper"][field] for s in stats]
         shown = [(xi, v) for xi, v in zip(x, paper) if v is not None]
         if shown:
-            axes.scatter(*zip(*shown), marker="D", s=40, color="black", edgecolor="white", linewidth=0.8,
-                         zorder=3, label=None if paper_shown else "paper")
+            axes.scatter(
+                *zip(*shown),
+                marker="D",
+                s=40,
+                color="black",
+                edgecolor="white",
+                linewidth=0.8,
+                zorder=3,
+                label=None if paper_shown else "paper",
+            )
             paper_shown = True
     axes.set_xticks(centres, [c["condition"] for c in conditions])
     axes.set_xlim(-0.6, len(conditions) - 0.4)
@@ -73,8 +100,15 @@ def _title(summary: dict[str, Any]) -> str:
 def _legend_below(figure: plt.Figure, axes: plt.Axes) -> None:
     """One legend for the figure, centred below the panels (clear of bars and markers)."""
     handles, labels = axes.get_legend_handles_labels()
-    figure.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=len(labels),
-                  fontsize=9, frameon=False)
+    figure.legend(
+        handles,
+        labels,
+        loc="upper center",
+        bbox_to_anchor=(0.5, 0.0),
+        ncol=len(labels),
+        fontsize=9,
+        frameon=False,
+    )
 
 
 def plot_success(summary: dict[str, Any], path: Path) -> None:

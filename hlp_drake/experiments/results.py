@@ -20,8 +20,22 @@ from hlp_drake.atomic import atomic_path
 from hlp_drake.errors import HlpError
 from hlp_drake.experiments.runner import Row
 
-COLUMNS = ("scene", "objects", "planner", "success", "failure_reason", "init_s", "optimise_s", "total_s",
-           "rollouts", "objects_moved", "objects_dropped", "seed", "iterations", "execute_s")
+COLUMNS = (
+    "scene",
+    "objects",
+    "planner",
+    "success",
+    "failure_reason",
+    "init_s",
+    "optimise_s",
+    "total_s",
+    "rollouts",
+    "objects_moved",
+    "objects_dropped",
+    "seed",
+    "iterations",
+    "execute_s",
+)
 INT_COLUMNS = frozenset({"objects", "rollouts", "objects_moved", "objects_dropped", "seed", "iterations"})
 FLOAT_COLUMNS = frozenset({"init_s", "optimise_s", "total_s", "execute_s"})
 BOOLEANS = {"true": True, "false": False}
@@ -79,8 +93,9 @@ def read_results(path: Path) -> list[Row]:
         reader = csv.reader(file)
         header = tuple(next(reader, ()))
         if header != COLUMNS:
-            raise HlpError(f"{path}: not an experiment results file (unexpected columns); "
-                           "use --fresh to start over")
+            raise HlpError(
+                f"{path}: not an experiment results file (unexpected columns); use --fresh to start over"
+            )
         rows = []
         for record in reader:
             try:
@@ -88,8 +103,9 @@ def read_results(path: Path) -> list[Row]:
                     raise ValueError(f"{len(record)} fields")
                 rows.append({column: _parse(column, text) for column, text in zip(COLUMNS, record)})
             except (KeyError, ValueError) as error:
-                raise HlpError(f"{path}: line {reader.line_num}: malformed row ({error}); "
-                               "use --fresh to start over") from None
+                raise HlpError(
+                    f"{path}: line {reader.line_num}: malformed row ({error}); use --fresh to start over"
+                ) from None
     return rows
 
 

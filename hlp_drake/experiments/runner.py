@@ -1,6 +1,6 @@
 """One experiment job: plan and execute one scene with one planner, reduced to a ``results.csv`` row.
 
-A job is a pure function of its ``Job`` (kind, seed, object count, planner, world config YAML), so the
+A job is a pure function of its ``Job`` (kind, seed, object count, planner, scenario YAML), so the
 same job gives the same outcome in this process, a local worker process or a dask worker. Drake is
 imported inside ``run_job`` only: worker processes are spawned and import what they run.
 """
@@ -8,7 +8,7 @@ imported inside ``run_job`` only: worker processes are spawned and import what t
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from hlp_drake.errors import SceneError
@@ -31,7 +31,9 @@ class Job:
     objects: int  # the scene's number of obstacles
     scene: str  # the scene's name, e.g. "gen1-3" or "gen2-7-12"
     planner: str
-    config_yaml: str  # the world config as YAML text (``dump_world_config``), not a Drake object
+    config_yaml: (
+        str  # the scenario as YAML text (``Scenario.yaml``; its scene is replaced), not a Drake object
+    )
 
     @property
     def key(self) -> tuple[str, str]:
@@ -62,23 +64,46 @@ def make_jobs(kind: str, seeds: Iterable[int], objects: Iterable[int], config_ya
                 scene = generate_scene(kind, seed, count)
             except SceneError as error:
                 objects_note = "" if count is None else f" with {count} objects"
-                raise SceneError(f"cannot generate the {kind} scene of seed {seed}{objects_note}: {error}") \
-                    from None
-            jobs += [Job(kind, seed, len(scene.obstacles), scene.name, planner, config_yaml)
-                     for planner in PLANNERS]
+                raise SceneError(
+                    f"cannot generate the {kind} scene of seed {seed}{objects_note}: {error}"
+                ) from None
+            jobs += [
+                Job(kind, seed, len(scene.obstacles), scene.name, planner, config_yaml)
+                for planner in PLANNERS
+            ]
     return jobs
 
 
-def make_row(job: Job, *, success: bool, failure_reason: str | None, plan_s: float, ik_s: float,
-             optimise_s: float, execute_s: float, rollouts: int, iterations: int, objects_moved: int,
-             objects_dropped: int) -> Row:
+def make_row(
+    job: Job,
+    *,
+    success: bool,
+    failure_reason: str | None,
+    plan_s: float,
+    ik_s: float,
+    optimise_s: float,
+    execute_s: float,
+    rollouts: int,
+    iterations: int,
+    objects_moved: int,
+    objects_dropped: int,
+) -> Row:
     """The row of ``job``'s outcome: init = plan + IK, total = init + optimise (execution excluded)."""
     init_s = plan_s + ik_s
     return {
-        "scene": job.scene, "objects": job.objects, "planner": job.planner, "success": bool(success),
-        "failure_reason": failure_reason, "init_s": init_s, "optimise_s": optimise_s,
-        "total_s": init_s + optimise_s, "rollouts": int(rollouts), "objects_moved": int(objects_moved),
-        "objects_dropped": int(objects_dropped), "seed": job.seed, "iterations": int(iterations),
+        "scene": job.scene,
+        "objects": job.objects,
+        "planner": job.planner,
+        "success": bool(success),
+        "failure_reason": failure_reason,
+        "init_s": init_s,
+        "optimise_s": optimise_s,
+        "total_s": init_s + optimise_s,
+        "rollouts": int(rollouts),
+        "objects_moved": int(objects_moved),
+        "objects_dropped": int(objects_dropped),
+        "seed": job.seed,
+        "iterations": int(iterations),
         "execute_s": execute_s,
     }
 
@@ -90,31 +115,51 @@ def run_job(job: Job) -> Row:
     is recorded as this planner's failure on this scene ("crashed: ..."), its times as NaN (left
     out of the means), rather than ending the run. The bundled decision models are loaded
     before the timed call, so a worker's first scene is not charged for loading them, and
-    every job starts without rollout worlds that an earlier job (maybe the other planner on the
-    same scene) built in this process.
+    every job has a rollout pool of its own: no job uses rollout worlds an earlier one (maybe the
+    other planner on the same scene) built.
     """
     from hlp_drake.learners.bundled import default_models
     from hlp_drake.systems.execution import plan_and_execute
-    from hlp_drake.systems.rollout import simulation_failure
-    from hlp_drake.systems.rollout_pool import forget_worlds
-    from hlp_drake.systems.world_config import load_world_config
+    from hlp_drake.systems.rollout_pool import RolloutPool
+    from hlp_drake.systems.rollout_world import simulation_failure
+    from hlp_drake.systems.scenario import load_scenario
 
-    config = load_world_config(overrides=job.config_yaml)
-    forget_worlds()
+    settings = load_scenario(data=job.config_yaml, where="the job's scenario")
     try:
-        result = plan_and_execute(job.make_scene(), planner=job.planner, models=default_models(),
-                                  config=config)
+        scenario = replace(
+            settings, scene=job.make_scene(), planner=replace(settings.planner, kind=job.planner)
+        )
+        with RolloutPool(scenario.optimiser.workers) as pool:
+            result = plan_and_execute(scenario, pool=pool, models=default_models())
     except (Exception, SystemExit) as error:  # noqa: BLE001 - a crash is this planner's failure here
         if isinstance(error, SystemExit):
             simulation_failure(error)  # raises it again unless it is Drake's
         reason = " ".join(f"crashed: {type(error).__name__}: {error}".split())[:300]
         nan = float("nan")
-        return make_row(job, success=False, failure_reason=reason, plan_s=nan, ik_s=nan, optimise_s=nan,
-                        execute_s=nan, rollouts=0, iterations=0, objects_moved=0, objects_dropped=0)
+        return make_row(
+            job,
+            success=False,
+            failure_reason=reason,
+            plan_s=nan,
+            ik_s=nan,
+            optimise_s=nan,
+            execute_s=nan,
+            rollouts=0,
+            iterations=0,
+            objects_moved=0,
+            objects_dropped=0,
+        )
     t = result.timings
     return make_row(
-        job, success=result.success, failure_reason=result.failure_reason, plan_s=t["plan_s"], ik_s=t["ik_s"],
-        optimise_s=t.get("optimise_s", 0.0), execute_s=t.get("execute_s", 0.0), rollouts=result.rollouts,
-        iterations=result.iterations, objects_moved=len(result.objects_moved),
+        job,
+        success=result.success,
+        failure_reason=result.failure_reason,
+        plan_s=t["plan_s"],
+        ik_s=t["ik_s"],
+        optimise_s=t.get("optimise_s", 0.0),
+        execute_s=t.get("execute_s", 0.0),
+        rollouts=result.rollouts,
+        iterations=result.iterations,
+        objects_moved=len(result.objects_moved),
         objects_dropped=len(result.objects_dropped),
     )

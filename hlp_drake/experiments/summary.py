@@ -38,27 +38,45 @@ class PaperFigures:
 # Paper Table II (Gen I): success and total time; the init times are total - optimisation.
 # Table III (Gen II): success only; its times are not in our notes.
 PAPER: dict[tuple[str, int | None], dict[str, PaperFigures]] = {
-    ("gen1", None): {"hlp": PaperFigures(94.0, round(1.56 - 0.97, 2), 0.97, 1.56),
-                     "sto": PaperFigures(84.0, round(17.88 - 17.84, 2), 17.84, 17.88)},
+    ("gen1", None): {
+        "hlp": PaperFigures(94.0, round(1.56 - 0.97, 2), 0.97, 1.56),
+        "sto": PaperFigures(84.0, round(17.88 - 17.84, 2), 17.84, 17.88),
+    },
     ("gen2", 5): {"hlp": PaperFigures(93.0), "sto": PaperFigures(96.0)},
     ("gen2", 7): {"hlp": PaperFigures(93.0), "sto": PaperFigures(96.0)},
     ("gen2", 9): {"hlp": PaperFigures(95.0), "sto": PaperFigures(98.0)},
 }
 COMMON_NOTES = [
-    ("Times are planning times per scene in seconds, means over all scenes of the condition (successes "
-     "and failures): init = high-level plan + keypoint IK (plan_s + ik_s), optimisation = the stochastic "
-     "trajectory optimiser, total = init + optimisation. The simulated execution (execute_s in "
-     "results.csv) is excluded."),
-    ("Success % is followed by its 95 % Wilson interval; success = the target in the gripper's pre-grasp "
-     "region at the end of the executed motion and no object fallen off the table."),
-    ("A run that crashed (an exception in plan_and_execute) counts as a failure; its times are left out "
-     "of the means."),
+    (
+        "Times are planning times per scene in seconds, means over all scenes of the condition (successes "
+        "and failures): init = high-level plan + keypoint IK (plan_s + ik_s), optimisation = the stochastic "
+        "trajectory optimiser, total = init + optimisation. The simulated execution (execute_s in "
+        "results.csv) is excluded."
+    ),
+    (
+        "Success % is followed by its 95 % Wilson interval; success = the target in the gripper's pre-grasp "
+        "region at the end of the executed motion and no object fallen off the table."
+    ),
+    (
+        "A run that crashed (an exception in plan_and_execute) counts as a failure; its times are left out "
+        "of the means."
+    ),
 ]
 NOTES = {
-    "gen1": [*COMMON_NOTES, ("The paper's init times are derived as total - optimisation "
-                             "(HLP 1.56 - 0.97 s, STO 17.88 - 17.84 s).")],
-    "gen2": [*COMMON_NOTES, ("Table III's times are not in our notes: the paper's time columns show n/a "
-                             "(null in summary.json) rather than invented numbers.")],
+    "gen1": [
+        *COMMON_NOTES,
+        (
+            "The paper's init times are derived as total - optimisation "
+            "(HLP 1.56 - 0.97 s, STO 17.88 - 17.84 s)."
+        ),
+    ],
+    "gen2": [
+        *COMMON_NOTES,
+        (
+            "Table III's times are not in our notes: the paper's time columns show n/a "
+            "(null in summary.json) rather than invented numbers."
+        ),
+    ],
 }
 
 
@@ -96,7 +114,9 @@ def planner_stats(rows: list[Row], paper: PaperFigures) -> dict[str, Any]:
     n = len(rows)
     successes = sum(row["success"] for row in rows)
     stats: dict[str, Any] = {
-        "n": n, "successes": successes, "success_pct": round(100 * successes / n, 2),
+        "n": n,
+        "successes": successes,
+        "success_pct": round(100 * successes / n, 2),
         "success_ci95": wilson_interval(successes, n),
         "crashed": sum((row["failure_reason"] or "").startswith("crashed:") for row in rows),
     }
@@ -113,17 +133,30 @@ def summarise(kind: str, rows: Iterable[Row], measured_on: str | None = None) ->
     conditions = []
     for objects in sorted(groups):
         by_planner = groups[objects]
-        planners = {p: planner_stats(by_planner[p], paper_figures(kind, objects, p))
-                    for p in PLANNERS if by_planner[p]}
+        planners = {
+            p: planner_stats(by_planner[p], paper_figures(kind, objects, p))
+            for p in PLANNERS
+            if by_planner[p]
+        }
         hlp, sto = planners.get("hlp", {}), planners.get("sto", {})
-        conditions.append({
-            "condition": condition_label(kind, objects), "objects": objects, "planners": planners,
-            "hlp_to_sto_total": _ratio(hlp.get("total_s"), sto.get("total_s")),
-            "paper_hlp_to_sto_total": _ratio(paper_figures(kind, objects, "hlp").total_s,
-                                             paper_figures(kind, objects, "sto").total_s),
-        })
-    return {"kind": kind, "table": TABLES[kind], "measured_on": measured_on, "conditions": conditions,
-            "notes": NOTES[kind]}
+        conditions.append(
+            {
+                "condition": condition_label(kind, objects),
+                "objects": objects,
+                "planners": planners,
+                "hlp_to_sto_total": _ratio(hlp.get("total_s"), sto.get("total_s")),
+                "paper_hlp_to_sto_total": _ratio(
+                    paper_figures(kind, objects, "hlp").total_s, paper_figures(kind, objects, "sto").total_s
+                ),
+            }
+        )
+    return {
+        "kind": kind,
+        "table": TABLES[kind],
+        "measured_on": measured_on,
+        "conditions": conditions,
+        "notes": NOTES[kind],
+    }
 
 
 def _number(value: float | None, digits: int = 2) -> str:
@@ -139,8 +172,12 @@ def _table_rows(condition: dict[str, Any]) -> list[str]:
     for planner, stats in condition["planners"].items():
         paper = stats["paper"]
         low, high = stats["success_ci95"]
-        cells = [condition["condition"], PLANNER_LABELS[planner], str(stats["n"]),
-                 f"{stats['success_pct']:.1f} [{low:.0f}-{high:.0f}] ({_paper_number(paper['success_pct'])})"]
+        cells = [
+            condition["condition"],
+            PLANNER_LABELS[planner],
+            str(stats["n"]),
+            f"{stats['success_pct']:.1f} [{low:.0f}-{high:.0f}] ({_paper_number(paper['success_pct'])})",
+        ]
         cells += [f"{_number(stats[column])} ({_paper_number(paper[column])})" for column in TIMES]
         lines.append("| " + " | ".join(cells) + " |")
     return lines
@@ -151,16 +188,22 @@ def summary_markdown(summary: dict[str, Any]) -> str:
     lines = [f"# {summary['table']}", ""]
     if summary["measured_on"]:
         lines += [f"Measured on {summary['measured_on']}.", ""]
-    lines += ["Ours, with the paper's value in parentheses.", "",
-              "| condition | planner | n | success % [95 % CI] (paper) | "
-              + " | ".join(f"{TIME_LABELS[c]} s (paper)" for c in TIMES) + " |",
-              "|---|---|---:|---:|" + "---:|" * len(TIMES)]
+    lines += [
+        "Ours, with the paper's value in parentheses.",
+        "",
+        "| condition | planner | n | success % [95 % CI] (paper) | "
+        + " | ".join(f"{TIME_LABELS[c]} s (paper)" for c in TIMES)
+        + " |",
+        "|---|---|---:|---:|" + "---:|" * len(TIMES),
+    ]
     for condition in summary["conditions"]:
         lines += _table_rows(condition)
     lines += ["", "| condition | HLP / STO mean total time | paper |", "|---|---:|---:|"]
     for condition in summary["conditions"]:
-        lines.append(f"| {condition['condition']} | {_number(condition['hlp_to_sto_total'], 3)} | "
-                     f"{_number(condition['paper_hlp_to_sto_total'], 3)} |")
+        lines.append(
+            f"| {condition['condition']} | {_number(condition['hlp_to_sto_total'], 3)} | "
+            f"{_number(condition['paper_hlp_to_sto_total'], 3)} |"
+        )
     lines += ["", "Notes:", ""] + [f"- {note}" for note in summary["notes"]]
     return "\n".join(lines) + "\n"
 

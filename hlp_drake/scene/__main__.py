@@ -1,19 +1,23 @@
-"""``python -m hlp_drake.scene {generate,show,validate}``: make, draw and check scene files."""
+"""Make, draw and check scene files: python -m hlp_drake.scene {generate,show,validate}.
+
+python -m hlp_drake.scene generate --kind vr|gen1|gen2|unstructured --seed N [--objects K] --out FILE
+python -m hlp_drake.scene show FILE --png OUT.png [--plan]
+python -m hlp_drake.scene validate FILE
+"""
 
 from __future__ import annotations
 
-import argparse
 import sys
 from collections.abc import Sequence
 
-from hlp_drake.cli import run_cli
+from hlp_drake.cli import make_parser, run_cli
 from hlp_drake.scene.generators import KINDS, generate_scene
 from hlp_drake.scene.io import load_scene, save_scene
 from hlp_drake.scene.rows import find_rows
 
 
-def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="python -m hlp_drake.scene", description=__doc__)
+def _parser():
+    parser = make_parser("python -m hlp_drake.scene", __doc__)
     commands = parser.add_subparsers(dest="command", required=True)
     generate = commands.add_parser("generate", help="write a seeded random scene")
     generate.add_argument("--kind", choices=KINDS, required=True)
@@ -23,6 +27,11 @@ def _parser() -> argparse.ArgumentParser:
     show = commands.add_parser("show", help="draw a scene file top-down")
     show.add_argument("file")
     show.add_argument("--png", required=True, help="output PNG")
+    show.add_argument(
+        "--plan",
+        action="store_true",
+        help="draw the human-like plan (bundled models) and the pushing robot's plan over it",
+    )
     validate = commands.add_parser("validate", help="check a scene file")
     validate.add_argument("file")
     return parser
@@ -37,13 +46,32 @@ def main(argv: Sequence[str] | None = None) -> int:
     elif args.command == "show":
         from hlp_drake.scene.plot import save_scene_png
 
-        save_scene_png(load_scene(args.file), args.png)
+        scene = load_scene(args.file)
+        plans = _plans(scene) if args.plan else {}
+        save_scene_png(scene, args.png, plans=plans)
+        for label, plan in plans.items():
+            print(f"{label}: {' -> '.join(k.action for k in plan.keypoints) or plan.reason}")
         print(f"wrote {args.png}")
     else:
         scene = load_scene(args.file)
         rows = find_rows(scene)
         print(f"{args.file}: valid ({len(scene.obstacles)} obstacles in {len(rows)} rows)")
     return 0
+
+
+def _plans(scene) -> dict:
+    """The human-like plan of ``scene`` and the pushing robot's plan of it (imports Drake)."""
+    from hlp_drake.learners.bundled import default_models
+    from hlp_drake.planner import plan
+    from hlp_drake.systems.push_transfer import robot_plan
+    from hlp_drake.systems.scenario import Scenario
+    from hlp_drake.systems.transfer_geometry import gripper_geometry, push_rules
+
+    human = plan(scene, default_models())
+    return {
+        "human plan": human,
+        "robot plan": robot_plan(human, scene, push_rules(Scenario().transfer, gripper_geometry())),
+    }
 
 
 if __name__ == "__main__":

@@ -325,7 +325,11 @@ def generate_unstructured(seed: int, objects: int = 6) -> Scene:
     cm = 0.01
     start = (VR_START[0], float(rng.integers(-20, 21)) * cm)
     target = SceneObject(
-        name="Target", shape="cylinder", x=VR_TARGET_X, y=float(rng.integers(-25, 26)) * cm, size=VR_TARGET_SIZE
+        name="Target",
+        shape="cylinder",
+        x=VR_TARGET_X,
+        y=float(rng.integers(-25, 26)) * cm,
+        size=VR_TARGET_SIZE,
     )
     occupied = [footprint(target), _keep_clear(start, 0.025)]
     names = list(VR_OBSTACLE_WIDTHS)
@@ -372,7 +376,9 @@ def generate_scene(kind: str, seed: int, objects: int | None = None) -> Scene:
         raise SceneError(f"unknown scene kind {kind!r} (expected one of {', '.join(KINDS)})")
     if kind in FIXED_OBJECT_COUNT:
         if objects is not None and objects != FIXED_OBJECT_COUNT[kind]:
-            raise SceneError(f"{kind} scenes always have {FIXED_OBJECT_COUNT[kind]} obstacles, got --objects {objects}")
+            raise SceneError(
+                f"{kind} scenes always have {FIXED_OBJECT_COUNT[kind]} obstacles, got --objects {objects}"
+            )
         return generate_vr(seed) if kind == "vr" else generate_gen1(seed)
     if kind == "gen2":
         return generate_gen2(seed, 7 if objects is None else objects)

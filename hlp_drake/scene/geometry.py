@@ -39,7 +39,11 @@ def _sweep(b: np.ndarray, axis: int) -> tuple[np.ndarray, np.ndarray, np.ndarray
     it start before it ends along that axis."""
     order = np.argsort(b[:, axis], kind="stable")
     s = b[order]
-    return order, s, np.maximum(np.searchsorted(s[:, axis], s[:, axis + 2], side="left") - np.arange(1, len(b) + 1), 0)
+    return (
+        order,
+        s,
+        np.maximum(np.searchsorted(s[:, axis], s[:, axis + 2], side="left") - np.arange(1, len(b) + 1), 0),
+    )
 
 
 def overlapping_bounds(bounds: np.ndarray, margin: float = 0.0) -> np.ndarray:

@@ -1,7 +1,12 @@
-"""Scene files: YAML or JSON, chosen by the file extension. Loading validates; saving is atomic."""
+"""Scene files: YAML or JSON, chosen by the file extension. Loading validates; saving is atomic.
+
+The format is the ``Scene`` dataclass itself, read with Drake's typed loader (``hlp_drake.typed_yaml``),
+the same way a scenario file's ``scene:`` is read.
+"""
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 from pathlib import Path
@@ -11,9 +16,12 @@ import yaml
 
 from hlp_drake.atomic import write_text_atomic
 from hlp_drake.errors import SceneError
-from hlp_drake.scene.model import Scene, SceneObject, Table
+from hlp_drake.scene.model import Scene, SceneObject
 from hlp_drake.scene.validation import validate_scene
+from hlp_drake.typed_yaml import load_typed, parse_yaml
 
+DEFAULT_SCENE_FILE = Path(__file__).resolve().parents[1] / "scenes" / "default.yaml"
+"""The bundled default scene (Generalization I, seed 3), which ``run_scene`` runs without arguments."""
 YAML_SUFFIXES = (".yaml", ".yml")
 JSON_SUFFIXES = (".json",)
 
@@ -45,89 +53,19 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
     }
 
 
-class _Reader:
-    """Reads typed fields out of nested plain data, naming the field in every error."""
+def scene_from_dict(data: Any, *, where: str = "") -> Scene:
+    """Read and validate a Scene from parsed YAML or JSON (``Scene`` is the schema, read with Drake's
+    typed loader; see ``hlp_drake.typed_yaml``).
 
-    def __init__(self) -> None:
-        self.problems: list[str] = []
-
-    def mapping(self, value: Any, where: str, required: set[str], optional: set[str]) -> dict | None:
-        if not isinstance(value, dict):
-            self.problems.append(f"{where}: expected a mapping, got {type(value).__name__}")
-            return None
-        for key in sorted(set(value) - required - optional, key=str):
-            self.problems.append(f"{where}: unknown field {key!r}")
-        for key in sorted(required - set(value)):
-            self.problems.append(f"{where}: missing field {key!r}")
-        return value
-
-    def number(self, value: Any, where: str) -> float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            self.problems.append(f"{where}: expected a number, got {value!r}")
-            return float("nan")
-        return float(value)
-
-    def numbers(self, value: Any, where: str, count: int) -> tuple[float, ...]:
-        if not isinstance(value, (list, tuple)) or len(value) != count:
-            self.problems.append(f"{where}: expected a list of {count} numbers, got {value!r}")
-            return (float("nan"),) * count
-        return tuple(self.number(v, f"{where}[{i}]") for i, v in enumerate(value))
-
-    def text(self, value: Any, where: str) -> str:
-        if not isinstance(value, str):
-            self.problems.append(f"{where}: expected text, got {value!r}")
-            return ""
-        return value
-
-    def scene_object(self, value: Any, where: str) -> SceneObject | None:
-        data = self.mapping(value, where, {"name", "shape", "x", "y", "size"}, {"yaw"})
-        if data is None or not {"name", "shape", "x", "y", "size"} <= set(data):
-            return None
-        return SceneObject(
-            name=self.text(data["name"], f"{where}.name"),
-            shape=self.text(data["shape"], f"{where}.shape"),
-            x=self.number(data["x"], f"{where}.x"),
-            y=self.number(data["y"], f"{where}.y"),
-            size=self.numbers(data["size"], f"{where}.size", 3),  # type: ignore[arg-type]
-            yaw=self.number(data.get("yaw", 0.0), f"{where}.yaw"),
-        )
-
-
-def scene_from_dict(data: Any) -> Scene:
-    """Build and validate a Scene from plain data; raise ``SceneError`` naming every problem."""
-    reader = _Reader()
-    top = reader.mapping(data, "scene", {"table", "start", "target"}, {"name", "start_yaw", "obstacles"})
-    if top is None or not {"table", "start", "target"} <= set(top):
-        raise SceneError(*reader.problems)
-    table_data = reader.mapping(top["table"], "table", {"length", "width", "height"}, set())
-    table = None
-    if table_data is not None and {"length", "width", "height"} <= set(table_data):
-        table = Table(
-            length=reader.number(table_data["length"], "table.length"),
-            width=reader.number(table_data["width"], "table.width"),
-            height=reader.number(table_data["height"], "table.height"),
-        )
-    target = reader.scene_object(top["target"], "target")
-    raw_obstacles = top.get("obstacles") or []
-    if not isinstance(raw_obstacles, list):
-        reader.problems.append(f"obstacles: expected a list, got {type(raw_obstacles).__name__}")
-        raw_obstacles = []
-    obstacles = [reader.scene_object(v, f"obstacles[{i}]") for i, v in enumerate(raw_obstacles)]
-    start = reader.numbers(top["start"], "start", 2)
-    start_yaw = reader.number(top.get("start_yaw", 0.0), "start_yaw")
-    raw_name = top.get("name")
-    name = "" if raw_name is None else reader.text(raw_name, "name")
-    if reader.problems or table is None or target is None or None in obstacles:
-        raise SceneError(*(reader.problems or ["scene: incomplete"]))
-    scene = Scene(
-        table=table,
-        start=start,  # type: ignore[arg-type]
-        target=target,
-        obstacles=tuple(obstacles),  # type: ignore[arg-type]
-        start_yaw=start_yaw,
-        name=name,
-    )
-    return validate_scene(scene)
+    Raises:
+        SceneError: every problem on its own line, located (``obstacles[0].x: expected a number``)
+            and prefixed with ``where`` when given.
+    """
+    scene = load_typed(Scene, data, where=where, top="scene", error=SceneError)
+    try:
+        return validate_scene(scene)
+    except SceneError as error:
+        raise SceneError(*(f"{where}: {p}" if where else p for p in error.problems)) from None
 
 
 def _suffix(path: Path) -> str:
@@ -159,19 +97,14 @@ def load_scene(path: str | os.PathLike[str]) -> Scene:
         raise SceneError(f"{path}: no such file") from None
     except (OSError, UnicodeDecodeError) as error:
         raise SceneError(f"{path}: cannot read: {error}") from None
-    try:
-        data = json.loads(text) if suffix in JSON_SUFFIXES else yaml.safe_load(text)
-    except json.JSONDecodeError as error:
-        raise SceneError(f"{path}: not valid JSON: {error}") from None
-    except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(error, "problem", None) or "syntax error"
-        raise SceneError(f"{path}: not valid YAML{where}: {problem}") from None
-    try:
-        return scene_from_dict(data)
-    except SceneError as error:
-        raise SceneError(*(f"{path}: {p}" for p in error.problems)) from None
+    if suffix in JSON_SUFFIXES:
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as error:
+            raise SceneError(f"{path}: not valid JSON: {error}") from None
+    else:
+        data = parse_yaml(text, str(path), SceneError)
+    return scene_from_dict(data, where=str(path))
 
 
 def save_scene(scene: Scene, path: str | os.PathLike[str]) -> None:
@@ -180,3 +113,9 @@ def save_scene(scene: Scene, path: str | os.PathLike[str]) -> None:
     suffix = _suffix(path)
     validate_scene(scene)
     write_text_atomic(path, scene_to_text(scene, json_format=suffix in JSON_SUFFIXES))
+
+
+@functools.cache
+def default_scene() -> Scene:
+    """The bundled default scene (``DEFAULT_SCENE_FILE``), read once."""
+    return load_scene(DEFAULT_SCENE_FILE)

@@ -39,20 +39,31 @@ def draw_scene(axes: Axes, scene: Scene, *, labels: bool = True) -> None:
     """Draw table, rows, obstacles (coloured by row), start and target onto ``axes``."""
     table = scene.table
     axes.add_patch(
-        Rectangle((-table.width / 2.0, 0.0), table.width, table.length, facecolor="#f3ead8", edgecolor="#8b6d3f")
+        Rectangle(
+            (-table.width / 2.0, 0.0), table.width, table.length, facecolor="#f3ead8", edgecolor="#8b6d3f"
+        )
     )
     row_of = {}
     for row in find_rows(scene):
         colour = ROW_COLOURS[(row.index - 1) % len(ROW_COLOURS)]
         axes.add_patch(
             Rectangle(
-                (-table.width / 2.0, row.x_min), table.width, row.x_max - row.x_min,
-                color=colour, alpha=0.12, zorder=0.5,
+                (-table.width / 2.0, row.x_min),
+                table.width,
+                row.x_max - row.x_min,
+                color=colour,
+                alpha=0.12,
+                zorder=0.5,
             )
         )
         axes.annotate(
-            f"row {row.index}", (table.width / 2.0, row.x), xytext=(4, 0), textcoords="offset points",
-            va="center", fontsize=8, color=colour,
+            f"row {row.index}",
+            (table.width / 2.0, row.x),
+            xytext=(4, 0),
+            textcoords="offset points",
+            va="center",
+            fontsize=8,
+            color=colour,
         )
         row_of.update({name: colour for name in row.members})
     for obstacle in scene.obstacles:
@@ -73,9 +84,38 @@ def draw_scene(axes: Axes, scene: Scene, *, labels: bool = True) -> None:
     axes.set_ylabel("depth: x (m), away from the start")
 
 
-def save_scene_png(scene: Scene, path: str | os.PathLike[str]) -> None:
-    """Write a top-down PNG of ``scene`` to ``path``."""
+PLAN_STYLES = (
+    {"color": "#555555", "linestyle": "--", "marker": "o", "markersize": 4},
+    {"color": "#1f5fd0", "linestyle": "-", "marker": "s", "markersize": 4},
+)
+
+
+def draw_plan(axes: Axes, plan, label: str, style: dict) -> None:
+    """A plan's keypoints as a path from the start to the target, each keypoint marked (lifted ones hollow)."""
+    if not plan.keypoints:
+        return
+    xs, ys = zip(*(page_xy(*k.position) for k in plan.keypoints))
+    axes.plot(xs, ys, label=label, zorder=6, linewidth=1.5, **style)
+    lifted = [page_xy(*k.position) for k in plan.keypoints if k.height is not None]
+    if lifted:
+        axes.plot(
+            *zip(*lifted),
+            linestyle="none",
+            marker="o",
+            markersize=9,
+            markerfacecolor="none",
+            color=style["color"],
+            zorder=6,
+        )
+
+
+def save_scene_png(scene: Scene, path: str | os.PathLike[str], *, plans: dict | None = None) -> None:
+    """Write a top-down PNG of ``scene`` to ``path``, with ``plans`` (label -> ``HighLevelPlan``) drawn over it."""
     figure, axes = new_figure()
     draw_scene(axes, scene)
+    for (label, plan), style in zip((plans or {}).items(), PLAN_STYLES * 4):
+        draw_plan(axes, plan, label, style)
+    if plans:
+        axes.legend(loc="lower left", fontsize=7)
     axes.set_title(scene.name or "scene")
     save_png(figure, path)

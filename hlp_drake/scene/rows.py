@@ -32,8 +32,11 @@ class Row:
     members: tuple[str, ...]
 
 
-def find_rows(scene: Scene, tolerance: float | None = None,
-              bounds: Mapping[str, tuple[float, float, float, float]] | None = None) -> list[Row]:
+def find_rows(
+    scene: Scene,
+    tolerance: float | None = None,
+    bounds: Mapping[str, tuple[float, float, float, float]] | None = None,
+) -> list[Row]:
     """Cluster obstacle centres along x (single linkage): neighbours closer than ``tolerance`` join.
 
     Args:

@@ -116,8 +116,9 @@ def scene_problems(scene: Scene) -> list[str]:
             if not (x_min - tol <= x <= x_max + tol and y_min - tol <= y <= y_max + tol):
                 problems.append(f"start point ({x:.3f}, {y:.3f}) is off the table")
         edges = np.array(table.bounds)
-        outside = (np.any(boxes[:, :2] < edges[:2] - LENGTH_TOLERANCE, axis=1)
-                   | np.any(boxes[:, 2:] > edges[2:] + LENGTH_TOLERANCE, axis=1))
+        outside = np.any(boxes[:, :2] < edges[:2] - LENGTH_TOLERANCE, axis=1) | np.any(
+            boxes[:, 2:] > edges[2:] + LENGTH_TOLERANCE, axis=1
+        )
         for k in np.flatnonzero(outside).tolist():  # the message names the sides
             problems.append(_off_table(*sound[k], bounds[k], scene))
     problems += _overlaps(sound, boxes)
@@ -143,14 +144,21 @@ def _overlaps(sound: list[tuple[SceneObject, str]], bounds: np.ndarray) -> list[
     return problems
 
 
-def _start_inside(sound: list[tuple[SceneObject, str]], bounds: list[tuple[float, ...]],
-                  start: tuple[float, float]) -> list[str]:
+def _start_inside(
+    sound: list[tuple[SceneObject, str]], bounds: list[tuple[float, ...]], start: tuple[float, float]
+) -> list[str]:
     """A message per footprint the start point lies in (only footprints whose box holds it are tested)."""
     x, y = start
     m = BOUNDS_MARGIN
-    near = [obj_role for obj_role, (x0, y0, x1, y1) in zip(sound, bounds) if x0 - m < x < x1 + m and y0 - m < y < y1 + m]
+    near = [
+        obj_role
+        for obj_role, (x0, y0, x1, y1) in zip(sound, bounds)
+        if x0 - m < x < x1 + m and y0 - m < y < y1 + m
+    ]
     point = shapely.Point(x, y) if near else None
-    return [f"start point lies inside {_label(obj, role)}" for obj, role in near if footprint(obj).contains(point)]
+    return [
+        f"start point lies inside {_label(obj, role)}" for obj, role in near if footprint(obj).contains(point)
+    ]
 
 
 def validate_scene(scene: Scene) -> Scene:

@@ -1,21 +1,23 @@
-"""``StoConfig``: every setting of the stochastic trajectory optimiser (part of ``WorldConfig``).
+"""``StoConfig``: every setting of the stochastic trajectory optimiser (a ``Scenario``'s ``optimiser``).
 
-In a world YAML file it sits under ``sto:``::
+In a scenario file it sits under ``optimiser:``::
 
-    sto:
+    optimiser:
       samples: 8
       update: mppi
       noise: {vx: 0.04, vy: 0.04, yaw_rate: 0.02}
       cost: {goal_weight: 2000.0}
 """
 
-# No "from __future__ import annotations": yaml_load_typed reads the field types at run time.
+from __future__ import annotations
+
 from dataclasses import dataclass, field
+from typing import Literal
 
 UPDATES = ("greedy", "mppi")
 
 
-@dataclass
+@dataclass(frozen=True)
 class BaseNoise:
     """Standard deviations of the Gaussian noise added to the base's planar velocity per control step.
 
@@ -31,7 +33,7 @@ class BaseNoise:
     evenly over the steps, so a detour returns towards the end point the sequence aims at."""
 
 
-@dataclass
+@dataclass(frozen=True)
 class StoCost:
     """Weights of the rollout cost (charged from the states at the ends of the control steps).
 
@@ -62,9 +64,9 @@ class StoCost:
     effort_weight: float = 0.05
 
 
-@dataclass
+@dataclass(frozen=True)
 class StoConfig:
-    """The stochastic trajectory optimiser (``hlp_drake.systems.sto``).
+    """The stochastic trajectory optimiser (``hlp_drake.systems.optimiser``).
 
     Attributes:
         samples: noisy rollouts per iteration (K).
@@ -104,7 +106,7 @@ class StoConfig:
     time_budget_s: float = 120.0
     step_duration: float = 0.5
     noise: BaseNoise = field(default_factory=BaseNoise)
-    update: str = "greedy"
+    update: Literal["greedy", "mppi"] = "greedy"
     mppi_temperature: float = 10.0
     workers: int = 2
     seed: int = 0
@@ -119,22 +121,3 @@ class StoConfig:
     max_sink: float = 0.03
     cost: StoCost = field(default_factory=StoCost)
     alternatives: int = 3
-
-
-@dataclass
-class GraspConfig:
-    """The grasp after a successful reach: close the fingers, then lift the tcp straight up.
-
-    Attributes:
-        close_s: time to close the fingers, s.
-        lift_height: how far the tcp rises, m.
-        lift_s: time of the lift, s.
-        hold_s: time held at the top before the check, s.
-        held_height: the grasp held when the target rose at least this far, m.
-    """
-
-    close_s: float = 1.0
-    lift_height: float = 0.10
-    lift_s: float = 1.5
-    hold_s: float = 0.5
-    held_height: float = 0.05

@@ -8,7 +8,7 @@ pull an obstacle towards itself: a backward direction (BB, BL, BR) becomes the s
 RR) that leaves the least of the obstacle in the corridor along the straight start-target line (a
 person lifts the obstacle back over the table; pushed sideways into the corridor it would block the
 way), the side the obstacle lies on when both leave the same. A push that cannot move the obstacle
-``MIN_PUSH_TRAVEL`` before it nears the table's edge or another object is left out: pressing it
+``min_push_travel`` before it nears the table's edge or another object is left out: pressing it
 into its neighbours would only shove them along (or off the table).
 A person can put an obstacle down anywhere; a push that would leave it in the way on through the
 gaps to the target goes another way (``chosen_push``).
@@ -16,12 +16,16 @@ gaps to the target goes another way (``chosen_push``).
 A person lifts their hand over the table on the way to an obstacle; a robot arm moving sideways at
 push height would sweep its forearm through everything between the base and the gripper. So the
 way to each push start, and any other way whose tcp path would pass over an object (within
-``PATH_CLEARANCE`` of its footprint, the objects where the pushes so far left them), goes over the
-objects: two "transit" waypoints ``TRANSIT_CLEARANCE`` over the tallest object, above the previous
+``path_clearance`` of its footprint, the objects where the pushes so far left them), goes over the
+objects: two "transit" waypoints ``transit_clearance`` over the tallest object, above the previous
 waypoint and above the next one, where the arm comes down, if nothing lies under the arm there
 (else the waypoint is reached directly, at push height). The gripper's approach axis is +x; coming
 onto the target from the side would sweep it along, so the way ends with an "approach" waypoint
-``APPROACH_GAP`` behind the target, from where the gripper slides straight on.
+``approach_gap`` behind the target, from where the gripper slides straight on.
+
+The clearances (``PushRules``, in backticks here) are ``TransferConfig``'s margins on the robot's
+sizes, which ``hlp_drake.systems.transfer_geometry`` reads from the robot model. The ``RobotPlanTransfer``
+block (``hlp_drake.systems.robot_transfer``) runs this in a diagram.
 """
 
 from __future__ import annotations
@@ -34,50 +38,27 @@ import numpy as np
 
 from hlp_drake.planner.plan import HighLevelPlan, PlanKeypoint
 from hlp_drake.scene.model import Scene
+from hlp_drake.systems.transfer_geometry import PushRules
 from hlp_drake.taskspace import DIRECTION_VECTORS, Rect, TaskSpace, rect_array
 from hlp_drake.taskspace.relocation import relocated
 
-# Gap between the obstacle's face and the tcp at the push start: the fingertips reach 2 cm ahead
-# of the tcp, the open fingers' outer sides ~5.5 cm beside it; plus 2-3 cm of free approach (the
-# arm comes down there from a transit waypoint, its approach axis up to 20 degrees off level).
-FORWARD_CLEARANCE = 0.05
-SIDEWAYS_CLEARANCE = 0.075
+ROBOT_ACTIONS = ("start", "gap", "move", "release", "target", "transit", "approach")
+"""The actions of a robot plan: the person's (``hlp_drake.planner.ACTIONS``), "transit" (a waypoint
+lifted clear of the objects) and "approach" (the waypoint the gripper slides onto the target from)."""
 BACKWARD = ("BB", "BL", "BR")
-# Half-width of the corridor along the start-target line that a backward move should clear: the open
-# gripper's half-width (5.5 cm) plus 2.5 cm.
-CORRIDOR_HALF_WIDTH = 0.08
-# Pushes that would move the obstacle less than this are left out of the robot plan.
-MIN_PUSH_TRAVEL = 0.01
-# A pushed obstacle stops this far short of the table's edge and of the other objects: a person
-# lifts an obstacle over its neighbours, a pushing robot would shove them along (or off the table).
-EDGE_MARGIN = 0.03
-OBJECT_MARGIN = 0.01
-TRAVEL_STEP = 0.005
-# The tcp's height over the tallest object on transit waypoints: the palm reaches 3 cm below the tcp
-# when the fingers open sideways, the wrist ~5 cm; plus 2 cm.
-TRANSIT_CLEARANCE = 0.07
-# Under the arm at push height: the tcp, the fingers and palm (14 cm behind it) and the wrist
-# (another ~20 cm), the wrist's half-width plus 1.5 cm to the sides. The arm only comes down where
-# nothing lies there: pressing it down onto an object would crush it into the table.
-ARM_SHADOW_LENGTH = 0.35
-ARM_SHADOW_HALF_WIDTH = 0.06
-# A way between waypoints whose tcp path passes this close to an object's footprint goes over it.
-PATH_CLEARANCE = 0.02
-# The gripper slides onto the target straight along its approach axis (+x), from a waypoint this
-# far behind the target's back face (the fingertips 2 cm ahead of the tcp, then 3 cm of free space),
-# where the way there would otherwise come in more than ``APPROACH_ANGLE`` off +x.
-APPROACH_GAP = 0.05
-APPROACH_ANGLE = np.radians(15.0)
-# The gripper's footprint at that waypoint (tcp-relative: the palm 5 cm behind it, the open fingers
-# 5.5 cm to either side, the fingertips 2 cm ahead) must be clear of the other objects.
-GRIPPER_BEHIND, GRIPPER_HALF_WIDTH, GRIPPER_AHEAD = 0.05, 0.055, 0.02
-# A push must not leave the obstacle this close to the tcp's way on through the gaps to the target:
-# the open gripper's half-width.
-WAY_CLEARANCE = 0.055
+TRANSFERRED = "robot_plan"
+"""The key ``robot_plan`` sets in a plan's ``details``: its moves are the robot's pushes (``KeypointIk``
+refuses a person's moves, the obstacles' centres)."""
 
 
-def _robot_direction(space: TaskSpace, scene: Scene, name: str, direction: str,
-                     footprints: Mapping[str, Rect] | None = None) -> str:
+def _robot_direction(
+    rules: PushRules,
+    space: TaskSpace,
+    scene: Scene,
+    name: str,
+    direction: str,
+    footprints: Mapping[str, Rect] | None = None,
+) -> str:
     """The robot's push direction for a person's move of obstacle ``name`` towards ``direction``
     (the other objects at ``footprints``, by default where the scene has them)."""
     if direction not in BACKWARD:
@@ -91,9 +72,12 @@ def _robot_direction(space: TaskSpace, scene: Scene, name: str, direction: str,
 
     def blocking(side: str) -> float:  # how much of the corridor the obstacle still covers after the push
         unit = _unit(side)
-        travel = push_travel(space, scene, name, unit, _wanted(space, name, side), footprints=footprints)
+        travel = push_travel(
+            rules, space, scene, name, unit, _wanted(space, name, side), footprints=footprints
+        )
         lateral = (corners + travel * unit - start) @ normal
-        return max(0.0, min(lateral.max(), CORRIDOR_HALF_WIDTH) - max(lateral.min(), -CORRIDOR_HALF_WIDTH))
+        half = rules.corridor_half_width
+        return max(0.0, min(lateral.max(), half) - max(lateral.min(), -half))
 
     return min((away, "RR" if away == "LL" else "LL"), key=blocking)
 
@@ -110,28 +94,44 @@ def _wanted(space: TaskSpace, name: str, direction: str) -> float:
     return max(float(np.dot(shift, _unit(direction))), 0.0)
 
 
-def push_travel(space: TaskSpace, scene: Scene, name: str, unit: np.ndarray, wanted: float,
-                footprints: Mapping[str, Rect] | None = None) -> float:
-    """How far (<= ``wanted``, in ``TRAVEL_STEP`` steps) obstacle ``name`` can be pushed along
-    ``unit`` before its footprint comes within ``EDGE_MARGIN`` of the table's edge or
-    ``OBJECT_MARGIN`` of another object, the objects' footprints being ``footprints`` (by default
+def push_travel(
+    rules: PushRules,
+    space: TaskSpace,
+    scene: Scene,
+    name: str,
+    unit: np.ndarray,
+    wanted: float,
+    footprints: Mapping[str, Rect] | None = None,
+) -> float:
+    """How far (<= ``wanted``, in ``rules.travel_step`` steps) obstacle ``name`` can be pushed along
+    ``unit`` before its footprint comes within ``rules.edge_margin`` of the table's edge or
+    ``rules.object_margin`` of another object, the objects' footprints being ``footprints`` (by default
     where the scene has them). An edge or object already nearer than that only stops a push that
     brings the obstacle closer to it."""
     footprints = space.rects if footprints is None else footprints
     rect = space.rects[name]
-    steps = np.arange(TRAVEL_STEP, wanted + 1e-9, TRAVEL_STEP)
+    steps = np.arange(rules.travel_step, wanted + 1e-9, rules.travel_step)
     if steps.size == 0:
         return 0.0
     start = rect_array([rect])[0]
     boxes = np.vstack([start, start + np.outer(steps, [unit[0], unit[1], unit[0], unit[1]])])
     x_min, y_min, x_max, y_max = scene.table.bounds
-    edges = np.column_stack([boxes[:, 0] - x_min, boxes[:, 1] - y_min, x_max - boxes[:, 2], y_max - boxes[:, 3]])
-    blocked = _nearing(edges, EDGE_MARGIN)
+    edges = np.column_stack(
+        [boxes[:, 0] - x_min, boxes[:, 1] - y_min, x_max - boxes[:, 2], y_max - boxes[:, 3]]
+    )
+    blocked = _nearing(edges, rules.edge_margin)
     others = rect_array([r for other, r in footprints.items() if other != name])
     if others.size:  # the gap to each other object along the axis that separates them most
-        gaps = np.max([others[None, :, 0] - boxes[:, None, 2], boxes[:, None, 0] - others[None, :, 2],
-                       others[None, :, 1] - boxes[:, None, 3], boxes[:, None, 1] - others[None, :, 3]], axis=0)
-        blocked |= _nearing(gaps, OBJECT_MARGIN)
+        gaps = np.max(
+            [
+                others[None, :, 0] - boxes[:, None, 2],
+                boxes[:, None, 0] - others[None, :, 2],
+                others[None, :, 1] - boxes[:, None, 3],
+                boxes[:, None, 1] - others[None, :, 3],
+            ],
+            axis=0,
+        )
+        blocked |= _nearing(gaps, rules.object_margin)
     stops = np.flatnonzero(blocked[1:])  # blocked[i + 1]: after steps[i]
     if stops.size == 0:
         return float(steps[-1])
@@ -155,44 +155,61 @@ class RobotPush:
     footprint: Rect
 
 
-def robot_push(space: TaskSpace, scene: Scene, name: str, direction: str, placed: Mapping[str, Rect]) -> RobotPush:
+def robot_push(
+    rules: PushRules, space: TaskSpace, scene: Scene, name: str, direction: str, placed: Mapping[str, Rect]
+) -> RobotPush:
     """The push of obstacle ``name`` towards ``direction``: towards its relocated place, short of
     the edge and the other objects (at ``placed``), from just behind its face opposite the push."""
     rect = space.rects[name]
     unit = _unit(direction)
-    travel = push_travel(space, scene, name, unit, _wanted(space, name, direction), footprints=placed)
+    travel = push_travel(rules, space, scene, name, unit, _wanted(space, name, direction), footprints=placed)
     # Distance from the centre to the face opposite the push, along the push direction.
-    clearance = abs(unit[0]) * FORWARD_CLEARANCE + abs(unit[1]) * SIDEWAYS_CLEARANCE
+    clearance = abs(unit[0]) * rules.forward_clearance + abs(unit[1]) * rules.sideways_clearance
     reach = abs(unit[0]) * rect.depth / 2.0 + abs(unit[1]) * rect.width / 2.0 + clearance
     start = np.array(rect.center) - reach * unit
     dx, dy = travel * unit
-    return RobotPush(direction, travel, (float(start[0]), float(start[1])),
-                     (float(start[0] + dx), float(start[1] + dy)),
-                     Rect(rect.x_min + dx, rect.y_min + dy, rect.x_max + dx, rect.y_max + dy))
+    return RobotPush(
+        direction,
+        travel,
+        (float(start[0]), float(start[1])),
+        (float(start[0] + dx), float(start[1] + dy)),
+        Rect(rect.x_min + dx, rect.y_min + dy, rect.x_max + dx, rect.y_max + dy),
+    )
 
 
-def chosen_push(space: TaskSpace, scene: Scene, move: PlanKeypoint, rest: Sequence[PlanKeypoint],
-                placed: Mapping[str, Rect]) -> RobotPush:
+def chosen_push(
+    rules: PushRules,
+    space: TaskSpace,
+    scene: Scene,
+    move: PlanKeypoint,
+    rest: Sequence[PlanKeypoint],
+    placed: Mapping[str, Rect],
+) -> RobotPush:
     """The robot's push for the person's ``move``: towards the person's direction (a backward move
-    made sideways), unless that leaves the obstacle within ``WAY_CLEARANCE`` of the way on through
+    made sideways), unless that leaves the obstacle within ``rules.way_clearance`` of the way on through
     the gaps to the target (``rest``: the plan's later keypoints); then the push among LL, RR and
     FF that leaves the way clear and moves the obstacle furthest, if any does."""
-    first = robot_push(space, scene, move.element, _robot_direction(space, scene, move.element, move.direction,
-                                                                     footprints=placed), placed)
+    direction = _robot_direction(rules, space, scene, move.element, move.direction, footprints=placed)
+    first = robot_push(rules, space, scene, move.element, direction, placed)
     ways = [k.position for k in rest if k.action in ("gap", "target")]
 
     def clear(push: RobotPush) -> bool:
         points = [push.end, *ways]
-        return push.travel >= MIN_PUSH_TRAVEL and not any(
-            crosses(a, b, [push.footprint], clearance=WAY_CLEARANCE) for a, b in pairwise(points))
+        return push.travel >= rules.min_push_travel and not any(
+            crosses(rules, a, b, [push.footprint], clearance=rules.way_clearance) for a, b in pairwise(points)
+        )
 
     if not ways or clear(first):
         return first
-    others = [robot_push(space, scene, move.element, d, placed) for d in ("LL", "RR", "FF") if d != first.direction]
+    others = [
+        robot_push(rules, space, scene, move.element, d, placed)
+        for d in ("LL", "RR", "FF")
+        if d != first.direction
+    ]
     return max((push for push in others if clear(push)), key=lambda push: push.travel, default=first)
 
 
-def robot_plan(plan: HighLevelPlan, scene: Scene) -> HighLevelPlan:
+def robot_plan(plan: HighLevelPlan, scene: Scene, rules: PushRules) -> HighLevelPlan:
     """The plan with each move/release pair turned into the push's start and end points (see
     ``chosen_push``), pushes with no room left out, and the ways that would pass over objects
     going over them where the arm can come down (see ``transit``)."""
@@ -205,38 +222,50 @@ def robot_plan(plan: HighLevelPlan, scene: Scene) -> HighLevelPlan:
     for i, k in enumerate(plan.keypoints):
         if k.action not in ("move", "release") or k.element not in space.rects:
             if k.action == "target" and keypoints:
-                for point in approach(keypoints[-1].position, placed[scene.target.name], placed, scene.target.name):
-                    keypoints += _way_to(keypoints, point, scene, placed)
+                for point in approach(
+                    rules, keypoints[-1].position, placed[scene.target.name], placed, scene.target.name
+                ):
+                    keypoints += _way_to(rules, keypoints, point, scene, placed)
                     keypoints.append(point)
-            keypoints += _way_to(keypoints, k, scene, placed)
+            keypoints += _way_to(rules, keypoints, k, scene, placed)
             keypoints.append(k)
             continue
         if k.action == "move" or k.element not in pushes:
-            pushes[k.element] = chosen_push(space, scene, k, plan.keypoints[i + 1:], placed)
+            pushes[k.element] = chosen_push(rules, space, scene, k, plan.keypoints[i + 1 :], placed)
         push = pushes[k.element]
-        if push.travel < MIN_PUSH_TRAVEL:
+        if push.travel < rules.min_push_travel:
             continue
         if k.action == "move":
             start = replace(k, position=push.start, direction=push.direction)
-            keypoints += _way_to(keypoints, start, scene, placed)
+            keypoints += _way_to(rules, keypoints, start, scene, placed)
             keypoints.append(start)
         else:
             placed[k.element] = push.footprint
             keypoints.append(replace(k, position=push.end, direction=push.direction))
-    return replace(plan, keypoints=tuple(keypoints))
+    return replace(plan, keypoints=tuple(keypoints), details={**plan.details, TRANSFERRED: True})
 
 
-def robot_alternatives(plan: HighLevelPlan, scene: Scene, limit: int) -> tuple[HighLevelPlan, ...]:
+def robot_alternatives(
+    plan: HighLevelPlan, scene: Scene, rules: PushRules, limit: int
+) -> tuple[HighLevelPlan, ...]:
     """The robot plans (``robot_plan``) of ``plan``'s alternative candidates, best first: at most
     ``limit``, each different from the chosen plan's and from the earlier ones (two candidates
     can differ only where the transfer makes them the same, e.g. in a push it leaves out)."""
     if not plan.ok or limit <= 0:
         return ()
-    seen = {robot_plan(plan, scene).keypoints}
+    seen = {robot_plan(plan, scene, rules).keypoints}
     found: list[HighLevelPlan] = []
     for candidate in plan.alternatives:
-        robot = robot_plan(replace(plan, keypoints=candidate.keypoints,
-                                   expected_collision=candidate.expected_collision, alternatives=()), scene)
+        robot = robot_plan(
+            replace(
+                plan,
+                keypoints=candidate.keypoints,
+                expected_collision=candidate.expected_collision,
+                alternatives=(),
+            ),
+            scene,
+            rules,
+        )
         if robot.ok and robot.keypoints not in seen:
             seen.add(robot.keypoints)
             found.append(robot)
@@ -245,24 +274,27 @@ def robot_alternatives(plan: HighLevelPlan, scene: Scene, limit: int) -> tuple[H
     return tuple(found)
 
 
-def approach(previous: tuple[float, float], target: Rect, placed: Mapping[str, Rect], name: str
-             ) -> list[PlanKeypoint]:
-    """The waypoint ``APPROACH_GAP`` behind the ``target`` footprint from which the gripper slides
-    straight onto it, if the way from ``previous`` would come in more than ``APPROACH_ANGLE`` off
+def approach(
+    rules: PushRules, previous: tuple[float, float], target: Rect, placed: Mapping[str, Rect], name: str
+) -> list[PlanKeypoint]:
+    """The waypoint ``approach_gap`` behind the ``target`` footprint from which the gripper slides
+    straight onto it, if the way from ``previous`` would come in more than ``rules.approach_angle`` off
     the approach axis and the gripper fits there, clear of the other objects (``placed``, the
     target ``name`` aside); else none."""
-    x, y = target.x_min - APPROACH_GAP, (target.y_min + target.y_max) / 2.0
+    x, y = target.x_min - rules.approach_gap, (target.y_min + target.y_max) / 2.0
     dx, dy = target.center[0] - previous[0], target.center[1] - previous[1]
-    if dx > 0.0 and abs(np.arctan2(dy, dx)) <= APPROACH_ANGLE:
+    if dx > 0.0 and abs(np.arctan2(dy, dx)) <= rules.approach_angle:
         return []
-    gripper = Rect(x - GRIPPER_BEHIND, y - GRIPPER_HALF_WIDTH, x + GRIPPER_AHEAD, y + GRIPPER_HALF_WIDTH)
+    half = rules.gripper_half_width
+    gripper = Rect(x - rules.gripper_behind, y - half, x + rules.gripper_ahead, y + half)
     if any(gripper.overlap(r) > 0.0 for other, r in placed.items() if other != name):
         return []
     return [PlanKeypoint("approach", (float(x), float(y)), element=name)]
 
 
-def _way_to(keypoints: list[PlanKeypoint], k: PlanKeypoint, scene: Scene, placed: Mapping[str, Rect]
-            ) -> list[PlanKeypoint]:
+def _way_to(
+    rules: PushRules, keypoints: list[PlanKeypoint], k: PlanKeypoint, scene: Scene, placed: Mapping[str, Rect]
+) -> list[PlanKeypoint]:
     """The transit waypoints on the way from the last of ``keypoints`` to ``k``, a push start or a
     waypoint the hand passes: over the objects to a push start, or where the straight way would
     pass over an object (the target aside), if the arm can come down at ``k`` (the target aside
@@ -271,41 +303,53 @@ def _way_to(keypoints: list[PlanKeypoint], k: PlanKeypoint, scene: Scene, placed
         return []
     target = scene.target.name
     others = [r for name, r in placed.items() if name != target]
-    if k.action != "move" and not crosses(keypoints[-1].position, k.position, others):
+    if k.action != "move" and not crosses(rules, keypoints[-1].position, k.position, others):
         return []
     under = others if k.action == "target" else list(placed.values())
-    return transit(keypoints[-1], k, transit_height(scene), under)
+    return transit(rules, keypoints[-1], k, transit_height(rules, scene), under)
 
 
-def crosses(a: tuple[float, float], b: tuple[float, float], rects, *, clearance: float = PATH_CLEARANCE) -> bool:
-    """Whether the straight tcp path from ``a`` to ``b`` passes within ``clearance`` of any of
-    ``rects`` (sampled every ``TRAVEL_STEP``)."""
+def crosses(
+    rules: PushRules, a: tuple[float, float], b: tuple[float, float], rects, *, clearance: float | None = None
+) -> bool:
+    """Whether the straight tcp path from ``a`` to ``b`` passes within ``clearance`` (default
+    ``rules.path_clearance``) of any of ``rects`` (sampled every ``rules.travel_step``)."""
+    clearance = rules.path_clearance if clearance is None else clearance
     boxes = rect_array(list(rects))
     if boxes.size == 0:
         return False
-    count = max(int(np.ceil(np.hypot(b[0] - a[0], b[1] - a[1]) / TRAVEL_STEP)), 1) + 1
+    count = max(int(np.ceil(np.hypot(b[0] - a[0], b[1] - a[1]) / rules.travel_step)), 1) + 1
     points = np.linspace(a, b, count)[:, None, :]
-    inside = ((points[..., 0] > boxes[:, 0] - clearance) & (points[..., 0] < boxes[:, 2] + clearance)
-              & (points[..., 1] > boxes[:, 1] - clearance) & (points[..., 1] < boxes[:, 3] + clearance))
+    inside = (
+        (points[..., 0] > boxes[:, 0] - clearance)
+        & (points[..., 0] < boxes[:, 2] + clearance)
+        & (points[..., 1] > boxes[:, 1] - clearance)
+        & (points[..., 1] < boxes[:, 3] + clearance)
+    )
     return bool(inside.any())
 
 
-def transit_height(scene: Scene) -> float:
+def transit_height(rules: PushRules, scene: Scene) -> float:
     """The tcp's height above the table top on transit waypoints."""
-    return max(obj.size[2] for obj in scene.objects) + TRANSIT_CLEARANCE
+    return max(obj.size[2] for obj in scene.objects) + rules.transit_clearance
 
 
-def arm_shadow(x: float, y: float) -> Rect:
+def arm_shadow(rules: PushRules, x: float, y: float) -> Rect:
     """The table area under the gripper and wrist when the tcp is at (x, y) at push height."""
-    return Rect(x - ARM_SHADOW_LENGTH, y - ARM_SHADOW_HALF_WIDTH, x, y + ARM_SHADOW_HALF_WIDTH)
+    half = rules.arm_shadow_half_width
+    return Rect(x - rules.arm_shadow_length, y - half, x, y + half)
 
 
-def transit(previous: PlanKeypoint, push: PlanKeypoint, height: float, objects) -> list[PlanKeypoint]:
+def transit(
+    rules: PushRules, previous: PlanKeypoint, push: PlanKeypoint, height: float, objects
+) -> list[PlanKeypoint]:
     """The waypoints over the objects from ``previous`` to the push start ``push``: lifted above
     ``previous`` and above the push start, from where the arm comes straight down. None if an
     object lies under the arm at the push start (``arm_shadow``): the push start is then reached
     directly, at push height."""
-    if any(arm_shadow(*push.position).overlap(o) > 0.0 for o in objects):
+    if any(arm_shadow(rules, *push.position).overlap(o) > 0.0 for o in objects):
         return []
-    return [PlanKeypoint("transit", point, push.row, push.element, height=height)
-            for point in (previous.position, push.position)]
+    return [
+        PlanKeypoint("transit", point, push.row, push.element, height=height)
+        for point in (previous.position, push.position)
+    ]

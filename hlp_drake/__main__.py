@@ -1,0 +1,55 @@
+"""hlp-drake: human-like planning for reaching in clutter, executed in Drake.
+
+    hlp-drake COMMAND [ARGS ...]      (or: python -m hlp_drake COMMAND [ARGS ...])
+
+Commands (each takes --help; the same as python -m hlp_drake.MODULE):
+    run-scene     plan a scene, optimise it with the STO and run it in Drake (hlp_drake.run_scene)
+    scene         generate, validate and draw scene files (hlp_drake.scene)
+    experiments   the paper's Generalization I and II experiments, Tables II and III (hlp_drake.experiments)
+    train         train the decision models on the VR dataset (hlp_drake.train)
+    evaluate      the cross-subject evaluation, Table I (hlp_drake.evaluate)
+    segment       segment the VR demonstrations into per-row decisions (hlp_drake.segment)
+    dataset       summarise the VR dataset (hlp_drake.dataset)
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+from collections.abc import Sequence
+
+from hlp_drake import __version__
+from hlp_drake.cli import plain, run_cli
+
+COMMANDS = {
+    "run-scene": "hlp_drake.run_scene",
+    "scene": "hlp_drake.scene.__main__",
+    "experiments": "hlp_drake.experiments.cli",
+    "train": "hlp_drake.train",
+    "evaluate": "hlp_drake.evaluate",
+    "segment": "hlp_drake.segment",
+    "dataset": "hlp_drake.dataset.__main__",
+}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``hlp-drake``'s command ``argv[0]`` with the rest of ``argv``."""
+    args = list(sys.argv[1:] if argv is None else argv)
+    if not args or args[0] in ("-h", "--help"):
+        print(plain(__doc__).strip())
+        return 0 if args else 2
+    if args[0] == "--version":
+        print(f"hlp-drake {__version__}")
+        return 0
+    module = COMMANDS.get(args[0])
+    if module is None:
+        print(
+            f"error: unknown command {args[0]!r}; choose one of {', '.join(COMMANDS)} (see hlp-drake --help)",
+            file=sys.stderr,
+        )
+        return 2
+    return run_cli(importlib.import_module(module).main, args[1:])
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

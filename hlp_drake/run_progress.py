@@ -1,0 +1,98 @@
+"""How ``run_scene`` shows a run as it happens: a line per stage, and bars for the rollouts and the simulation.
+
+``ProgressListener`` has the methods of ``hlp_drake.systems.RunListener``: the stage lines go to
+stdout as each stage ends; the optimiser's rollouts and the execution's simulated time are tqdm
+bars on ``stream`` (off with ``quiet``).
+"""
+
+from __future__ import annotations
+
+import sys
+from typing import TextIO
+
+from tqdm import tqdm
+
+
+def plan_steps(plan) -> str:
+    """A plan's keypoints as one line: ``start -> move Long RR -> release -> target``."""
+    return (
+        " -> ".join(
+            k.action
+            + (f" {k.element}" if k.action in ("gap", "move") else "")
+            + (f" {k.direction}" if k.action == "move" else "")
+            for k in plan.keypoints
+        )
+        or "(none)"
+    )
+
+
+class ProgressListener:
+    """Prints each stage of a run as it happens (see the module's docstring)."""
+
+    def __init__(self, *, quiet: bool = False, stream: TextIO = sys.stderr) -> None:
+        self._quiet, self._stream = quiet, stream
+        self._bar: tqdm | None = None
+        self._shown = 0.0
+
+    def _line(self, text: str) -> None:
+        print(text, flush=True)
+
+    def _open(self, **kwargs) -> None:
+        if not self._quiet:
+            self._bar = tqdm(file=self._stream, dynamic_ncols=True, leave=False, **kwargs)
+
+    def _close(self) -> None:
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
+
+    def planned(self, plan, seconds: float) -> None:
+        what = f"plan: {plan_steps(plan)}" if plan.ok else f"plan: none ({plan.reason})"
+        self._line(f"{what} ({seconds:.2f} s)")
+
+    def solved(self, keyframes, trajectory, seconds: float) -> None:
+        solved = sum(keyframes.success)
+        failed = "" if keyframes.ok else f"; failed: {'; '.join(keyframes.failures)}"
+        self._line(
+            f"IK: {solved} of {len(keyframes.success)} keyframes, a {trajectory.end_time():.1f} s "
+            f"trajectory ({seconds:.2f} s){failed}"
+        )
+
+    def optimising(self) -> None:
+        self._open(desc="optimise", unit="rollout")
+
+    def rollout(self, outcome) -> None:
+        if self._bar is not None:
+            self._bar.set_postfix_str(f"cost {outcome.cost:.3g}", refresh=False)
+            self._bar.update()
+
+    def optimised(self, result) -> None:
+        self._close()
+        verdict = "success" if result.success else f"no success ({result.failure_reason})"
+        self._line(
+            f"optimise: {verdict} after {result.iterations} iterations, {result.rollouts} rollouts "
+            f"({result.optimise_s:.1f} s)"
+        )
+
+    def executing(self, duration: float) -> None:
+        self._line(f"execute: up to {duration:.1f} s simulated (reach, settle, grasp and lift)")
+        self._shown = 0.0
+        self._open(
+            desc="execute",
+            total=round(duration, 1),
+            unit="s sim",
+            bar_format=(
+                "{desc}: {percentage:3.0f}%|{bar}| {n:.1f}/{total:.1f} s simulated [{elapsed}<{remaining}]"
+            ),
+        )
+
+    def simulated(self, t: float) -> None:
+        if self._bar is not None and t - self._shown >= 0.1:
+            self._bar.update(round(t - self._shown, 1))
+            self._shown += round(t - self._shown, 1)
+        if self._bar is not None and t >= self._bar.total - 1e-9:
+            self._close()
+
+    def finished(self, result) -> None:
+        self._close()
+        self._line(f"execute: {result.simulated_s:.1f} s simulated in {result.timings['execute_s']:.1f} s")

@@ -1,0 +1,110 @@
+"""``make_planning_diagram``: scene -> planner block -> push transfer -> KeypointIk (-> optimiser).
+
+The diagram's one input is ``scene``: fix it, or feed it from a plant's body poses through
+``SceneFromPlant`` (as ``plan_and_execute`` does), and the diagram plans again when the scene changes.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from pydrake.systems.framework import Diagram, DiagramBuilder
+
+from hlp_drake.learners.bundled import default_models
+from hlp_drake.learners.models import DecisionModels
+from hlp_drake.systems.control_sequence import ControlSequence
+from hlp_drake.systems.hlp_planner_system import HlpPlannerSystem
+from hlp_drake.systems.keypoint_ik import KeypointIk
+from hlp_drake.systems.optimiser_system import StochasticTrajectoryOptimiser
+from hlp_drake.systems.robot_transfer import RobotPlanTransfer
+from hlp_drake.systems.rollout_cost import RolloutOutcome
+from hlp_drake.systems.rollout_pool import RolloutPool
+from hlp_drake.systems.scene_rollouts import SceneRollouts
+from hlp_drake.systems.scene_source import SCENE_PORT
+from hlp_drake.systems.straight_line import StraightLinePlanSystem
+
+if TYPE_CHECKING:
+    from hlp_drake.systems.scenario import Scenario
+
+
+@cache
+def _models_in(directory: str) -> DecisionModels:
+    return DecisionModels.load(Path(directory))
+
+
+def scenario_models(scenario: Scenario) -> DecisionModels:
+    """The decision models ``scenario.planner.models`` names (the bundled ones for ""), loaded once."""
+    return _models_in(scenario.planner.models) if scenario.planner.models else default_models()
+
+
+def make_planning_diagram(
+    scenario: Scenario, *, pool: RolloutPool | None = None, models: DecisionModels | None = None
+) -> Diagram:
+    """``scene`` input -> planner block -> push transfer -> KeypointIk -> StochasticTrajectoryOptimiser.
+
+    The planner block is ``scenario.planner.kind``'s: "hlp" (``HlpPlannerSystem``) or "sto" (the
+    straight line, ``StraightLinePlanSystem``); the rest is the same for both. Outputs ``plan`` (the
+    planner's), ``robot_plan`` (its pushing-robot waypoints), ``keyframes``, ``trajectory`` (the
+    initial joint trajectory through the keyframes) and, with a ``pool``, ``optimised_trajectory``
+    and ``optimisation`` (the optimiser's ``StoResult``; evaluating them runs the optimiser). The
+    transfer's ``robot_alternatives`` (``optimiser.alternatives`` of the plan's next candidates) go
+    through KeypointIk's ``alternatives`` to the optimiser, which evaluates them only when the
+    initial trajectory's rollout fails.
+
+    Args:
+        pool: the optimiser's rollout workers (the caller's); without one, no optimiser.
+        models: the decision models (default: ``scenario_models(scenario)``).
+    """
+    kind = scenario.planner.kind
+    builder = DiagramBuilder()
+    if kind == "hlp":
+        block = HlpPlannerSystem(models=models or scenario_models(scenario), config=scenario.planner.hlp)
+    else:
+        block = StraightLinePlanSystem()
+    builder.AddNamedSystem(f"{kind}_planner", block)
+    transfer = builder.AddNamedSystem("robot_plan_transfer", RobotPlanTransfer(scenario))
+    ik = builder.AddNamedSystem("keypoint_ik", KeypointIk(scenario))
+    builder.Connect(block.get_plan_output_port(), transfer.get_plan_input_port())
+    builder.Connect(transfer.get_robot_plan_output_port(), ik.get_plan_input_port())
+    builder.Connect(transfer.get_robot_alternatives_output_port(), ik.get_alternatives_input_port())
+    builder.ExportInput(block.get_scene_input_port(), SCENE_PORT)
+    builder.ConnectToSame(block.get_scene_input_port(), transfer.get_scene_input_port())
+    builder.ExportOutput(block.get_plan_output_port(), "plan")
+    builder.ExportOutput(transfer.get_robot_plan_output_port(), "robot_plan")
+    builder.ExportOutput(ik.get_keyframes_output_port(), "keyframes")
+    builder.ExportOutput(ik.get_trajectory_output_port(), "trajectory")
+    if pool is not None:
+        optimiser = builder.AddNamedSystem("optimiser", StochasticTrajectoryOptimiser(scenario, pool))
+        builder.ConnectToSame(block.get_scene_input_port(), optimiser.get_scene_input_port())
+        builder.Connect(ik.get_trajectory_output_port(), optimiser.get_initial_trajectory_input_port())
+        builder.Connect(
+            ik.get_alternative_trajectories_output_port(), optimiser.get_alternatives_input_port()
+        )
+        builder.ExportOutput(optimiser.get_trajectory_output_port(), "optimised_trajectory")
+        builder.ExportOutput(optimiser.get_result_output_port(), "optimisation")
+    diagram = builder.Build()
+    diagram.set_name(f"{kind}_planning")
+    return diagram
+
+
+def initial_sequence(scenario: Scenario, *, models: DecisionModels | None = None) -> ControlSequence | None:
+    """The planner's initial (IK) control sequence on ``scenario``'s scene, the optimiser's starting
+    point; None if there is no trajectory at all (a keypoint whose IK failed is skipped, as the
+    trajectory does)."""
+    diagram = make_planning_diagram(scenario, models=models)
+    context = diagram.CreateDefaultContext()
+    diagram.GetInputPort(SCENE_PORT).FixValue(context, scenario.scene)
+    trajectory = diagram.GetOutputPort("trajectory").Eval(context)
+    if trajectory.get_number_of_segments() == 0:
+        return None
+    return ControlSequence.from_trajectory(trajectory, scenario.optimiser.step_duration)
+
+
+def first_rollout(scenario: Scenario, *, models: DecisionModels | None = None) -> RolloutOutcome | None:
+    """The rollout of ``initial_sequence``, as the optimiser's first one (``SceneRollouts``: the
+    reduced model if ``optimiser.reduced_model``, at the rollout time step); None if there is no
+    initial sequence."""
+    sequence = initial_sequence(scenario, models=models)
+    return None if sequence is None else SceneRollouts(scenario).rollout(sequence)

@@ -1,0 +1,154 @@
+"""``Scenario``: one typed description of a run, the argument of every builder in ``hlp_drake.systems``.
+
+A frozen dataclass tree (the pattern of manipulation's ``Scenario``): the scene, the planner, the
+plant and contact settings, how the scene becomes bodies, the robot's controller, keypoint IK,
+motion timing, the push transfer's margins, the optimiser and the grasp. Loaded once with Drake's
+typed loader (``load_scenario``; problems are located one-line errors), it is passed to the
+builders at construction. ``Scenario.key`` (computed once) identifies it, e.g. for rollout worlds.
+
+A scenario file gives only what it changes; ``scene:`` is a scene in the format of a scene file (read
+whole)::
+
+    scene: {name: mine, table: {length: 0.9, width: 0.8, height: 0.75}, start: [0.1, 0.0],
+            target: {name: Target, shape: cylinder, x: 0.7, y: 0.0, size: [0.06, 0.06, 0.12]},
+            obstacles: []}
+    planner: {kind: hlp}            # hlp (human-like) or sto (the straight line of the STO baseline)
+    plant: {time_step: 0.002}       # Drake's MultibodyPlantConfig
+    controller: {arm: {kp: 2000.0, kd: 150.0}}
+    optimiser: {samples: 8, max_iterations: 20}
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+from typing import Literal
+
+from pydrake.multibody.plant import MultibodyPlantConfig
+
+from hlp_drake.errors import HlpError
+from hlp_drake.planner.config import PlannerConfig
+from hlp_drake.scene.io import default_scene
+from hlp_drake.scene.model import Scene
+from hlp_drake.scene.validation import scene_problems
+from hlp_drake.systems.optimiser_config import StoConfig
+from hlp_drake.systems.scenario_checks import scenario_problems
+from hlp_drake.systems.transfer_geometry import TransferConfig
+from hlp_drake.systems.world_settings import (
+    BodiesConfig,
+    ContactConfig,
+    ControlConfig,
+    GraspConfig,
+    IkConfig,
+    MotionConfig,
+    default_plant_config,
+)
+from hlp_drake.typed_yaml import dump_typed, load_typed, parse_yaml
+
+PLANNERS = ("hlp", "sto")
+
+
+@dataclass(frozen=True)
+class PlannerSettings:
+    """Which plan initialises the optimiser.
+
+    Attributes:
+        kind: "hlp" (the human-like planner) or "sto" (the straight line of the baseline STO); the
+            optimiser and its settings are the same for both.
+        models: a directory of trained decision models (``python -m hlp_drake.train --out DIR``);
+            "" for the bundled ones.
+        hlp: the human-like planner's settings.
+    """
+
+    kind: Literal["hlp", "sto"] = "hlp"
+    models: str = ""
+    hlp: PlannerConfig = field(default_factory=PlannerConfig)
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """Everything a run depends on (see the module's docstring). Frozen: derive variants with
+    ``updated`` (YAML text) or ``dataclasses.replace``.
+
+    Attributes:
+        scene: the table, start, target and obstacles (default: the bundled default scene).
+        planner: the planner and its settings.
+        plant: Drake's plant settings; ``time_step`` > 0 and a SAP contact approximation ("sap",
+            "lagged", "similar"), which the robot's mimic finger needs.
+        contact: contact materials.
+        bodies: how the scene's table and objects become bodies.
+        controller: the robot's PD gains and gravity compensation.
+        ik: keypoint inverse kinematics and the start pose.
+        motion: the timing of the joint trajectory through the keyframes.
+        transfer: the push transfer's margins (the robot's sizes come from its model).
+        optimiser: the stochastic trajectory optimiser.
+        grasp: the grasp and lift after the reach.
+    """
+
+    scene: Scene = field(default_factory=default_scene)
+    planner: PlannerSettings = field(default_factory=PlannerSettings)
+    plant: MultibodyPlantConfig = field(default_factory=default_plant_config)
+    contact: ContactConfig = field(default_factory=ContactConfig)
+    bodies: BodiesConfig = field(default_factory=BodiesConfig)
+    controller: ControlConfig = field(default_factory=ControlConfig)
+    ik: IkConfig = field(default_factory=IkConfig)
+    motion: MotionConfig = field(default_factory=MotionConfig)
+    transfer: TransferConfig = field(default_factory=TransferConfig)
+    optimiser: StoConfig = field(default_factory=StoConfig)
+    grasp: GraspConfig = field(default_factory=GraspConfig)
+
+    @cached_property
+    def yaml(self) -> str:
+        """The scenario as YAML text that ``load_scenario(data=...)`` reads back (computed once)."""
+        return dump_typed(self)
+
+    @cached_property
+    def key(self) -> str:
+        """A digest of ``yaml``: equal for equal scenarios (computed once)."""
+        return hashlib.sha256(self.yaml.encode()).hexdigest()
+
+    def updated(self, data: str, *, where: str = "overrides") -> Scenario:
+        """This scenario with the YAML text ``data`` laid over it (see ``load_scenario``)."""
+        return load_scenario(data=data, defaults=self, where=where)
+
+
+def load_scenario(
+    filename: str | Path | None = None,
+    *,
+    data: str | None = None,
+    defaults: Scenario | None = None,
+    where: str | None = None,
+) -> Scenario:
+    """``defaults`` (``Scenario()``), updated by the file ``filename`` and then by the YAML text ``data``.
+
+    Args:
+        where: how messages name ``data`` (default "overrides").
+
+    Raises:
+        HlpError: the file is missing or unreadable, is not YAML, has a field the scenario does not
+            know or a value of the wrong type, or a value out of range; one line per problem, each
+            naming the file (or ``where``) and the field.
+    """
+    scenario = Scenario() if defaults is None else defaults
+    sources: list[tuple[str, str]] = []
+    if filename is not None:
+        try:
+            sources.append((str(filename), Path(filename).read_text(encoding="utf-8")))
+        except FileNotFoundError:
+            raise HlpError(f"{filename}: scenario file not found") from None
+        except (OSError, UnicodeDecodeError) as error:
+            raise HlpError(f"{filename}: cannot read the scenario: {' '.join(str(error).split())}") from None
+    if data is not None:
+        sources.append((where or "overrides", data))
+    for name, text in sources:
+        scenario = load_typed(Scenario, parse_yaml(text, name), defaults=scenario, where=name, top="scenario")
+    problems = [f"scene: {p}" for p in scene_problems(scenario.scene)] + scenario_problems(scenario)
+    if problems:
+        where = " + ".join(name for name, _ in sources) or "defaults"
+        raise HlpError(*(f"{where}: {p}" for p in problems))
+    return scenario
+
+
+__all__ = ["PLANNERS", "PlannerSettings", "Scenario", "load_scenario"]

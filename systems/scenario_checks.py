@@ -1,0 +1,117 @@
+"""The checks of a ``Scenario``'s settings: every value out of range, one message each."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+from hlp_drake.systems.optimiser_config import StoCost
+from hlp_drake.systems.transfer_geometry import TransferConfig
+
+if TYPE_CHECKING:
+    from hlp_drake.systems.scenario import Scenario
+
+SAP_APPROXIMATIONS = ("sap", "lagged", "similar")
+"""Discrete contact approximations solved by SAP (TAMSI, "tamsi", cannot simulate the mimic finger)."""
+CONTACT_MODELS = ("point", "hydroelastic", "hydroelastic_with_fallback")
+
+
+def scenario_problems(scenario: Scenario) -> list[str]:
+    """The reasons ``scenario``'s settings cannot be used (empty when they are fine; the scene is
+    validated on its own, by ``validate_scene``)."""
+    problems: list[str] = []
+
+    def positive(where: str, value: float, *, zero_ok: bool = False) -> None:
+        if not math.isfinite(value) or value < 0 or (value == 0 and not zero_ok):
+            problems.append(f"{where} must be {'>= 0' if zero_ok else '> 0'}, got {value}")
+
+    plant = scenario.plant
+    positive("plant.time_step", plant.time_step)
+    if plant.discrete_contact_approximation not in SAP_APPROXIMATIONS:
+        problems.append(
+            f"plant.discrete_contact_approximation must be one of {', '.join(SAP_APPROXIMATIONS)} "
+            f"(the robot's mimic finger needs SAP), got {plant.discrete_contact_approximation!r}"
+        )
+    if plant.contact_model not in CONTACT_MODELS:
+        problems.append(
+            f"plant.contact_model must be one of {', '.join(CONTACT_MODELS)}, got {plant.contact_model!r}"
+        )
+    contact = scenario.contact
+    positive("contact.stiffness", contact.stiffness)
+    positive("contact.hunt_crossley_dissipation", contact.hunt_crossley_dissipation, zero_ok=True)
+    positive("contact.relaxation_time", contact.relaxation_time, zero_ok=True)
+    positive("contact.corner_sphere_radius", contact.corner_sphere_radius, zero_ok=True)
+    if contact.rim_spheres < 0 or contact.rim_spheres == 1 or contact.rim_spheres == 2:
+        problems.append(f"contact.rim_spheres must be 0 or >= 3, got {contact.rim_spheres}")
+    for name in ("table_friction", "object_friction", "gripper_friction"):
+        positive(f"contact.{name}", getattr(contact, name))
+    bodies = scenario.bodies
+    positive("bodies.table_thickness", bodies.table_thickness)
+    positive("bodies.object_density", bodies.object_density)
+    positive("bodies.object_min_mass", bodies.object_min_mass)
+    if bodies.object_max_mass < bodies.object_min_mass:
+        problems.append(
+            f"bodies.object_max_mass ({bodies.object_max_mass}) is below "
+            f"bodies.object_min_mass ({bodies.object_min_mass})"
+        )
+    for name in ("base", "base_yaw", "arm", "wrist", "gripper"):
+        gains = getattr(scenario.controller, name)
+        positive(f"controller.{name}.kp", gains.kp, zero_ok=True)
+        positive(f"controller.{name}.kd", gains.kd, zero_ok=True)
+    ik = scenario.ik
+    for name in (
+        "height",
+        "position_tolerance",
+        "approach_tolerance",
+        "roll_tolerance",
+        "start_reach",
+        "base_max_yaw",
+    ):
+        positive(f"ik.{name}", getattr(ik, name))
+    for name in ("table_clearance", "base_under_table", "base_lateral_margin", "start_base_clearance"):
+        positive(f"ik.{name}", getattr(ik, name), zero_ok=True)
+    if ik.max_iterations < 1 or ik.attempts < 1:
+        problems.append(
+            f"ik.max_iterations and ik.attempts must be >= 1, got {ik.max_iterations}, {ik.attempts}"
+        )
+    positive("motion.tcp_speed", scenario.motion.tcp_speed)
+    positive("motion.transit_speed", scenario.motion.transit_speed)
+    positive("motion.joint_speed_fraction", scenario.motion.joint_speed_fraction)
+    positive("motion.min_segment_duration", scenario.motion.min_segment_duration)
+    sto, grasp = scenario.optimiser, scenario.grasp
+    for name in ("samples", "max_iterations", "workers"):
+        if int(getattr(sto, name)) < 1:
+            problems.append(f"optimiser.{name} must be >= 1, got {getattr(sto, name)}")
+    if int(sto.alternatives) < 0:
+        problems.append(f"optimiser.alternatives must be >= 0, got {sto.alternatives}")
+    for name in (
+        "time_budget_s",
+        "step_duration",
+        "mppi_temperature",
+        "rollout_time_step",
+        "sample_period",
+        "max_object_speed",
+        "max_sink",
+    ):
+        positive(f"optimiser.{name}", getattr(sto, name))
+    positive("optimiser.settle_s", sto.settle_s, zero_ok=True)
+    positive("optimiser.weld_clearance", sto.weld_clearance)
+    positive("optimiser.weld_lookahead", sto.weld_lookahead, zero_ok=True)
+    positive("optimiser.weld_margin", sto.weld_margin, zero_ok=True)
+    if sto.weld_margin > sto.weld_clearance:
+        problems.append(
+            f"optimiser.weld_margin ({sto.weld_margin}) must not exceed optimiser.weld_clearance ({sto.weld_clearance})"
+        )
+    for name in ("vx", "vy", "yaw_rate"):
+        positive(f"optimiser.noise.{name}", getattr(sto.noise, name), zero_ok=True)
+    if not 0.0 <= sto.noise.end_fraction <= 1.0:
+        problems.append(f"optimiser.noise.end_fraction must be in [0, 1], got {sto.noise.end_fraction}")
+    for name in StoCost.__dataclass_fields__:
+        positive(f"optimiser.cost.{name}", getattr(sto.cost, name), zero_ok=True)
+    for name in TransferConfig.__dataclass_fields__:  # every margin may be 0, every length must be > 0
+        positive(f"transfer.{name}", getattr(scenario.transfer, name), zero_ok=name.endswith("margin"))
+    for name in ("close_s", "lift_s", "held_height"):
+        positive(f"grasp.{name}", getattr(grasp, name))
+    for name in ("lift_height", "hold_s"):
+        positive(f"grasp.{name}", getattr(grasp, name), zero_ok=True)
+    return problems

@@ -1,0 +1,65 @@
+"""The command lines share one style: plain help text, --version, --quiet, one-line usage errors."""
+
+from __future__ import annotations
+
+import importlib
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from hlp_drake import __version__
+from hlp_drake.__main__ import COMMANDS, main
+
+MODULES = sorted(set(COMMANDS.values()))
+
+
+@pytest.mark.parametrize("module", MODULES)
+def test_help_is_plain_text_and_every_command_has_a_version(module, capsys):
+    entry = importlib.import_module(module).main
+    with pytest.raises(SystemExit) as done:
+        entry(["--help"])
+    assert done.value.code == 0
+    text = capsys.readouterr().out
+    assert "``" not in text and "--version" in text
+    with pytest.raises(SystemExit):
+        entry(["--version"])
+    assert __version__ in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    "module",
+    [
+        "hlp_drake.run_scene",
+        "hlp_drake.experiments.cli",
+        "hlp_drake.train",
+        "hlp_drake.evaluate",
+        "hlp_drake.segment",
+    ],
+)
+def test_long_commands_take_quiet(module, capsys):
+    with pytest.raises(SystemExit):
+        importlib.import_module(module).main(["--help"])
+    assert "--quiet" in capsys.readouterr().out
+
+
+def test_hlp_drake_dispatches_to_the_commands(capsys):
+    assert main(["--version"]) == 0 and capsys.readouterr().out.strip() == f"hlp-drake {__version__}"
+    assert main([]) == 2 and "run-scene" in capsys.readouterr().out
+    assert main(["fly"]) == 2 and "unknown command 'fly'" in capsys.readouterr().err
+    assert main(["scene", "validate", "missing.yaml"]) == 2
+    assert capsys.readouterr().err.strip() == "error: missing.yaml: no such file"
+    assert main(["run-scene", "--planner", "astar"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: argument --planner: invalid choice") and "\n" not in err
+
+
+def test_the_console_script_is_installed():
+    script = Path(sys.executable).with_name("hlp-drake")
+    if not script.exists():
+        pytest.skip(f"{script} is not installed (pip install -e . installs it)")
+    result = subprocess.run(
+        [str(script), "--version"], capture_output=True, text=True, timeout=60, check=False
+    )
+    assert result.returncode == 0 and result.stdout.strip() == f"hlp-drake {__version__}"

@@ -1,0 +1,103 @@
+"""Every code block of the README runs, verbatim: python and bash blocks, scenario and scene YAML.
+
+Blocks in ``text`` are program output and pictures, not code. The test command (pytest) is the one
+``.ci/run`` runs (``test_packaging``); install commands (venv, pip) are what CI itself does, so of a
+quick-start line only the part after them runs, with this interpreter as ``.venv/bin/python``.
+"""
+
+from __future__ import annotations
+
+import re
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from conftest import REPO
+
+BLOCK = re.compile(r"^```(\w*)\n(.*?)^```", re.DOTALL | re.MULTILINE)
+
+
+def readme_blocks() -> list[tuple[str, str]]:
+    return [(language, code) for language, code in BLOCK.findall((REPO / "README.md").read_text())]
+
+
+def blocks(language: str) -> list[str]:
+    return [code for kind, code in readme_blocks() if kind == language]
+
+
+def test_the_readme_has_only_runnable_blocks_and_output():
+    kinds = {kind for kind, _ in readme_blocks()}
+    assert kinds <= {"python", "bash", "yaml", "text"}, kinds
+    assert blocks("python") and blocks("bash") and blocks("yaml")
+
+
+def commands(block: str) -> list[str]:
+    """The block's commands, one a line (comments dropped), install steps left out."""
+    found = []
+    for line in block.splitlines():
+        line = line.split("  #")[0].strip()
+        if not line or line.startswith("#"):
+            continue
+        steps = [s for s in line.split(" && ") if not (s.startswith("python3 -m venv") or "pip install" in s)]
+        found += steps
+    return found
+
+
+def run(command: str, cwd: Path) -> subprocess.CompletedProcess:
+    argv = shlex.split(command)
+    if argv[0] in ("python", ".venv/bin/python"):
+        argv[0] = sys.executable
+    return subprocess.run(argv, cwd=cwd, capture_output=True, text=True, timeout=600, check=False)
+
+
+def test_every_bash_block_runs(tmp_path):
+    lines = [c for block in blocks("bash") for c in commands(block)]
+    assert any("hlp_drake.run_scene" in c for c in lines) and any("hlp_drake.scene show" in c for c in lines)
+    for command in lines:
+        if "pytest" in command:
+            assert command in (REPO / ".ci" / "run").read_text()  # the test command: what CI runs
+            continue
+        result = run(command, tmp_path)
+        assert result.returncode == 0, (command, result.stdout, result.stderr)
+        if "scene show" in command:
+            assert "robot plan: start ->" in result.stdout and "human plan: start ->" in result.stdout
+        if "hlp_drake.run_scene" in command:  # the quick start: the default scene, planned and grasped
+            for line in ("plan: start ->", "optimise: success", "success\n", "grasp: held"):
+                assert line in result.stdout, (line, result.stdout)
+    assert (tmp_path / "scene.png").stat().st_size > 10_000
+
+
+def test_the_python_block_is_the_example_file_and_runs(tmp_path):
+    (code,) = blocks("python")
+    assert code == (REPO / "examples" / "compose_diagram.py").read_text()
+    result = subprocess.run(
+        [sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=600, check=False
+    )
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.splitlines()
+    assert lines[0].startswith("robot plan: start -> ") and lines[0].endswith(" -> target")
+    assert lines[1] == "optimised: success True after 1 rollout(s)"
+    assert re.fullmatch(r"after moving FailOnTouchObstacleShort: \d+ keypoints", lines[2])
+
+
+def test_the_yaml_blocks_load_as_a_scenario_and_a_scene(tmp_path):
+    from hlp_drake.scene.io import load_scene
+    from hlp_drake.systems.scenario import Scenario, load_scenario
+
+    scenario_block, scene_block = sorted(blocks("yaml"), key=lambda text: "table:" in text)
+    scenario = load_scenario(data=scenario_block)
+    assert scenario.planner.kind == "hlp" and scenario.optimiser.samples == 8
+    assert scenario.key == Scenario().key  # the README shows the defaults
+    path = tmp_path / "example.yaml"
+    path.write_text(scene_block)
+    scene = load_scene(path)
+    assert scene.name == "example" and [o.name for o in scene.obstacles] == ["box1"]
+
+
+@pytest.mark.parametrize(
+    "link", sorted(set(re.findall(r"\]\(((?:docs|examples)/[^)#]+)", (REPO / "README.md").read_text())))
+)
+def test_the_readmes_links_into_the_repository_exist(link):
+    assert (REPO / link).exists(), link

@@ -1,38 +1,56 @@
-"""Planning time of the human-like planner with the bundled models, and per-scene feature time.
+"""Planning time of the human-like planner with its bundled models, beside another release's.
 
-    python benchmarks/planning_time.py [--dataset PATH] [--scenes 50] [--rounds 1] [--json OUT]
+    python benchmarks/planning_time.py [--dataset PATH] [--scenes 50] [--rounds 3]
+        [--baseline CHECKOUT] [--json OUT] [--png OUT]
 
-Scenes: the VR scenes of 5 held-out subjects (the ~450 test scenes of one 19/5 split), seeded
-Generalization II scenes with 6, 12, 25 and 50 objects (sizes the generator cannot place are
-reported as such; their row count grows too), and two-row scenes with 6, 12, 25 and 50 boxes (the
-object count alone). Prints the median and 95th percentile per group, then a table of them.
-With ``--rounds R`` every scene is planned R times (all scenes of a group once per round) and its
-fastest time counts, which steadies the figures on a busy machine.
+Scene groups: the VR structured scenes of 5 held-out subjects (one 19/5 split), every unstructured
+VR scene, seeded Generalization II scenes with 6, 12, 25 and 50 objects (sizes the generator
+cannot place are reported as such; their row count grows too), and two-row scenes with 6, 12, 25
+and 50 boxes (the object count alone). Every round plans every scene once in a fresh process of
+this checkout, then (with --baseline, a checkout with its own .venv, e.g. a worktree of the
+previous release) once in one of the baseline; the order alternates between rounds, so both see
+the same machine load. A scene's time is its fastest over the rounds. Prints the median, p95 and
+p99 per group and planner, and the ratio of the medians; writes JSON and a PNG.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import pickle
 import platform
+import subprocess
+import sys
+import tempfile
 import time
-import timeit
 from pathlib import Path
 
 import numpy as np
+from tqdm import tqdm
 
-from hlp_drake.dataset import Dataset
+from hlp_drake.dataset import STRUCTURED, UNSTRUCTURED, Dataset
 from hlp_drake.errors import HlpError
 from hlp_drake.evaluation import subject_splits
-from hlp_drake.features import gap_features, object_features, segment_feature_matrix
-from hlp_drake.learners.bundled import default_models
-from hlp_drake.planner import plan
+from hlp_drake.plotting import new_figure, save_png
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene, SceneObject, Table
 from hlp_drake.segmentation import demonstration_records
 from hlp_drake.taskspace import TaskSpace
 
-DEFAULT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "hlp-vr-dataset.tar.xz"
+DEFAULT = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+# Runs in each planner's own interpreter: plan every pickled scene once (after a warm-up), write the times.
+WORKER = """
+import json, pickle, sys
+from hlp_drake.learners.bundled import default_models
+from hlp_drake.planner import plan
+groups = pickle.load(open(sys.argv[1], "rb"))
+models = default_models()
+for scenes in groups.values():
+    for scene in scenes[:3]:
+        plan(scene, models)
+json.dump({name: [plan(s, models).planning_time_s for s in scenes] for name, scenes in groups.items()},
+          open(sys.argv[2], "w"))
+"""
 
 
 def two_row_scene(objects: int, seed: int) -> Scene:
@@ -51,58 +69,90 @@ def two_row_scene(objects: int, seed: int) -> Scene:
                  tuple(obstacles), name=f"two-row-{objects}-{seed}")
 
 
-def times(scenes, models, rounds: int = 1) -> dict[str, float]:
-    for scene in scenes[:3]:
-        plan(scene, models)  # warm up
-    t = np.min([[plan(scene, models).planning_time_s for scene in scenes] for _ in range(rounds)], axis=0)
-    return {"scenes": len(scenes), "median_ms": float(np.median(t) * 1e3), "p95_ms": float(np.percentile(t, 95) * 1e3)}
+def scene_groups(dataset_path: str, count: int) -> tuple[dict[str, list[Scene]], dict[str, str]]:
+    """The scenes of every group, and the groups the generator could not make (with the reason)."""
+    dataset = Dataset(dataset_path, progress=False)
+    _, test = subject_splits(dataset.subjects, n_train=19, splits=1, seed=0)[0]
+    groups = {"vr_structured": [dataset.scene(r.key) for r in demonstration_records(dataset, test, (STRUCTURED,))],
+              "vr_unstructured": [dataset.scene(r.key) for r in demonstration_records(dataset, None, (UNSTRUCTURED,))]}
+    failed = {}
+    for objects in (6, 12, 25, 50):
+        try:
+            groups[f"gen2_{objects}"] = [generate_scene("gen2", seed, objects) for seed in range(count)]
+        except HlpError as error:
+            failed[f"gen2_{objects}"] = str(error)
+    for objects in (6, 12, 25, 50):
+        groups[f"two_rows_{objects}"] = [two_row_scene(objects, seed) for seed in range(count)]
+    return {name: scenes for name, scenes in groups.items() if scenes}, failed
 
 
-def table(report: dict) -> str:
-    """The timed groups as a text table."""
-    lines = [f"{'group':16s} {'scenes':>6s} {'rows':>5s} {'median ms':>10s} {'p95 ms':>8s}"]
-    for name, value in report.items():
-        if isinstance(value, dict) and "median_ms" in value:
-            rows = f"{value['rows_mean']:.1f}" if "rows_mean" in value else "2.0" if name.startswith("two_rows") else ""
-            lines.append(f"{name:16s} {value['scenes']:6d} {rows:>5s} {value['median_ms']:10.2f} {value['p95_ms']:8.2f}")
-    return "\n".join(lines)
+def time_rounds(groups: dict[str, list[Scene]], pythons: dict[str, str], rounds: int) -> dict[str, dict]:
+    """Per planner and group, each scene's fastest planning time over ``rounds`` fresh processes."""
+    best: dict[str, dict[str, np.ndarray]] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        scenes = Path(tmp) / "scenes.pkl"
+        scenes.write_bytes(pickle.dumps(groups))
+        order = list(pythons)
+        for r in tqdm(range(rounds), desc="rounds", unit="round"):
+            for name in order if r % 2 == 0 else order[::-1]:
+                out = Path(tmp) / f"{name}.json"
+                subprocess.run([pythons[name], "-c", WORKER, str(scenes), str(out)], cwd=tmp, check=True)
+                times = {g: np.array(t) for g, t in json.loads(out.read_text()).items()}
+                best[name] = times if name not in best else {g: np.minimum(best[name][g], t) for g, t in times.items()}
+    return {name: {g: {"scenes": len(t), "median_ms": float(np.median(t) * 1e3), "p95_ms": float(np.percentile(t, 95) * 1e3),
+                       "p99_ms": float(np.percentile(t, 99) * 1e3)} for g, t in per_group.items()}
+            for name, per_group in best.items()}
+
+
+def plot(report: dict, path: str) -> None:
+    figure, axes = new_figure(9.0, 4.2)
+    groups = list(report["planners"]["this"])
+    for k, name in enumerate(report["planners"]):
+        medians = [report["planners"][name][g]["median_ms"] for g in groups]
+        p99 = [report["planners"][name][g]["p99_ms"] - m for g, m in zip(groups, medians)]
+        x = np.arange(len(groups)) + (k - 0.5) * 0.4
+        axes.bar(x, medians, 0.4, yerr=[np.zeros(len(groups)), p99], capsize=2, label=f"{name} (median, to p99)")
+    axes.set_xticks(np.arange(len(groups)), groups, rotation=30, ha="right", fontsize=8)
+    axes.set_ylabel("planning time per scene, ms")
+    axes.grid(axis="y", alpha=0.3)
+    axes.legend(fontsize=8)
+    axes.set_title("Planning time (fastest of the rounds per scene)")
+    save_png(figure, path)
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--dataset", default=str(DEFAULT))
     parser.add_argument("--scenes", type=int, default=50, help="generated scenes per object count")
-    parser.add_argument("--rounds", type=int, default=1, help="plan every scene this often, keep its fastest time")
+    parser.add_argument("--rounds", type=int, default=3, help="plan every scene this often, keep its fastest time")
+    parser.add_argument("--baseline", type=Path, help="a checkout with its own .venv to time beside this one")
     parser.add_argument("--json")
+    parser.add_argument("--png")
     args = parser.parse_args()
-    models = default_models()
-    report: dict = {"machine": f"{platform.processor() or platform.machine()}, {platform.python_version()}"}
-    dataset = Dataset(args.dataset, progress=False)
-    _, test = subject_splits(dataset.subjects, n_train=19, splits=1, seed=0)[0]
-    vr = [dataset.scene(r.key) for r in demonstration_records(dataset, test)]
-    report["vr_test_scenes"] = times(vr, models, args.rounds)
-    space = TaskSpace(vr[0])
-    feature_time = timeit.timeit(lambda: (gap_features(TaskSpace(vr[0])), object_features(TaskSpace(vr[0]))), number=300)
-    segment_time = timeit.timeit(lambda: segment_feature_matrix(space, space.nodes(1), space.nodes(2), mode="fixed"),
-                                 number=300)
-    report["features_per_scene_ms"] = {"task_space_gap_object": feature_time / 300 * 1e3,
-                                       "segment_grid_7x7": segment_time / 300 * 1e3}
-    for objects in (6, 12, 25, 50):
-        try:
-            scenes = [generate_scene("gen2", seed, objects) for seed in range(args.scenes)]
-        except HlpError as error:
-            report[f"gen2_{objects}"] = {"error": str(error)}
-            continue
-        report[f"gen2_{objects}"] = times(scenes, models, args.rounds) | {
-            "rows_mean": float(np.mean([len(TaskSpace(s).rows) for s in scenes]))}
-    for objects in (6, 12, 25, 50):
-        report[f"two_rows_{objects}"] = times([two_row_scene(objects, seed) for seed in range(args.scenes)], models,
-                                              args.rounds)
-    for name, value in report.items():
-        print(f"{name}: {value}")
-    print(table(report))
+    groups, failed = scene_groups(args.dataset, args.scenes)
+    pythons = {"this": sys.executable}
+    if args.baseline is not None:
+        pythons["baseline"] = str(args.baseline.resolve() / ".venv" / "bin" / "python")
+    report = {"machine": f"{platform.processor() or platform.machine()}, Python {platform.python_version()}",
+              "rounds": args.rounds, "baseline": str(args.baseline) if args.baseline else None,
+              "rows_mean": {g: float(np.mean([len(TaskSpace(s).rows) for s in scenes])) for g, scenes in groups.items()},
+              "not_generated": failed, "planners": time_rounds(groups, pythons, args.rounds)}
+    print(f"{'group':18s} {'rows':>5s}" + "".join(f" {n + ' median':>16s} {'p95':>7s} {'p99':>7s}" for n in pythons)
+          + ("   ratio" if len(pythons) > 1 else ""))
+    for g in groups:
+        line = f"{g:18s} {report['rows_mean'][g]:5.1f}"
+        for name in pythons:
+            t = report["planners"][name][g]
+            line += f" {t['median_ms']:13.2f} ms {t['p95_ms']:7.2f} {t['p99_ms']:7.2f}"
+        if len(pythons) > 1:
+            line += f"   {report['planners']['this'][g]['median_ms'] / report['planners']['baseline'][g]['median_ms']:.2f}"
+        print(line)
+    for g, reason in failed.items():
+        print(f"{g}: not generated ({reason})")
     if args.json:
         Path(args.json).write_text(json.dumps(report, indent=2) + "\n")
+    if args.png:
+        plot(report, args.png)
 
 
 if __name__ == "__main__":

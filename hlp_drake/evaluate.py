@@ -1,14 +1,20 @@
-"""``python -m hlp_drake.evaluate``: the paper's cross-subject evaluation (Table I), side by side.
+"""python -m hlp_drake.evaluate: how human-like the planner is on people it never saw, beside two baselines.
 
-    python -m hlp_drake.evaluate [--dataset PATH] [--splits 5] [--seed 0] [--protocol 80_20|num_subjects]
-        [--mode fixed|faithful] --json OUT [--predictions CSV] [--png CURVE.png]
+    python -m hlp_drake.evaluate [--dataset PATH] [--protocol 80_20|num_subjects|unstructured]
+        [--preset boosted|svm|paper] [--mode fixed|faithful] --json OUT [--csv ROWS.csv] [--png OUT.png]
+    python -m hlp_drake.evaluate --models DIR|bundled [--category unstructured|structured] --json OUT
+
+Protocols: 80_20 (the paper's Table I: random 19/5 subject splits of the structured trials);
+num_subjects (the learning curve over 3-23 training subjects); unstructured (folds of the
+participants who have unstructured trials, tested on those; trained in setting a on the other
+participants' structured trials only, in setting b on their structured and unstructured trials).
+With --models, no training: the given models (a directory, or the bundled ones) plan every
+successful trial of --category. Every result scores the planner and the two baselines (the gap
+nearest the start-target line; the majority decision) on the same rows.
 """
 
 from __future__ import annotations
 
-import csv
-import io
-import json
 import os
 import time
 from collections.abc import Sequence
@@ -18,117 +24,97 @@ from functools import partial
 
 from tqdm import tqdm
 
-from hlp_drake.atomic import write_text_atomic
 from hlp_drake.cli import add_quiet, make_parser, run_cli
 from hlp_drake.dataset.dataset import Dataset
-from hlp_drake.evaluation import METRICS, PAPER_TABLE_I, evaluate_split, subject_splits, summarise
+from hlp_drake.dataset.records import STRUCTURED, UNSTRUCTURED, category_of
+from hlp_drake.errors import HlpError
+from hlp_drake.evaluation import SETTINGS, evaluate_split, subject_splits, transfer_filter, transfer_folds
+from hlp_drake.evaluation.fixed_models import evaluate_models
+from hlp_drake.evaluation.report import write_report
 from hlp_drake.features import training_data
-from hlp_drake.learners import PRESETS
-from hlp_drake.plotting import new_figure, save_png
+from hlp_drake.learners import DEFAULT_PRESET, PRESETS, DecisionModels
+from hlp_drake.learners.bundled import default_models
 from hlp_drake.segmentation import DEFAULT_MODE, MODES, segment_dataset
 
 TRAIN_SIZES = (3, 7, 11, 15, 19, 23)
-LABELS = {"gap_accuracy": "Cg accuracy", "object_accuracy": "Co accuracy", "shlp": "sHLP",
-          "shlp_decision": "I(D)", "shlp_element": "I(E) (raw classifier labels)",
-          "shlp_element_plan": "I(E) (plan's element)"}
+PROTOCOLS = ("80_20", "num_subjects", "unstructured")
 
 
-def table(summary: dict) -> str:
-    lines = [f"{'metric':<30}{'ours (mean +- std)':>22}{'paper':>8}"]
-    for metric in METRICS:
-        paper = PAPER_TABLE_I.get(metric)
-        value = summary[metric]
-        lines.append(f"{LABELS[metric]:<30}{value['mean']:>13.3f} +- {value['std']:.3f}"
-                     f"{(f'{paper:.2f}' if paper is not None else '-'):>8}")
-    t = summary["planning_time_s"]
-    lines.append(f"planning time per scene: median {t['median'] * 1e3:.2f} ms, 95th percentile {t['p95'] * 1e3:.2f} ms")
-    return "\n".join(lines)
-
-
-def predictions_csv(results) -> str:
-    out = io.StringIO()
-    writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(["split", "subject", "trial", "row", "human_decision", "human_element", "hlp_decision",
-                     "hlp_element"])
-    for split, result in enumerate(results, start=1):
-        for outcome in result.outcomes:
-            subject, trial = outcome.key.split("/T")
-            for r in outcome.rows:
-                writer.writerow([split, subject, int(trial), r.row, r.human_decision, r.human_element,
-                                 r.hlp_decision, r.hlp_element])
-    return out.getvalue()
+def _jobs(args, subjects: list[str], unstructured_subjects: list[str]) -> list[tuple[str, list[str], list[str], str]]:
+    """(label, train subjects, test subjects, transfer setting) of every split or fold."""
+    if args.protocol == "80_20":
+        n = round(0.8 * len(subjects))
+        return [(f"{n}/{len(subjects) - n}", tr, te, "") for tr, te in
+                subject_splits(subjects, n_train=n, splits=args.splits, seed=args.seed)]
+    if args.protocol == "num_subjects":
+        return [(str(n), tr, te, "") for n in TRAIN_SIZES if n < len(subjects)
+                for tr, te in subject_splits(subjects, n_train=n, splits=args.splits, seed=args.seed)]
+    if len(unstructured_subjects) < args.folds:
+        raise HlpError(f"the unstructured protocol needs at least {args.folds} participants with unstructured "
+                       f"trials; the dataset has {len(unstructured_subjects)} (lay the unstructured archive over it)")
+    folds = transfer_folds(unstructured_subjects, folds=args.folds, seed=args.seed)
+    return [(setting, [s for s in subjects if s not in test], test, setting) for setting in args.settings
+            for test in folds]
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = make_parser("python -m hlp_drake.evaluate", __doc__)
-    parser.add_argument("--dataset", help="the archive or the unpacked dataset/ folder (default: $HLP_DATASET)")
-    parser.add_argument("--splits", type=int, default=5, help="random subject splits (default 5)")
+    parser.add_argument("--dataset", help="the dataset: archives or folders (default: $HLP_DATASET)")
+    parser.add_argument("--protocol", choices=PROTOCOLS, default="80_20")
+    parser.add_argument("--splits", type=int, default=5, help="random subject splits per size (default 5)")
+    parser.add_argument("--folds", type=int, default=4, help="participant folds of the unstructured protocol")
+    parser.add_argument("--settings", nargs="+", choices=sorted(SETTINGS), default=sorted(SETTINGS),
+                        help="the unstructured protocol's training settings (default: a b)")
     parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--protocol", choices=("80_20", "num_subjects"), default="80_20")
     parser.add_argument("--mode", choices=MODES, default=DEFAULT_MODE)
-    parser.add_argument("--preset", choices=sorted(PRESETS), default="strong")
+    parser.add_argument("--preset", choices=sorted(PRESETS), default=DEFAULT_PRESET)
+    parser.add_argument("--models", help="score these trained models (a directory, or 'bundled') instead of training")
+    parser.add_argument("--category", choices=(UNSTRUCTURED, STRUCTURED), default=UNSTRUCTURED,
+                        help="with --models: the trials to plan (default unstructured)")
     parser.add_argument("--json", required=True, help="write the figures here")
-    parser.add_argument("--predictions", help="CSV of every test trial's per-row decisions (80_20)")
-    parser.add_argument("--png", help="learning curve (num_subjects protocol)")
+    parser.add_argument("--csv", "--predictions", dest="csv", help="every scored row's decisions, per planner")
+    parser.add_argument("--png", help="a bar chart of the planners' scores")
     parser.add_argument("--workers", type=int, help="parallel splits (default: one per core)")
     add_quiet(parser)
     args = parser.parse_args(argv)
-    if args.splits < 1:
-        parser.error("--splits must be at least 1")
+    if args.splits < 1 or args.folds < 2:
+        parser.error("--splits must be at least 1 and --folds at least 2")
+    if args.protocol == "unstructured" and args.mode != "fixed":
+        parser.error("the unstructured protocol segments in fixed mode (faithful mode cannot read unstructured rows)")
     started = time.perf_counter()
+    models = None
+    if args.models:  # before any work: a missing or damaged model file is a usage error
+        models = default_models() if args.models == "bundled" else DecisionModels.load(args.models)
     dataset = Dataset(args.dataset, progress=not args.quiet)
-    segmentation = segment_dataset(dataset, mode=args.mode, progress=not args.quiet)
-    data = training_data(segmentation.demonstrations, mode=args.mode)
-    subjects = sorted({d.subject for d in segmentation.demonstrations})
-    settings = PRESETS[args.preset]
-    sizes = [round(0.8 * len(subjects))] if args.protocol == "80_20" else [n for n in TRAIN_SIZES if n < len(subjects)]
-    curve = {}
-    jobs = [(n, split) for n in sizes for split in subject_splits(subjects, n_train=n, splits=args.splits, seed=args.seed)]
-    results_by_size: dict[int, list] = {n: [] for n in sizes}
+    categories = (STRUCTURED, UNSTRUCTURED) if args.mode == "fixed" else (STRUCTURED,)
+    segmentation = segment_dataset(dataset, mode=args.mode, categories=categories, progress=not args.quiet)
+    demonstrations = segmentation.demonstrations
+    if models is not None:
+        results = {args.category: [evaluate_models(models, demonstrations, category=args.category)]}
+        return write_report(args, results, demonstrations, time.perf_counter() - started)
+    data = training_data(demonstrations, mode=args.mode)
+    subjects = sorted({d.subject for d in demonstrations})
+    structured = [d for d in demonstrations if category_of(d.trial) == STRUCTURED]
+    unstructured = [d for d in demonstrations if category_of(d.trial) == UNSTRUCTURED]
+    unstructured_subjects = sorted({d.subject for d in unstructured})
+    jobs = _jobs(args, subjects, unstructured_subjects)
     workers = max(1, min(args.workers or os.cpu_count() or 1, len(jobs)))
+    results: dict[str, list] = {}
     with ProcessPoolExecutor(workers) if workers > 1 else nullcontext() as pool:
-        run = partial(evaluate_split, data, segmentation.demonstrations, settings=settings)
-        futures = [(n, pool.submit(run, train, test) if pool else None, train, test) for n, (train, test) in jobs]
-        for n, future, train, test in tqdm(futures, desc=f"{args.protocol} splits ({workers} workers)", unit="split",
-                                           disable=args.quiet):
-            results_by_size[n].append(future.result() if future else run(train, test))
-    for n, results in results_by_size.items():
-        curve[n] = summarise(results)
-    elapsed = time.perf_counter() - started
-    report = {
-        "protocol": args.protocol, "mode": args.mode, "preset": args.preset, "splits": args.splits, "seed": args.seed,
-        "demonstrations": len(segmentation.demonstrations), "seconds": elapsed, "paper": PAPER_TABLE_I,
-    }
-    if args.protocol == "80_20":
-        summary = curve[sizes[0]]
-        report.update(summary)
-        report["splits_subjects"] = [{"train": r.train, "test": r.test} for r in results_by_size[sizes[0]]]
-        print(f"cross-subject evaluation, {args.splits} random {sizes[0]}/{len(subjects) - sizes[0]} splits "
-              f"(seed {args.seed}), {args.mode} mode, {args.preset} learners, {elapsed:.0f} s")
-        print(table(summary))
-        if args.predictions:
-            write_text_atomic(args.predictions, predictions_csv(results_by_size[sizes[0]]))
-    else:
-        report["curve"] = {str(n): s for n, s in curve.items()}
-        for n, s in curve.items():
-            print(f"{n:>2} training subjects: sHLP {s['shlp']['mean']:.3f} +- {s['shlp']['std']:.3f}, "
-                  f"Cg {s['gap_accuracy']['mean']:.3f}, Co {s['object_accuracy']['mean']:.3f}")
-        if args.png:
-            figure, axes = new_figure(6.5, 4.5)
-            for metric in ("shlp", "shlp_decision", "gap_accuracy", "object_accuracy"):
-                means = [curve[n][metric]["mean"] for n in sizes]
-                stds = [curve[n][metric]["std"] for n in sizes]
-                axes.errorbar(sizes, means, yerr=stds, marker="o", capsize=3, label=LABELS[metric])
-            axes.set_xlabel("training subjects")
-            axes.set_ylabel("score on the held-out subjects")
-            axes.set_ylim(0.0, 1.0)
-            axes.grid(alpha=0.3)
-            axes.legend(fontsize=8)
-            axes.set_title(f"Learning curve ({args.mode} mode, {args.splits} draws per size)")
-            save_png(figure, args.png)
-    write_text_atomic(args.json, json.dumps(report, indent=2) + "\n")
-    print(f"wrote {args.json}")
-    return 0
+        run = partial(_run, data, structured, unstructured, PRESETS[args.preset])
+        futures = [(job[0], pool.submit(run, *job[1:]) if pool else None, job) for job in jobs]
+        for label, future, job in tqdm(futures, desc=f"{args.protocol} ({workers} workers)", unit="split",
+                                       disable=args.quiet):
+            results.setdefault(label, []).append(future.result() if future else run(*job[1:]))
+    return write_report(args, results, demonstrations, time.perf_counter() - started)
+
+
+def _run(data, structured, unstructured, settings, train, test, setting):
+    """One split (Table I, learning curve) or fold (unstructured, ``setting``)."""
+    if setting:
+        return evaluate_split(data, unstructured, train, test, settings=settings,
+                              keep=transfer_filter(setting, test), setting=setting)
+    return evaluate_split(data, structured, train, test, settings=settings)
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 """``python -m hlp_drake.segment``: segment the VR demonstrations into per-row decisions.
 
-    python -m hlp_drake.segment [--dataset PATH] [--mode fixed|faithful] --out demos.csv
+    python -m hlp_drake.segment [--dataset PATH] [--mode fixed|faithful] [--category structured|unstructured]
+        --out demos.csv
     python -m hlp_drake.segment --trial sub_01/T050 --png OUT.png [--mode ...]
 """
 
@@ -10,11 +11,13 @@ import csv
 import io
 import json
 import time
+from collections import Counter
 from collections.abc import Sequence
 
 from hlp_drake.atomic import write_text_atomic
 from hlp_drake.cli import add_quiet, make_parser, run_cli
 from hlp_drake.dataset.dataset import Dataset
+from hlp_drake.dataset.records import STRUCTURED, UNSTRUCTURED
 from hlp_drake.errors import HlpError
 from hlp_drake.segmentation import (
     DEFAULT_MODE,
@@ -24,6 +27,7 @@ from hlp_drake.segmentation import (
     segment_dataset,
     segment_trial,
 )
+from hlp_drake.segmentation.batch import log_agreement
 from hlp_drake.segmentation.plot import save_segmentation_png
 
 CSV_COLUMNS = ("subject", "trial", "row", "decision", "element", "direction", "keypoints", "handedness")
@@ -41,11 +45,17 @@ def demonstrations_csv(result: SegmentationResult) -> str:
     return out.getvalue()
 
 
-def report(result: SegmentationResult, total: int, seconds: float) -> str:
+def report(result: SegmentationResult, total: int, seconds: float, category: str, agreement: float) -> str:
     kept = len(result.demonstrations)
-    lines = [f"kept {kept} of {total} successful structured trials ({result.mode} mode, {seconds:.1f} s)"]
-    flags = result.flag_counts()
-    lines.append("object-row flags: " + ", ".join(f"{list(k)} {v}" for k, v in sorted(flags.items())))
+    lines = [f"kept {kept} of {total} successful {category} trials ({result.mode} mode, {seconds:.1f} s)"]
+    if category == STRUCTURED:
+        flags = result.flag_counts()
+        lines.append("object-row flags: " + ", ".join(f"{list(k)} {v}" for k, v in sorted(flags.items())))
+    decisions = Counter(d.decision for demo in result.demonstrations for d in demo.decisions)
+    rows = Counter(len(demo.decisions) for demo in result.demonstrations)
+    lines.append("rows per trial: " + ", ".join(f"{k}: {v}" for k, v in sorted(rows.items()))
+                 + "; row decisions: " + ", ".join(f"{k} {v}" for k, v in sorted(decisions.items())))
+    lines.append(f"agreement with the interaction logs (first PickedUp obstacle per row): {agreement:.1%}")
     for reason, count in result.reasons().most_common():
         lines.append(f"rejected {count}: {reason}")
     return "\n".join(lines)
@@ -58,6 +68,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                         help="fixed: what the paper says (default); faithful: the released code, bugs included")
     parser.add_argument("--out", help="CSV of the per-row decisions of every kept trial")
     parser.add_argument("--json", help="also write the counts and every rejection as JSON")
+    parser.add_argument("--category", choices=(STRUCTURED, UNSTRUCTURED), default=STRUCTURED,
+                        help="the successful trials to segment (default structured; unstructured: fixed mode)")
     parser.add_argument("--trial", help="segment one trial, e.g. sub_01/T050 (with --png)")
     parser.add_argument("--png", help="picture of --trial's segmentation")
     add_quiet(parser)
@@ -66,6 +78,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.error("give --out CSV (all trials) or --trial KEY --png FILE (one trial)")
     if args.trial is not None and args.png is None:
         parser.error("--trial needs --png")
+    if args.category == UNSTRUCTURED and args.mode == "faithful":
+        parser.error("unstructured trials are segmented in fixed mode only (the released code reads two rows)")
     dataset = Dataset(args.dataset)
     if args.trial is not None:
         if args.trial not in dataset:
@@ -80,19 +94,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"wrote {args.png}")
         return 0
     started = time.perf_counter()
-    result = segment_dataset(dataset, mode=args.mode, progress=not args.quiet)
+    result = segment_dataset(dataset, mode=args.mode, categories=(args.category,), progress=not args.quiet)
     seconds = time.perf_counter() - started
+    agreement = log_agreement(dataset, result)
     total = len(result.demonstrations) + len(result.rejections)
     write_text_atomic(args.out, demonstrations_csv(result))
     if args.json:
         summary = {
-            "mode": result.mode, "trials": total, "kept": len(result.demonstrations),
+            "mode": result.mode, "category": args.category, "trials": total, "kept": len(result.demonstrations),
+            "log_agreement": agreement,
             "flags": {"".join(map(str, k)): v for k, v in sorted(result.flag_counts().items())},
             "rejection_reasons": dict(result.reasons()),
             "rejections": [{"trial": r.key, "reason": r.reason} for r in result.rejections],
         }
         write_text_atomic(args.json, json.dumps(summary, indent=2) + "\n")
-    print(report(result, total, seconds))
+    print(report(result, total, seconds, args.category, agreement))
     print(f"wrote {args.out}")
     return 0
 

@@ -27,7 +27,7 @@ class HlpPlannerSystem(LeafSystem):
     def __init__(self, *, models: DecisionModels | None = None, config: PlannerConfig | None = None) -> None:
         super().__init__()
         self._models = models or default_models()
-        self._config = config or PlannerConfig(mode=self._models.mode)
+        self._config = config or PlannerConfig(mode=self._models.mode_)
         self._scene_port = declare_scene_input_port(self)
         self._plan_port = self.DeclareAbstractOutputPort(
             name="plan",

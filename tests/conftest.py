@@ -12,7 +12,8 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
-DEFAULT_ARCHIVE = REPO.parent / "shared" / "data" / "hlp-vr-dataset.tar.xz"
+DEFAULT_DATA = REPO.parent / "shared" / "data"  # the structured archive and the unstructured part 1 beside it
+DEFAULT_ARCHIVE = DEFAULT_DATA / "hlp-vr-dataset.tar.xz"
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -46,20 +47,24 @@ def offline_drake(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def real_dataset_path() -> Path | None:
-    """HLP_DATASET if set, else the archive in ../shared/data, else None."""
+    """HLP_DATASET if set, else ../shared/data (its archives laid over each other), else None."""
     if os.environ.get("HLP_DATASET"):
         return Path(os.environ["HLP_DATASET"])
-    return DEFAULT_ARCHIVE if DEFAULT_ARCHIVE.exists() else None
+    return DEFAULT_DATA if DEFAULT_ARCHIVE.exists() else None
+
+
+def missing(message: str) -> None:
+    """Skip the test for missing data, or fail it under CI=true (where the data must be there)."""
+    if os.environ.get("CI", "").lower() == "true":
+        pytest.fail(f"{message}; it is required under CI")
+    pytest.skip(message)
 
 
 @pytest.fixture(scope="session")
 def dataset_path() -> Path:
     path = real_dataset_path()
     if path is None or not path.exists():
-        message = f"VR dataset not found (set HLP_DATASET or place it at {DEFAULT_ARCHIVE})"
-        if os.environ.get("CI", "").lower() == "true":
-            pytest.fail(f"{message}; it is required under CI")
-        pytest.skip(message)
+        missing(f"VR dataset not found (set HLP_DATASET or place it at {DEFAULT_ARCHIVE})")
     return path
 
 
@@ -68,6 +73,16 @@ def dataset(dataset_path: Path):
     from hlp_drake.dataset import Dataset
 
     return Dataset(dataset_path, progress=False)
+
+
+@pytest.fixture(scope="session")
+def unstructured(dataset):
+    """The dataset, which must hold unstructured trials (``hlp-vr-unstructured-part1.tar.xz``)."""
+    from hlp_drake.dataset import UNSTRUCTURED
+
+    if not dataset.select(category=UNSTRUCTURED):
+        missing(f"no unstructured trials in the dataset (place hlp-vr-unstructured-part1.tar.xz in {DEFAULT_DATA})")
+    return dataset
 
 
 def run_module(
@@ -83,3 +98,14 @@ def run_module(
         env={**os.environ, **(env or {})},
         timeout=600,
     )
+
+
+@pytest.fixture(scope="session")
+def paper_models(dataset):
+    """Paper-preset models (Algorithm 1: Cg, Co, Cc, Cd, Ra) fitted on every structured demonstration."""
+    from hlp_drake.features import training_data
+    from hlp_drake.learners import PRESETS, DecisionModels
+    from hlp_drake.segmentation import segment_dataset
+
+    demonstrations = segment_dataset(dataset, mode="fixed").demonstrations
+    return DecisionModels(PRESETS["paper"]).fit(training_data(demonstrations, mode="fixed"))

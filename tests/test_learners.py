@@ -3,13 +3,22 @@
 from __future__ import annotations
 
 import json
+import warnings
 
 import numpy as np
 import pytest
 from sklearn.base import clone
+from sklearn.exceptions import NotFittedError
+from sklearn.utils.estimator_checks import check_estimator
 
 from hlp_drake.errors import ModelError
-from hlp_drake.learners import ArmRegressor, DecisionModels, DirectionClassifier, RbfSvmClassifier
+from hlp_drake.learners import (
+    ArmRegressor,
+    DecisionModels,
+    DirectionClassifier,
+    RbfSvmClassifier,
+    RowChoiceClassifier,
+)
 from hlp_drake.learners.bundled import BUNDLED_DIRECTORY, default_models
 
 
@@ -46,20 +55,21 @@ def test_direction_classifier_and_arm_regressor_learn():
     free = rng.uniform(0, 1, (400, 8))
     label = np.argmax(free, axis=1)  # move towards the freest block
     X = np.column_stack([free, rng.integers(0, 8, 400), rng.integers(0, 8, 400)])
-    assert (DirectionClassifier().fit(X, label).predict(X) == label).mean() > 0.8
+    assert (DirectionClassifier(categorical=(8, 9)).fit(X, label).predict(X) == label).mean() > 0.8
     Xa = np.column_stack([rng.uniform(1, 2, (300, 2)), rng.normal(0, 0.3, (300, 2)), rng.integers(0, 8, 300)])
     ya = Xa[:, :2] + 0.5 * Xa[:, 2:4]
-    arm = ArmRegressor(max_samples=200).fit(Xa, ya)
+    arm = ArmRegressor(max_samples=200, categorical=(4,)).fit(Xa, ya)
     assert np.sqrt(((arm.predict(Xa) - ya) ** 2).mean()) < 0.05
 
 
 def test_bundled_models_load_and_round_trip(tmp_path):
     models = default_models()
-    assert models.mode == "fixed" and len(models.subjects) == 24
+    assert models.mode_ == "fixed" and len(models.subjects_) == 24 and models.planner == "rows"
     saved = models.save(tmp_path / "copy")
     again = DecisionModels.load(saved)
-    X = np.random.default_rng(0).uniform(0, 1, (5, 5))
-    assert again.gap.decision_function(X) == pytest.approx(models.gap.decision_function(X))
+    X = np.random.default_rng(0).uniform(0, 3, (5, models.row.n_features_in_))
+    assert again.row.predict_proba(X) == pytest.approx(models.row.predict_proba(X))
+    assert again.row.novelty(X) == pytest.approx(models.row.novelty(X))
 
 
 def test_tampered_or_foreign_model_files_are_refused(tmp_path):
@@ -79,3 +89,44 @@ def test_tampered_or_foreign_model_files_are_refused(tmp_path):
     with pytest.raises(ModelError, match="model file not found"):
         DecisionModels.load(tmp_path / "nowhere")
     assert (BUNDLED_DIRECTORY / "models.json").is_file()
+
+
+# Refitting with weights equals refitting on repeated rows only where no fold or resampling sees the
+# rows: the cross-validated calibration and the SVM's minority oversampling draw from the rows.
+SAMPLE_WEIGHT_CHECK = {"check_sample_weight_equivalence_on_dense_data":
+                       "calibration folds and class oversampling are drawn from the rows, not the weights"}
+
+
+@pytest.mark.parametrize("estimator", [
+    RowChoiceClassifier(n_estimators=20, novelty_samples=200),
+    RowChoiceClassifier(learner="svm", novelty_samples=200),
+    RbfSvmClassifier(),
+    DirectionClassifier(),
+    ArmRegressor(max_samples=200),
+], ids=["row-boosted", "row-svm", "rbf-svm", "direction", "arm"])
+def test_scikit_learn_conformance(estimator):
+    expected = SAMPLE_WEIGHT_CHECK if isinstance(estimator, (RowChoiceClassifier, RbfSvmClassifier)) else {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        results = check_estimator(estimator, expected_failed_checks=expected, on_fail=None)
+    failed = [r["check_name"] for r in results if r["status"] == "failed"]
+    assert failed == []
+    assert {r["check_name"] for r in results if r["status"] == "xfail"} <= set(expected)
+
+
+def test_row_choice_trees_calibration_and_novelty():
+    from sklearn.ensemble import GradientBoostingClassifier
+
+    X, y = _blobs(600)
+    model = RowChoiceClassifier(n_estimators=50, subsample=1.0).fit(X, y)
+    reference = GradientBoostingClassifier(n_estimators=50, max_depth=3, learning_rate=0.1, random_state=0).fit(X, y)
+    assert model.decision_function(X) == pytest.approx(reference.decision_function(X))  # the trees as arrays
+    p = model.predict_proba(X)[:, 1]
+    assert abs(p.mean() - y.mean()) < 0.02 and (model.predict(X) == y).mean() > 0.95  # calibrated on held-out folds
+    assert np.mean(model.novelty(X) <= 1.0) > 0.97  # the demonstrations lie within their own range
+    assert np.all(model.novelty(X[:10] + 10.0) > 1.0)  # far away: outside it
+    state = model.get_state()
+    again = RowChoiceClassifier(n_estimators=50).set_state(state)
+    assert again.predict_proba(X) == pytest.approx(model.predict_proba(X))
+    with pytest.raises(NotFittedError):
+        RowChoiceClassifier().predict(X)

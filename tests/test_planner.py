@@ -1,4 +1,4 @@
-"""The human-like planner on generated scenes with the bundled models."""
+"""The paper's planner (Algorithm 1, paper-preset models) on generated scenes; bad scenes for both planners."""
 
 from __future__ import annotations
 
@@ -14,10 +14,11 @@ from hlp_drake.taskspace import TaskSpace
 
 
 @pytest.fixture(scope="module")
-def models():
-    return default_models()
+def models(paper_models):
+    return paper_models
 
 
+@pytest.mark.dataset
 @pytest.mark.parametrize("kind", ["vr", "gen1", "gen2"])
 def test_plans_pass_every_row_and_end_at_the_target(models, kind):
     scene = generate_scene(kind, 3)
@@ -36,12 +37,15 @@ def test_plans_pass_every_row_and_end_at_the_target(models, kind):
     assert all(result.expected_collision <= c.expected_collision for c in result.alternatives)
 
 
+@pytest.mark.dataset
 def test_the_same_scene_gives_the_same_plan(models):
     scene = generate_scene("gen1", 8)
     assert plan(scene, models).to_dict()["keypoints"] == plan(scene, models).to_dict()["keypoints"]
 
 
-def test_bad_scenes_give_a_reason_not_an_exception(models):
+@pytest.mark.parametrize("planner", ["rows", "paper"])
+def test_bad_scenes_give_a_reason_not_an_exception(planner, request):
+    models = default_models() if planner == "rows" else request.getfixturevalue("paper_models")
     scene = generate_scene("vr", 1)
     off = replace(scene, obstacles=(replace(scene.obstacles[0], y=5.0), *scene.obstacles[1:]))
     result = plan(off, models)
@@ -54,6 +58,7 @@ def test_bad_scenes_give_a_reason_not_an_exception(models):
     assert not mismatch.ok and "fixed mode" in mismatch.reason
 
 
+@pytest.mark.dataset
 def test_rows_the_classifiers_know_nothing_about_keep_what_lies_nearest_the_reach(models):
     """Gen II scenes lie outside the demonstrations: Cg and Co score (almost) every candidate with
     their intercept. Such a row keeps the gap and the obstacle nearest the start-target line, not

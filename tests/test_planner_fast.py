@@ -25,13 +25,13 @@ from hlp_drake.planner.blas import single_blas_thread
 from hlp_drake.planner.candidates import nearest_per_row
 from hlp_drake.planner.human_arm import sweep_collision
 from hlp_drake.planner.plan import PlanKeypoint
-from hlp_drake.taskspace.relocation import relocated, relocated_array
 from hlp_drake.planner.rollout import PrefixTree
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.geometry import footprint, overlapping_bounds
 from hlp_drake.scene.validation import AREA_TOLERANCE, scene_problems
 from hlp_drake.taskspace import DIRECTIONS, Rect, TaskSpace
 from hlp_drake.taskspace.band import convex_rect_overlap
+from hlp_drake.taskspace.relocation import relocated, relocated_array
 
 
 @pytest.fixture(scope="module")

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 import yaml
 from conftest import run_module
+from human_plans import GEN1_19, GEN1_27, GEN2_9_12, GEN2_9_39, GEN2_9_39_NEXT, human_plan
 
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.planner import plan
@@ -70,7 +71,7 @@ def test_push_transfer_puts_the_tcp_behind_the_obstacle():
 
 def test_robot_alternatives_are_the_next_distinct_candidates_in_rank_order():
     scene = generate_scene("gen2", 39, 9)
-    human = plan(scene, default_models())
+    human = human_plan(scene, GEN2_9_39, GEN2_9_39_NEXT)
     chosen = robot_plan(human, scene, RULES)
     candidates = [
         robot_plan(replace(human, keypoints=c.keypoints), scene, RULES).keypoints for c in human.alternatives
@@ -264,7 +265,7 @@ def test_a_push_with_no_room_to_move_the_obstacle_is_left_out():
     # so the robot plan leaves it out and keeps the second.
     scene = generate_scene("gen1", 27)
     space = TaskSpace(scene)
-    human = plan(scene, default_models())
+    human = human_plan(scene, GEN1_27)
     robot = robot_plan(human, scene, RULES)
     moves = [(k.element, k.direction) for k in human.keypoints if k.action == "move"]
     assert moves == [("FailOnTouchObstacleMed", "BL"), ("FailOnTouchObstacleLong-1", "RR")]
@@ -466,7 +467,7 @@ def test_a_way_that_would_pass_over_an_object_goes_over_it():
     # sweep the gripper through obstacle_5 at push height; the robot plan goes over it instead.
     scene = generate_scene("gen2", 12, 9)
     space = TaskSpace(scene)
-    keypoints = robot_plan(plan(scene, default_models()), scene, RULES).keypoints
+    keypoints = robot_plan(human_plan(scene, GEN2_9_12), scene, RULES).keypoints
     i = next(i for i, k in enumerate(keypoints) if k.action == "release" and k.element == "obstacle_4")
     release, up, over, gap = keypoints[i : i + 4]
     assert crosses(RULES, release.position, gap.position, [space.rects["obstacle_5"]])
@@ -484,7 +485,7 @@ def test_a_push_that_would_leave_the_obstacle_in_the_way_goes_another_way():
     # forwards it would end up across the way to the target (and shove the target off the table).
     scene = generate_scene("gen1", 19)
     space = TaskSpace(scene)
-    human = plan(scene, default_models())
+    human = human_plan(scene, GEN1_19)
     i = next(i for i, k in enumerate(human.keypoints) if k.action == "move")
     move, rest = human.keypoints[i], human.keypoints[i + 1 :]
     assert (move.element, move.direction) == ("FailOnTouchObstacleLong-1", "FF")

@@ -10,7 +10,7 @@ import pytest
 
 from hlp_drake.features import training_data
 from hlp_drake.segmentation import Rejected, segment_dataset, segment_trial
-from hlp_drake.taskspace import TaskSpace
+from hlp_drake.segmentation.batch import log_agreement
 
 pytestmark = pytest.mark.dataset
 
@@ -23,21 +23,6 @@ def faithful(dataset):
 @pytest.fixture(scope="module")
 def fixed(dataset):
     return segment_dataset(dataset, mode="fixed")
-
-
-def _picked_up_agreement(dataset, result) -> float:
-    """Share of rows whose decision and element match the log's first PickedUp obstacle of that row."""
-    agree = total = 0
-    for demo in result.demonstrations:
-        row_of = {n: row.index for row in TaskSpace(demo.scene).rows for n in row.members}
-        first: dict[int, str] = {}
-        for event in dataset.trial(demo.key).interactions:
-            if event.kind == "PickedUp" and event.non_dominant in row_of:
-                first.setdefault(row_of[event.non_dominant], event.non_dominant)
-        for d in demo.decisions:
-            total += 1
-            agree += (d.decision == "object") == (d.row in first) and (d.row not in first or first[d.row] == d.obstacle)
-    return agree / total
 
 
 def test_faithful_mode_reproduces_the_reference_counts(faithful):
@@ -68,8 +53,8 @@ def test_fixed_mode_labels_directions_from_the_displacement(fixed):
 
 
 def test_decisions_agree_with_the_interaction_log(dataset, faithful, fixed):
-    assert _picked_up_agreement(dataset, faithful) >= 0.97
-    assert _picked_up_agreement(dataset, fixed) >= 0.97
+    assert log_agreement(dataset, faithful) >= 0.97
+    assert log_agreement(dataset, fixed) >= 0.97
 
 
 def test_left_handers_are_mirrored_in_fixed_mode(fixed, faithful):

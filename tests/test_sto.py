@@ -8,6 +8,7 @@ import re
 
 import numpy as np
 import pytest
+from human_plans import GEN1_15, GEN2_9_39, GEN2_9_39_NEXT, chain_first_rollout, human_plan, plan_chain
 from pydrake.trajectories import PiecewisePolynomial
 
 from hlp_drake.run_scene import DEFAULT_SCENE
@@ -17,7 +18,7 @@ from hlp_drake.scene.model import SceneObject
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser import mppi_weights, optimise, sample_base_noise
 from hlp_drake.systems.optimiser_system import StochasticTrajectoryOptimiser
-from hlp_drake.systems.planning_diagram import first_rollout, make_planning_diagram
+from hlp_drake.systems.planning_diagram import make_planning_diagram
 from hlp_drake.systems.rollout_cost import BLOWN_UP_COST, RolloutSamples, rollout_cost
 from hlp_drake.systems.rollout_pool import RolloutPool
 from hlp_drake.systems.rollout_world import RolloutWorld
@@ -183,34 +184,34 @@ def test_a_gripper_closed_among_the_obstacles_does_not_carry_one_into_the_target
     (FailOnTouchObstacleShort) and carry it through both rows into the target, which falls off
     the table; closed there, the same plan passes at its first rollout."""
     scene = generate_scene("gen1", 15)
-    closed = first_rollout(on(scene))
+    person = human_plan(scene, GEN1_15)
+    closed = chain_first_rollout(on(scene), person)
     assert closed.success, closed.failure_reason
-    opened = first_rollout(on(scene, "motion: {closed_among_obstacles: false}"))
+    opened = chain_first_rollout(on(scene, "motion: {closed_among_obstacles: false}"), person)
     assert not opened.success and opened.fallen == ("Target",), opened.failure_reason
 
 
 def test_where_the_hlps_plan_fails_at_its_first_rollout_its_next_candidates_are_tried():
-    """Gen II seed 39, 9 objects: the chosen plan's way to a push start runs through the pushed
-    obstacle and knocks another off the table; of the next three distinct candidate plans, the
-    second passes at its first rollout. The straight line has no candidates to try."""
+    """Gen II seed 39, 9 objects, the previous release's plan: its way to a push start runs through
+    the pushed obstacle and knocks another off the table; of the next three distinct candidate
+    plans, the second passes at its first rollout. The straight line has no candidates to try."""
     scene = generate_scene("gen2", 39, 9)
     config = on(scene, "optimiser: {max_iterations: 1, samples: 2}")
-    results = {}
+    person = human_plan(scene, GEN2_9_39, GEN2_9_39_NEXT)
     with RolloutPool(1) as pool:
-        for planner in ("hlp", "sto"):
-            diagram = make_planning_diagram(config.updated(f"planner: {{kind: {planner}}}"), pool=pool)
-            context = diagram.CreateDefaultContext()
-            diagram.GetInputPort("scene").FixValue(context, scene)
-            transfer = diagram.GetSubsystemByName("robot_plan_transfer")
-            alternatives = transfer.GetOutputPort("robot_alternatives").Eval(
-                transfer.GetMyContextFromRoot(context)
-            )
-            results[planner] = (len(alternatives), diagram.GetOutputPort("optimisation").Eval(context))
-    count, hlp = results["hlp"]
+        diagram = plan_chain(config, person, pool)
+        context = diagram.CreateDefaultContext()
+        transfer = diagram.GetSubsystemByName("robot_plan_transfer")
+        count = len(transfer.GetOutputPort("robot_alternatives").Eval(transfer.GetMyContextFromRoot(context)))
+        hlp = diagram.GetOutputPort("optimisation").Eval(context)
+        sto = make_planning_diagram(config.updated("planner: {kind: sto}"), pool=pool)
+        sto_context = sto.CreateDefaultContext()
+        sto.GetInputPort("scene").FixValue(sto_context, scene)
+        straight = sto.GetOutputPort("optimisation").Eval(sto_context)
     assert count == 3
     assert hlp.success and hlp.start == 2 and hlp.iterations == 0 and hlp.rollouts == 1 + 3
-    assert "fell off the table" in first_rollout(config).failure_reason
-    assert results["sto"][0] == 0 and results["sto"][1].start == 0
+    assert "fell off the table" in chain_first_rollout(config, person).failure_reason
+    assert straight.start == 0
 
 
 def test_holding_still_fails_with_the_goal_cost(world, scene):

@@ -20,7 +20,7 @@ from tqdm import tqdm
 from hlp_drake.dataset.records import STRUCTURED, category_of
 from hlp_drake.evaluation.baselines import BASELINES, majority_plan, nearest_gap_plan
 from hlp_drake.evaluation.metrics import TrialOutcome, score_trial
-from hlp_drake.features.training import TrainingData
+from hlp_drake.features.training import LabelledSet, TrainingData
 from hlp_drake.learners.models import DecisionModels, LearnerSettings
 from hlp_drake.planner import PlannerConfig, plan
 from hlp_drake.segmentation.demonstration import GAP, OBJECT, Demonstration
@@ -89,6 +89,7 @@ class SplitResult:
     outcomes: list[TrialOutcome]
     baselines: dict[str, list[TrialOutcome]] = field(default_factory=dict)
     setting: str = ""
+    calibration: dict[str, float] = field(default_factory=dict)
 
     def metrics(self, planner: str = "hlp") -> dict[str, float]:
         return metrics_of(self.outcomes if planner == "hlp" else self.baselines[planner])
@@ -117,18 +118,43 @@ def evaluate_split(data: TrainingData, demonstrations: Sequence[Demonstration], 
     """
     training = data.where(keep) if keep is not None else data.subset(train)
     models = DecisionModels(settings).fit(training)
-    config = config or PlannerConfig(mode=data.mode)
-    faithful = is_faithful(data.mode)
-    majority = _majority(training)
     tests = [d for d in demonstrations if d.subject in test]
+    outcomes, baselines = score_plans(models, tests, _majority(training), config=config, progress=progress)
+    tested = {d.key for d in tests}
+    held_out = data.where(lambda key: key in tested).row
+    return SplitResult(train, test, outcomes, baselines, setting, calibration(models, held_out))
+
+
+def calibration(models: DecisionModels, rows: LabelledSet, bins: int = 10) -> dict[str, float]:
+    """How well Cr's probabilities match how often people took the candidates of ``rows``: the
+    expected calibration error (``bins`` equal-width bins) and the Brier score; the share of
+    candidates within the demonstrations' range (novelty <= 1). Empty for the paper's planner."""
+    if models.planner != "rows" or len(rows) == 0:
+        return {}
+    p = models.row.predict_proba(rows.X)[:, 1]
+    taken = rows.y > 0
+    which = np.minimum((p * bins).astype(int), bins - 1)
+    gap = sum(abs(p[which == b].mean() - taken[which == b].mean()) * np.mean(which == b)
+              for b in range(bins) if np.any(which == b))
+    return {"ece": float(gap), "brier": float(np.mean((p - taken) ** 2)),
+            "in_distribution": float(np.mean(models.row.novelty(rows.X) <= 1.0))}
+
+
+def score_plans(models: DecisionModels, demonstrations: Sequence[Demonstration], majority: str, *,
+                config: PlannerConfig | None = None,
+                progress: bool = False) -> tuple[list[TrialOutcome], dict[str, list[TrialOutcome]]]:
+    """Plan every demonstration's scene with ``models`` (the person's own arm at the start) and
+    with the baselines (``majority``: the majority decision), and score each against the person."""
+    config = config or PlannerConfig(mode=models.mode_)
+    faithful = is_faithful(models.mode_)
     outcomes, baselines = [], {name: [] for name in BASELINES}
-    for demo in tqdm(tests, desc="planning test scenes", unit="scene", leave=False, disable=not progress):
+    for demo in tqdm(demonstrations, desc="planning test scenes", unit="scene", leave=False, disable=not progress):
         lengths = (demo.link_lengths.upper_arm, demo.link_lengths.forearm)
         result = plan(demo.scene, models, config, start_arm=demo.keypoints[0].arm, link_lengths=lengths)
         outcomes.append(score_trial(demo, result, faithful=faithful))
         baselines["nearest_gap"].append(score_trial(demo, nearest_gap_plan(demo.scene), faithful=faithful))
         baselines["majority"].append(score_trial(demo, majority_plan(demo.scene, majority), faithful=faithful))
-    return SplitResult(train, test, outcomes, baselines, setting)
+    return outcomes, baselines
 
 
 def summarise(results: Sequence[SplitResult], planner: str = "hlp") -> dict[str, dict[str, float]]:
@@ -137,6 +163,10 @@ def summarise(results: Sequence[SplitResult], planner: str = "hlp") -> dict[str,
     per_split = [r.metrics(planner) for r in results]
     summary = {m: {"mean": float(np.mean([s[m] for s in per_split])), "std": float(np.std([s[m] for s in per_split]))}
                for m in METRICS}
+    for key in ("ece", "brier", "in_distribution"):
+        values = [r.calibration[key] for r in results if key in r.calibration]
+        if values and planner == "hlp":
+            summary[f"row_{key}"] = {"mean": float(np.mean(values)), "std": float(np.std(values))}
     times = np.array([o.planning_time_s for r in results for o in r.outcomes])
     summary["planning_time_s"] = {"median": float(np.median(times)), "p95": float(np.percentile(times, 95)),
                                   "p99": float(np.percentile(times, 99))}

@@ -18,8 +18,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hlp_drake.taskspace import TaskSpace, block_array, free_fractions
-from hlp_drake.taskspace.routes import FreeRoutes, segment_hits, segment_inside
+from hlp_drake.taskspace import TaskSpace, block_array, free_fractions, rect_array
+from hlp_drake.taskspace.model import table_walls
+from hlp_drake.taskspace.routes import FreeRoutes, segment_inside
 
 HUMAN_HAND_WIDTH = 0.05  # m: the VR study's hand (the original's hand_width)
 CAP = 10.0  # lengths in hand widths saturate here: a gap ten hands wide is as open as a wider one
@@ -29,7 +30,8 @@ ROW_CHOICE_FEATURES = (
     "at_table_edge", "corridor_overlap", "free_space", "free_sideways", "approach_collision",
     "route_via", "route_gain",
     "row_best_offset", "row_best_angle", "row_best_width", "row_corridor_block", "row_members", "progress",
-    "route_detour", "next_best_offset", "next_corridor_block",
+    "route_detour", "next_best_offset", "next_corridor_block", "ahead", "distance",
+    "target_offset", "target_beyond",
 )  # fmt: skip
 
 
@@ -88,20 +90,27 @@ def _corridor_overlap(y_min: np.ndarray, y_max: np.ndarray, line: np.ndarray, wi
 
 @dataclass(frozen=True, eq=False)
 class _RowGeometry:
-    """What a row offers, whoever looks at it: its gaps and its obstacles, left to right."""
+    """What a row offers, whoever looks at it: its gaps and its obstacles, left to right, and the
+    obstacles' free space (in the scene as it was set up)."""
 
     x: float
     gap_rows: np.ndarray  # positions in the gap table
     gaps: np.ndarray  # (G, 4)
+    at_edge: np.ndarray  # (G,) whether a gap is bounded by the table's edge
     members: np.ndarray  # obstacle positions in scene order
     obstacles: np.ndarray  # (M, 4)
+    free: np.ndarray  # (M, 8) free fractions of the obstacles' direction blocks
 
     @classmethod
-    def of(cls, space: TaskSpace, row: int) -> _RowGeometry:
+    def of(cls, space: TaskSpace, row: int, free: np.ndarray) -> _RowGeometry:
+        """Row ``row`` of ``space``; ``free``: every obstacle's free fractions (``free_space``)."""
         r = space.rows[row - 1]
-        gap_rows = np.flatnonzero(space.gap_table.row == row)
+        table = space.gap_table
+        gap_rows = np.flatnonzero(table.row == row)
+        at_edge = np.array([table.left[k] is None or table.right[k] is None for k in gap_rows], dtype=float)
         members = np.array([space.obstacle_index[n] for n in r.members], dtype=int)
-        return cls(r.x, gap_rows, space.gap_table.bounds[gap_rows], members, space.obstacle_bounds[members])
+        return cls(r.x, gap_rows, table.bounds[gap_rows], at_edge, members, space.obstacle_bounds[members],
+                   free[members].reshape(-1, 8))
 
     def best(self, hands: np.ndarray, goal: np.ndarray, width: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per hand (..., 2): (the smallest offset of a gap where the hand fits, that gap's width,
@@ -113,129 +122,179 @@ class _RowGeometry:
         if not open_.any():
             return np.full(line.shape[:-1], CAP * width), np.zeros(line.shape[:-1]), block
         offsets = np.abs(_passage(self.gaps[open_, 1], self.gaps[open_, 3], line, width) - line)
-        best = np.argmin(offsets, axis=-1)
-        return np.take_along_axis(offsets, best[..., None], -1)[..., 0], widths[open_][best], block
+        return offsets.min(axis=-1), widths[open_][np.argmin(offsets, axis=-1)], block
 
 
-def row_candidates(space: TaskSpace, row: int, hands: np.ndarray, goal: np.ndarray, *, hand_width: float,
-                   routes: FreeRoutes, removed: Sequence[Collection[int]] | None = None, mirror: bool = False,
-                   limit: int | None = None) -> list[RowCandidates]:
-    """The candidates of ``row`` and their features Xr, for each hand of ``hands`` heading for ``goal``.
+def free_space(space: TaskSpace) -> np.ndarray:
+    """(n, 8) the free fraction of each obstacle's eight direction blocks in the scene as set up:
+    the other obstacles and the target occlude, and so does everything off the table, however far
+    a block reaches past its edge (walls as thick as the table's diagonal)."""
+    walls = rect_array(list(table_walls(space.scene.table.bounds, space.scene.table.diagonal).values()))
+    occluders = np.vstack([space.obstacle_bounds, rect_array([space.target]), walls])
+    return free_fractions(block_array(space.obstacle_bounds, space.alpha), occluders).reshape(-1, 8)
+
+
+def _nearest(geometry: _RowGeometry, lines: np.ndarray, width: float,
+             limit: int | None) -> tuple[list[set[int]], list[set[int]]]:
+    """Per hand (its line's lateral position at the row): the row's gaps and obstacles to describe,
+    the ``limit`` of each kind laterally nearest the line (all if None)."""
+    gaps, obstacles = len(geometry.gaps), len(geometry.obstacles)
+    if limit is None or (gaps <= limit and obstacles <= limit):
+        return [set(range(gaps))] * len(lines), [set(range(obstacles))] * len(lines)
+    gb, ob = geometry.gaps, geometry.obstacles
+    gap_offset = np.abs(_passage(gb[:, 1], gb[:, 3], lines[:, None], width) - lines[:, None])
+    obj_offset = np.abs((ob[:, 1] + ob[:, 3])[None] / 2.0 - lines[:, None])
+    return ([set(np.argsort(o, kind="stable")[:limit].tolist()) for o in gap_offset],
+            [set(np.argsort(o, kind="stable")[:limit].tolist()) for o in obj_offset])
+
+
+class RowChoiceScene:
+    """The row-choice features of one scene for a hand of one width (``candidates``), with what
+    every row and every hand position share computed once: the rows' geometry and the route graph.
 
     Args:
         space: the scene's task space.
-        row: the row index (from 1).
-        hands: (B, 2) planar hand positions, m (one plan each); goal: (2,).
         hand_width: the hand's (gripper's) width, m; lengths are measured in it.
-        routes: the scene's ``FreeRoutes`` for the same hand width.
-        removed: per hand, the obstacles (scene order) moved earlier on its way: no longer
-            where they stood (they are of earlier rows).
-        mirror: describe a left arm as its mirror image (lateral signs swapped), so one model
-            serves both arms (the planner models a right arm).
-        limit: keep only this many gaps and this many obstacles, those laterally nearest each
-            hand's line (all if None).
-
-    Returns:
-        One ``RowCandidates`` per hand.
+        route_obstacles: the route graph holds at most this many obstacles, those nearest the
+            straight line from the start to the target (so its cost does not grow with a crowded
+            table's far corners).
     """
-    hands, goal = np.asarray(hands, float).reshape(-1, 2), np.asarray(goal, float)
-    removed = [frozenset(r) for r in removed] if removed is not None else [frozenset()] * len(hands)
-    w = hand_width
-    geometry = _RowGeometry.of(space, row)
-    gb, ob = geometry.gaps, geometry.obstacles
-    n_gaps, n_obj = len(gb), len(ob)
-    n = n_gaps + n_obj
-    line = line_at(hands, goal, geometry.x)  # (B,)
-    points = np.empty((len(hands), n, 2))
-    points[:, :n_gaps, 0] = geometry.x
-    points[:, :n_gaps, 1] = _passage(gb[:, 1], gb[:, 3], line[:, None], w)
-    points[:, n_gaps:] = np.column_stack([(ob[:, 0] + ob[:, 2]) / 2.0, (ob[:, 1] + ob[:, 3]) / 2.0])[None]
-    lateral = points[..., 1] - line[:, None]
-    depth = np.maximum(geometry.x - hands[:, 0], w / 2.0)[:, None]
-    best_offset, best_width, block = geometry.best(hands, goal, w)
 
-    X = np.zeros((len(hands), n, len(ROW_CHOICE_FEATURES)))
-    X[:, n_gaps:, 0] = 1.0
-    X[:, :, 1] = np.minimum(np.concatenate([gb[:, 3] - gb[:, 1], ob[:, 3] - ob[:, 1]]) / w, CAP)
-    X[:, n_gaps:, 2] = np.minimum((ob[:, 2] - ob[:, 0]) / w, CAP)
-    X[:, :, 3] = np.minimum(np.abs(lateral) / w, CAP)
-    X[:, :, 4] = np.clip((-1.0 if mirror else 1.0) * lateral / w, -CAP, CAP)
-    X[:, :, 5] = np.arctan2(np.abs(lateral), depth)
-    X[:, :n_gaps, 6] = np.minimum(np.maximum(np.abs(lateral[:, :n_gaps]) - best_offset[:, None], 0.0) / w, CAP)
-    table = space.gap_table
-    X[:, :n_gaps, 7] = [float(table.left[k] is None or table.right[k] is None) for k in geometry.gap_rows]
-    X[:, n_gaps:, 8] = np.minimum(_corridor_overlap(ob[:, 1], ob[:, 3], line[:, None], w) / w, CAP)
-    X[:, :n_gaps, 9:11] = 1.0
-    if n_obj:
-        free = free_fractions(block_array(ob, space.alpha), space.occluder_bounds(target=True))
+    def __init__(self, space: TaskSpace, hand_width: float, *, route_obstacles: int = 16) -> None:
+        self.space, self.width = space, hand_width
+        self.goal = np.asarray(space.target.center, float)
+        start, centres = np.asarray(space.scene.start, float), space.obstacle_centres
+        span = self.goal - start
+        offset = np.abs(span[0] * (centres[:, 1] - start[1]) - span[1] * (centres[:, 0] - start[0]))  # ~ distance
+        ids = np.sort(np.argsort(offset, kind="stable")[:route_obstacles])
+        self.routes = FreeRoutes(space.obstacle_bounds[ids], ids, space.scene.table.bounds, hand_width, self.goal)
+        self._free = free_space(space)
+        self._rows: dict[int, _RowGeometry] = {}
+
+    def row(self, index: int) -> _RowGeometry:
+        if index not in self._rows:
+            self._rows[index] = _RowGeometry.of(self.space, index, self._free)
+        return self._rows[index]
+
+    def candidates(self, row: int, hands: np.ndarray, removed: Sequence[Collection[int]] | None = None, *,
+                   mirror: bool = False, limit: int | None = None) -> list[RowCandidates]:
+        """The candidates of ``row`` and their features Xr, for each hand of ``hands`` heading for
+        the target.
+
+        Args:
+            row: the row index (from 1).
+            hands: (B, 2) planar hand positions, m (one plan each).
+            removed: per hand, the obstacles (scene order) moved earlier on its way: no longer
+                where they stood (they are of earlier rows).
+            mirror: describe a left arm as its mirror image (lateral signs swapped), so one model
+                serves both arms (the planner models a right arm).
+            limit: keep only this many gaps and this many obstacles, those laterally nearest each
+                hand's line (all if None).
+
+        Returns:
+            One ``RowCandidates`` per hand.
+        """
+        hands = np.asarray(hands, float).reshape(-1, 2)
+        removed = [frozenset(r) for r in removed] if removed is not None else [frozenset()] * len(hands)
+        w, goal, geometry = self.width, self.goal, self.row(row)
+        line = line_at(hands, goal, geometry.x)  # (B,)
+        gap_keep, obj_keep = _nearest(geometry, line, w, limit)  # per hand, positions in the row
+        gap_union, obj_union = sorted(set().union(*gap_keep)), sorted(set().union(*obj_keep))
+        gb, ob = geometry.gaps[gap_union], geometry.obstacles[obj_union]
+        members, free = geometry.members[obj_union], geometry.free[obj_union]
+        n_gaps, n_obj = len(gb), len(ob)
+        n = n_gaps + n_obj
+        points = np.empty((len(hands), n, 2))
+        points[:, :n_gaps, 0] = geometry.x
+        points[:, :n_gaps, 1] = _passage(gb[:, 1], gb[:, 3], line[:, None], w)
+        points[:, n_gaps:] = np.column_stack([(ob[:, 0] + ob[:, 2]) / 2.0, (ob[:, 1] + ob[:, 3]) / 2.0])[None]
+        lateral = points[..., 1] - line[:, None]
+        depth = np.maximum(geometry.x - hands[:, 0], w / 2.0)[:, None]
+        best_offset, best_width, block = geometry.best(hands, goal, w)
+
+        X = np.zeros((len(hands), n, len(ROW_CHOICE_FEATURES)))
+        X[:, n_gaps:, 0] = 1.0
+        X[:, :, 1] = np.minimum(np.concatenate([gb[:, 3] - gb[:, 1], ob[:, 3] - ob[:, 1]]) / w, CAP)
+        X[:, n_gaps:, 2] = np.minimum((ob[:, 2] - ob[:, 0]) / w, CAP)
+        X[:, :, 3] = np.minimum(np.abs(lateral) / w, CAP)
+        X[:, :, 4] = np.clip((-1.0 if mirror else 1.0) * lateral / w, -CAP, CAP)
+        X[:, :, 5] = np.arctan2(np.abs(lateral), depth)
+        X[:, :n_gaps, 6] = np.minimum(np.maximum(np.abs(lateral[:, :n_gaps]) - best_offset[:, None], 0.0) / w, CAP)
+        X[:, :n_gaps, 7] = geometry.at_edge[gap_union]
+        X[:, n_gaps:, 8] = np.minimum(_corridor_overlap(ob[:, 1], ob[:, 3], line[:, None], w) / w, CAP)
+        X[:, :n_gaps, 9:11] = 1.0
         X[:, n_gaps:, 9] = free.mean(axis=1)
         X[:, n_gaps:, 10] = np.minimum(free[:, 2], free[:, 3])
-    X[:, :, 11] = np.minimum(_approach_collision(space, hands, points, geometry.members, n_gaps, w, removed), CAP)
-    X[:, :, 14] = np.minimum(best_offset / w, CAP)[:, None]
-    X[:, :, 15] = np.arctan2(best_offset, depth[:, 0])[:, None]
-    X[:, :, 16] = np.minimum(best_width / w, CAP)[:, None]
-    X[:, :, 17] = np.minimum(block / w, CAP)[:, None]
-    X[:, :, 18] = min(n_obj, CAP)
-    X[:, :, 19] = np.clip((geometry.x - hands[:, 0]) / np.maximum(goal[0] - hands[:, 0], w), -1.0, 2.0)[:, None]
-    if row < len(space.rows):
-        next_offset, _, next_block = _RowGeometry.of(space, row + 1).best(points, goal, w)
-        X[:, :, 21], X[:, :, 22] = np.minimum(next_offset / w, CAP), np.minimum(next_block / w, CAP)
-    _route_features(X, routes, hands, goal, points, geometry.members, n_gaps, w, removed)
+        X[:, :, 11] = np.minimum(self._approach_collision(hands, points, members, n_gaps, removed), CAP)
+        X[:, :, 14] = np.minimum(best_offset / w, CAP)[:, None]
+        X[:, :, 15] = np.arctan2(best_offset, depth[:, 0])[:, None]
+        X[:, :, 16] = np.minimum(best_width / w, CAP)[:, None]
+        X[:, :, 17] = np.minimum(block / w, CAP)[:, None]
+        X[:, :, 18] = min(len(geometry.members), CAP)
+        X[:, :, 19] = np.clip((geometry.x - hands[:, 0]) / np.maximum(goal[0] - hands[:, 0], w), -1.0, 2.0)[:, None]
+        if row < len(self.space.rows):
+            next_offset, _, next_block = self.row(row + 1).best(points, goal, w)
+            X[:, :, 21], X[:, :, 22] = np.minimum(next_offset / w, CAP), np.minimum(next_block / w, CAP)
+        X[:, :, 23] = np.minimum((geometry.x - hands[:, 0]) / w, CAP)[:, None]
+        X[:, :, 24] = np.minimum(np.linalg.norm(points - hands[:, None], axis=2) / w, CAP)
+        X[:, :, 25] = np.clip((-1.0 if mirror else 1.0) * (points[..., 1] - goal[1]) / w, -CAP, CAP)
+        X[:, :, 26] = np.minimum((goal[0] - geometry.x) / w, CAP)
+        self._route_features(X, hands, points, members, n_gaps, removed)
 
-    gaps = np.concatenate([table.index[geometry.gap_rows], np.zeros(n_obj, dtype=int)])
-    obstacles = np.concatenate([np.full(n_gaps, -1), geometry.members]).astype(int)
-    kinds = ("gap",) * n_gaps + ("object",) * n_obj
-    result = []
-    for b in range(len(hands)):
-        keep = np.arange(n)
-        if limit is not None:  # the nearest of each kind, kept in their order from left to right
-            gap_keep = np.sort(np.argsort(np.abs(lateral[b, :n_gaps]), kind="stable")[:limit])
-            obj_keep = n_gaps + np.sort(np.argsort(np.abs(lateral[b, n_gaps:]), kind="stable")[:limit])
-            keep = np.concatenate([gap_keep, obj_keep])
-        result.append(RowCandidates(row, tuple(kinds[k] for k in keep), gaps[keep], obstacles[keep], points[b, keep],
-                                    X[b, keep]))
-    return result
+        gaps = np.concatenate([self.space.gap_table.index[geometry.gap_rows[gap_union]], np.zeros(n_obj, dtype=int)])
+        obstacles = np.concatenate([np.full(n_gaps, -1), members]).astype(int)
+        kinds = ("gap",) * n_gaps + ("object",) * n_obj
+        at = {g: k for k, g in enumerate(gap_union)}
+        at_obj = {o: n_gaps + k for k, o in enumerate(obj_union)}
+        result = []
+        for b in range(len(hands)):
+            keep = np.array([at[g] for g in sorted(gap_keep[b])] + [at_obj[o] for o in sorted(obj_keep[b])], dtype=int)
+            result.append(RowCandidates(row, tuple(kinds[k] for k in keep), gaps[keep], obstacles[keep],
+                                        points[b, keep], X[b, keep]))
+        return result
 
+    def _approach_collision(self, hands: np.ndarray, points: np.ndarray, members: np.ndarray, n_gaps: int,
+                            removed: list[frozenset[int]]) -> np.ndarray:
+        """(B, n) per hand and candidate: the length of the hand's straight way from the hand to the
+        candidate inside the obstacles grown by half the hand's width, in hand widths (not counting
+        the candidate's own obstacle, nor the ones moved away)."""
+        B, n = points.shape[:2]
+        w = self.width
+        grown = self.space.obstacle_bounds + np.array([-w, -w, w, w]) / 2.0
+        inside = segment_inside(np.repeat(hands, n, axis=0), points.reshape(-1, 2), grown).reshape(B, n, -1)
+        for b, gone in enumerate(removed):
+            inside[b, :, list(gone)] = 0.0
+        inside[:, np.arange(n_gaps, n), members] = 0.0
+        return inside.sum(axis=2) / w
 
-def _approach_collision(space: TaskSpace, hands: np.ndarray, points: np.ndarray, members: np.ndarray, n_gaps: int,
-                        width: float, removed: list[frozenset[int]]) -> np.ndarray:
-    """(B, n) per hand and candidate: the length of the hand's straight way from the hand to the
-    candidate inside the obstacles grown by half the hand's width, in hand widths (not counting
-    the candidate's own obstacle, nor the ones moved away)."""
-    B, n = points.shape[:2]
-    grown = space.obstacle_bounds + np.array([-width, -width, width, width]) / 2.0
-    inside = segment_inside(np.repeat(hands, n, axis=0), points.reshape(-1, 2), grown).reshape(B, n, -1)
-    for b, gone in enumerate(removed):
-        inside[b, :, list(gone)] = 0.0
-    inside[:, np.arange(n_gaps, n), members] = 0.0
-    return inside.sum(axis=2) / width
-
-
-def _route_features(X: np.ndarray, routes: FreeRoutes, hands: np.ndarray, goal: np.ndarray, points: np.ndarray,
-                    members: np.ndarray, n_gaps: int, width: float, removed: list[frozenset[int]]) -> None:
-    """Fill columns 12, 13 and 20 of ``X`` (B, n, k): a gap's shortest route through it / the
-    shortest route; an obstacle's shortening of the shortest route if it were moved, in hand
-    widths (for the obstacles across the straight way from the hand to the target; 0 for the
-    others); the shortest route / the straight distance (ROUTE_CAP where there is no route)."""
-    B = len(hands)
-    per_hand = 1 + n_gaps  # each hand's points in the query: the hand, then its gap points
-    query = routes.query(np.vstack([goal[None], *(np.vstack([h[None], p[:n_gaps]]) for h, p in zip(hands, points))]))
-    starts = 1 + per_hand * np.arange(B)
-    straight = np.maximum(np.hypot(*(goal - hands).T), width)
-    in_the_way = segment_hits(np.repeat(hands, len(members), axis=0), np.tile(goal, (B * len(members), 1)),
-                              routes.grown[np.tile(members, B)]).reshape(B, len(members), -1)[..., 0] if len(members) \
-        else np.zeros((B, 0), dtype=bool)
-    for gone in set(removed):
-        group = [b for b in range(B) if removed[b] == gone]
-        lengths = query.lengths(gone)
-        for b in group:
-            s = starts[b]
-            shortest = lengths[s, 0] if np.isfinite(lengths[s, 0]) else ROUTE_CAP * straight[b]
-            X[b, :, 20] = min(shortest / straight[b], ROUTE_CAP)
-            if n_gaps:
-                via = lengths[s, s + 1 : s + per_hand] + lengths[s + 1 : s + per_hand, 0]
-                X[b, :n_gaps, 12] = np.minimum(via / shortest, ROUTE_CAP)
-            for k in np.flatnonzero(in_the_way[b]):
-                without = query.lengths(gone | {int(members[k])}, sources=[s], targets=[0])[0, 0]
-                without = without if np.isfinite(without) else ROUTE_CAP * straight[b]
-                X[b, n_gaps + k, 13] = np.clip((shortest - without) / width, 0.0, CAP)
+    def _route_features(self, X: np.ndarray, hands: np.ndarray, points: np.ndarray, members: np.ndarray,
+                        n_gaps: int, removed: list[frozenset[int]]) -> None:
+        """Fill columns 12, 13 and 20 of ``X`` (B, n, k): a gap's shortest route through it / the
+        shortest route; an obstacle's shortening of the shortest route if it were moved, in hand
+        widths (for the obstacles across the straight way from the hand to the target; 0 for the
+        others); the shortest route / the straight distance (ROUTE_CAP where there is no route)."""
+        routes, w, B, G = self.routes, self.width, len(hands), n_gaps
+        gap_points = points[:, :G].reshape(-1, 2)
+        sight, pair_hits = routes.sight(np.vstack([hands, gap_points]), pairs=(np.repeat(hands, G, axis=0), gap_points))
+        straight = np.maximum(np.hypot(*(self.goal - hands).T), w)
+        route_index = {int(k): i for i, k in enumerate(routes.ids)}
+        for gone in set(removed):
+            group = np.array([b for b in range(B) if removed[b] == gone])
+            shortest = routes.to_goal(sight, group, gone)
+            shortest = np.where(np.isfinite(shortest), shortest, ROUTE_CAP * straight[group])
+            X[group, :, 20] = np.minimum(shortest / straight[group], ROUTE_CAP)[:, None]
+            if G:
+                pairs = (group[:, None] * G + np.arange(G)).reshape(-1)
+                via = (routes.between(sight, np.repeat(group, G), B + pairs, pair_hits[pairs], gone)
+                       + routes.to_goal(sight, B + pairs, gone)).reshape(len(group), G)
+                X[group, :G, 12] = np.minimum(via / shortest[:, None], ROUTE_CAP)
+            for k, obstacle in enumerate(members):  # moved away: the route from the hands it stands before
+                r = route_index.get(int(obstacle))
+                if r is None or int(obstacle) in gone:
+                    continue
+                before = np.flatnonzero(sight.goal_hits[group, r])
+                if len(before) == 0:
+                    continue
+                without = routes.to_goal_without(sight, group[before], gone, int(obstacle))
+                without = np.where(np.isfinite(without), without, ROUTE_CAP * straight[group[before]])
+                X[group[before], G + k, 13] = np.clip((shortest[before] - without) / w, 0.0, CAP)

@@ -9,14 +9,13 @@ import numpy as np
 
 from hlp_drake.features.arm import ARM_FEATURES, arm_features
 from hlp_drake.features.direction import DIRECTION_FEATURES, direction_features, direction_index
-from hlp_drake.features.row_choice import HUMAN_HAND_WIDTH, ROW_CHOICE_FEATURES, row_candidates
+from hlp_drake.features.row_choice import HUMAN_HAND_WIDTH, ROW_CHOICE_FEATURES, RowChoiceScene
 from hlp_drake.features.scene_features import GAP_FEATURES, OBJECT_FEATURES, gap_features, object_features
 from hlp_drake.features.segment import SEGMENT_FEATURES, segment_feature_matrix
 from hlp_drake.segmentation.demonstration import GAP, NONE, OBJECT, Demonstration
 from hlp_drake.segmentation.modes import Mode, check_mode, is_faithful
 from hlp_drake.taskspace import DIRECTIONS, Node, TaskSpace
 from hlp_drake.taskspace.relocation import relocated_array
-from hlp_drake.taskspace.routes import FreeRoutes
 
 
 @dataclass
@@ -153,15 +152,14 @@ def row_choice_rows(demo: Demonstration, space: TaskSpace, *, hand_width: float 
     the person's gap, or to where the person's obstacle is released (the centre of its relocated
     region in the person's direction), which then no longer stands in its row.
     """
-    routes = FreeRoutes(space.obstacle_bounds, space.scene.table.bounds, hand_width)
-    hand, goal = np.asarray(demo.scene.start, float), np.asarray(space.target.center, float)
+    features = RowChoiceScene(space, hand_width)
+    hand = np.asarray(demo.scene.start, float)
     removed: set[int] = set()
     rows = []
     for decision in demo.decisions:
         if decision.decision == NONE:
             continue
-        candidates, = row_candidates(space, decision.row, hand, goal, hand_width=hand_width, routes=routes,
-                                     removed=[removed], mirror=demo.left_handed)
+        candidates, = features.candidates(decision.row, hand, [removed], mirror=demo.left_handed)
         names = space.obstacle_names
         chosen = [k for k in range(len(candidates)) if candidates.kinds[k] == decision.decision
                   and candidates.element(k, names) == decision.element]
@@ -177,6 +175,19 @@ def row_choice_rows(demo: Demonstration, space: TaskSpace, *, hand_width: float 
         else:
             hand = candidates.points[k]
     return rows
+
+
+def _add_row_choice(builder: _Builder, demo: Demonstration, space: TaskSpace) -> None:
+    for X, y in row_choice_rows(demo, space):
+        builder.add(demo.key, X, y)
+
+
+def row_choice_set(demonstrations: Iterable[Demonstration]) -> LabelledSet:
+    """The row-choice examples (``row_choice_rows``) of fixed-mode demonstrations."""
+    builder = _Builder(ROW_CHOICE_FEATURES)
+    for demo in demonstrations:
+        _add_row_choice(builder, demo, TaskSpace(demo.scene))
+    return builder.build()
 
 
 def training_data(demonstrations: Iterable[Demonstration], *, mode: Mode | None = None) -> TrainingData:
@@ -202,8 +213,7 @@ def training_data(demonstrations: Iterable[Demonstration], *, mode: Mode | None 
         space = TaskSpace(demo.scene)
         flags = demo.flags
         if not faithful:
-            for X, y in row_choice_rows(demo, space):
-                row_set.add(demo.key, X, y)
+            _add_row_choice(row_set, demo, space)
         gap.add(demo.key, gap_features(space), gap_labels(demo, space, faithful=faithful), not all(flags))
         obj.add(demo.key, object_features(space), object_labels(demo, space), any(flags))
         for k, keypoint in enumerate(demo.keypoints):

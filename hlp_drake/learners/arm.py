@@ -35,10 +35,16 @@ class ArmRegressor(RegressorMixin, BaseEstimator):
         self.categorical = categorical
         self.random_state = random_state
 
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.target_tags.multi_output = True
+        return tags
+
     def fit(self, X: np.ndarray, y: np.ndarray) -> ArmRegressor:
         X, y = validate_data(self, X, y, multi_output=True, y_numeric=True)
         check_categorical(self.categorical, X.shape[1])
         self.n_outputs_ = 1 if y.ndim == 1 else y.shape[1]
+        self._flat = y.ndim == 1  # predict as the target was given: (n,) or (n, outputs)
         y = y.reshape(len(y), -1).astype(float)
         rng = np.random.default_rng(self.random_state)
         if len(X) > self.max_samples:
@@ -68,7 +74,7 @@ class ArmRegressor(RegressorMixin, BaseEstimator):
         """(n, outputs) predictions; (n,) for a model fitted on a 1-D target."""
         X = prediction_input(self, X)
         q = self._predict(self._standardised(X))
-        return q[:, 0] if self.n_outputs_ == 1 else q
+        return q[:, 0] if self._flat else q
 
     def rollout(self, start: np.ndarray, parent: list[int], moves: np.ndarray,
                 limits: tuple[float, float] = (-np.inf, np.inf)) -> np.ndarray:
@@ -108,12 +114,13 @@ class ArmRegressor(RegressorMixin, BaseEstimator):
         check_is_fitted(self)
         return {"mean": self.mean_, "scale": self.scale_, "train": self.train_, "alpha": self.alpha_,
                 "length_scale": self.length_scale_, "amplitude": self.amplitude_, "y_mean": self.y_mean_,
-                "y_std": self.y_std_, "outputs": np.array(self.n_outputs_)}
+                "y_std": self.y_std_, "outputs": np.array(0 if self._flat else self.n_outputs_)}
 
     def set_state(self, state: dict[str, np.ndarray]) -> ArmRegressor:
         for name in ("mean", "scale", "train", "alpha", "length_scale", "amplitude", "y_mean", "y_std"):
             setattr(self, f"{name}_", state[name])
-        self.n_outputs_ = int(state["outputs"])
+        self._flat = int(state["outputs"]) == 0
+        self.n_outputs_ = len(self.y_mean_)
         self._weights = distance_weights(self.train_)
         self.n_features_in_ = self.train_.shape[1] - (N_DIRECTIONS - 1) * len(self.categorical)
         return self

@@ -20,7 +20,7 @@ from hlp_drake.learners.inputs import binary_classes, prediction_input, sample_w
 from hlp_drake.learners.kernel import distance_weights
 from hlp_drake.learners.novelty import fit_novelty, novelty_score
 from hlp_drake.learners.svm import RbfSvmClassifier
-from hlp_drake.learners.trees import boosted_tree_arrays, tree_sum
+from hlp_drake.learners.trees import BoostedTrees, boosted_tree_arrays
 
 LEARNERS = ("boosted", "svm")
 
@@ -42,7 +42,7 @@ class RowChoiceClassifier(ClassifierMixin, BaseEstimator):
     def __init__(self, learner: str = "boosted", n_estimators: int = 150, max_depth: int = 3,
                  learning_rate: float = 0.1, subsample: float = 0.8, C: float = 1.0, kernel_scale: float = 0.25,
                  calibration_folds: int = 2, novelty_neighbours: int = 5, novelty_quantile: float = 0.99,
-                 novelty_samples: int = 2000, random_state: int = 0) -> None:
+                 novelty_samples: int = 1000, random_state: int = 0) -> None:
         self.learner = learner
         self.n_estimators = n_estimators
         self.max_depth = max_depth
@@ -71,14 +71,10 @@ class RowChoiceClassifier(ClassifierMixin, BaseEstimator):
         raise ValueError(f"unknown learner {self.learner!r}; choose one of {', '.join(LEARNERS)}")
 
     def _fit_learner(self, X: np.ndarray, y: np.ndarray,
-                     sample_weight: np.ndarray | None) -> dict[str, np.ndarray] | RbfSvmClassifier:
-        """Fit one learner: the boosted trees' arrays, or the fitted SVM."""
+                     sample_weight: np.ndarray | None) -> BoostedTrees | RbfSvmClassifier:
+        """Fit one learner: the boosted trees (as arrays), or the SVM."""
         model = self._learner().fit(X, y, sample_weight=sample_weight)
-        return boosted_tree_arrays(model, X) if isinstance(model, GradientBoostingClassifier) else model
-
-    @staticmethod
-    def _raw(learner: dict[str, np.ndarray] | RbfSvmClassifier, X: np.ndarray) -> np.ndarray:
-        return learner.decision_function(X) if isinstance(learner, RbfSvmClassifier) else tree_sum(learner, X)
+        return BoostedTrees(boosted_tree_arrays(model, X)) if isinstance(model, GradientBoostingClassifier) else model
 
     def fit(self, X: np.ndarray, y: np.ndarray, sample_weight: np.ndarray | None = None,
             groups: np.ndarray | None = None) -> RowChoiceClassifier:
@@ -97,7 +93,7 @@ class RowChoiceClassifier(ClassifierMixin, BaseEstimator):
         folds = self._folds(positive, groups)
         for train, test in folds:
             learner = self._fit_learner(X[train], positive[train], None if weight is None else weight[train])
-            oof[test] = self._raw(learner, X[test])
+            oof[test] = learner.decision_function(X[test])
         platt = LogisticRegression(C=1e6).fit(oof[:, None], positive) if folds else None
         self.calibration_ = (np.array([float(platt.coef_[0, 0]), float(platt.intercept_[0])]) if platt is not None
                              else np.array([1.0, 0.0]))
@@ -123,7 +119,7 @@ class RowChoiceClassifier(ClassifierMixin, BaseEstimator):
     def decision_function(self, X: np.ndarray) -> np.ndarray:
         """The learner's raw score: > 0 leans to "taken" (``classes_[1]``)."""
         X = prediction_input(self, X)
-        return self._raw(self._learner_, X)
+        return self._learner_.decision_function(X)
 
     def predict_proba(self, X: np.ndarray) -> np.ndarray:
         """(n, 2) calibrated probabilities of ``classes_``."""
@@ -144,7 +140,7 @@ class RowChoiceClassifier(ClassifierMixin, BaseEstimator):
         """The fitted arrays (for safe saving)."""
         check_is_fitted(self)
         state = {"classes": self.classes_, "calibration": self.calibration_}
-        learner = self._learner_.get_state() if isinstance(self._learner_, RbfSvmClassifier) else self._learner_
+        learner = self._learner_.get_state() if isinstance(self._learner_, RbfSvmClassifier) else self._learner_.arrays
         state.update({f"learner.{k}": v for k, v in learner.items()})
         state.update({f"novelty.{k}": v for k, v in self.novelty_.items()})
         return state
@@ -152,7 +148,7 @@ class RowChoiceClassifier(ClassifierMixin, BaseEstimator):
     def set_state(self, state: dict[str, np.ndarray]) -> RowChoiceClassifier:
         self.classes_, self.calibration_ = state["classes"], state["calibration"]
         learner = {k[len("learner."):]: v for k, v in state.items() if k.startswith("learner.")}
-        self._learner_ = RbfSvmClassifier().set_state(learner) if self.learner == "svm" else learner
+        self._learner_ = RbfSvmClassifier().set_state(learner) if self.learner == "svm" else BoostedTrees(learner)
         self.novelty_ = {k[len("novelty."):]: v for k, v in state.items() if k.startswith("novelty.")}
         self.n_features_in_ = len(self.novelty_["mean"])
         self._novelty_weights = distance_weights(self.novelty_["points"])

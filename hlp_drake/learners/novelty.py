@@ -2,8 +2,10 @@
 
 Features are standardised with the training set's mean and spread; a seeded sample of the
 training rows is kept. ``score`` is the distance to the k-th nearest of them divided by the same
-distance's ``quantile`` among the kept rows themselves (each left out of its own neighbours), so a
-score above 1 means "further from the demonstrations than all but (1 - quantile) of them are".
+distance's ``quantile`` over other training rows (a second sample, as far from the kept ones as a
+new case from the same source; with too few rows, the kept ones each left out of their own
+neighbours), so a score above 1 means "further from the demonstrations than all but
+(1 - quantile) of them are".
 """
 
 from __future__ import annotations
@@ -28,12 +30,15 @@ def fit_novelty(X: np.ndarray, rng: np.random.Generator, *, samples: int, neighb
     mean = X.mean(axis=0)
     scale = np.where(X.std(axis=0) > 0, X.std(axis=0), 1.0)
     Z = (X - mean) / scale
-    if len(Z) > samples:
-        Z = Z[np.sort(rng.choice(len(Z), samples, replace=False))]
-    weights = distance_weights(Z)
-    own = _kth_distance(Z, weights, neighbours, exclude_self=True) if len(Z) > 1 else np.zeros(1)
-    return {"mean": mean, "scale": scale, "points": Z, "neighbours": np.array(neighbours),
-            "threshold": np.array(max(float(np.quantile(own, quantile)), 1e-9))}
+    order = rng.permutation(len(Z))
+    kept, probe = Z[np.sort(order[:samples])], Z[np.sort(order[samples : 2 * samples])]
+    weights = distance_weights(kept)
+    if len(probe) >= samples // 2 and len(probe) > 0:
+        distances = _kth_distance(probe, weights, neighbours)
+    else:
+        distances = _kth_distance(kept, weights, neighbours, exclude_self=True) if len(kept) > 1 else np.zeros(1)
+    return {"mean": mean, "scale": scale, "points": kept, "neighbours": np.array(neighbours),
+            "threshold": np.array(max(float(np.quantile(distances, quantile)), 1e-9))}
 
 
 def novelty_score(state: dict[str, np.ndarray], weights: np.ndarray, X: np.ndarray) -> np.ndarray:

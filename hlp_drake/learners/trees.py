@@ -31,20 +31,40 @@ def boosted_tree_arrays(model: GradientBoostingClassifier, X: np.ndarray) -> dic
     arrays["value"] *= model.learning_rate
     arrays["depth"] = np.array(max(e.get_depth() for e in model.estimators_[:, 0]))
     sample = X[:1]
-    arrays["offset"] = np.array(float(model.decision_function(sample)[0]) - float(tree_sum(arrays, sample)[0]))
+    arrays["offset"] = np.array(0.0)
+    arrays["offset"] = np.array(float(model.decision_function(sample)[0])
+                                - float(BoostedTrees(arrays).decision_function(sample)[0]))
     return arrays
 
 
-def tree_sum(arrays: dict[str, np.ndarray], X: np.ndarray) -> np.ndarray:
-    """(n,) the summed leaf values of every tree for the rows of ``X`` (thresholds compared in
-    float32, as scikit-learn's trees do), plus the constant term where present."""
-    X32 = np.asarray(X, dtype=np.float32)
-    feature, threshold, left, right = arrays["feature"], arrays["threshold"], arrays["left"], arrays["right"]
-    trees = np.arange(len(feature))[None, :]
-    rows = np.arange(len(X32))[:, None]
-    node = np.zeros((len(X32), len(feature)), dtype=np.int32)
-    for _ in range(int(arrays["depth"])):
-        go_left = X32[rows, feature[trees, node]] <= threshold[trees, node]
-        child = np.where(go_left, left[trees, node], right[trees, node])
-        node = np.where(child == LEAF, node, child)
-    return arrays["value"][trees, node].sum(axis=1) + float(arrays.get("offset", 0.0))
+class BoostedTrees:
+    """Evaluates the trees of ``boosted_tree_arrays``: the summed leaf values plus the constant.
+
+    The nodes are laid out flat (node k of tree t at t * nodes + k), a leaf's children pointing at
+    itself, so every row walks the full depth in a few array operations.
+    """
+
+    def __init__(self, arrays: dict[str, np.ndarray]) -> None:
+        self.arrays = arrays
+        trees, nodes = arrays["feature"].shape
+        ids = np.arange(trees * nodes).reshape(trees, nodes)
+        leaf = arrays["left"] == LEAF
+        base = (np.arange(trees) * nodes)[:, None]
+        self._roots = base[:, 0]
+        self._feature, self._threshold = arrays["feature"].ravel(), arrays["threshold"].ravel()
+        self._left = np.where(leaf, ids, arrays["left"] + base).ravel()
+        self._right = np.where(leaf, ids, arrays["right"] + base).ravel()
+        self._value = arrays["value"].ravel()
+        self._depth, self._offset = int(arrays["depth"]), float(arrays.get("offset", 0.0))
+
+    def decision_function(self, X: np.ndarray) -> np.ndarray:
+        """(n,) the trees' score of the rows of ``X`` (thresholds compared in float32, as
+        scikit-learn's trees do)."""
+        X32 = np.ascontiguousarray(X, dtype=np.float32)
+        rows = (np.arange(len(X32)) * X32.shape[1])[:, None]
+        values = X32.ravel()
+        node = np.broadcast_to(self._roots, (len(X32), len(self._roots)))
+        for _ in range(self._depth):
+            go_left = values[rows + self._feature[node]] <= self._threshold[node]
+            node = np.where(go_left, self._left[node], self._right[node])
+        return self._value[node].sum(axis=1) + self._offset

@@ -35,6 +35,9 @@ class PlannerConfig:
         beam: the row-by-row planner keeps this many partial plans from row to row.
         min_share: ... and follows a row's candidate only where its share of the row's choice
             probability is at least this (always the most likely one).
+        collision_weight: the complete plans of the beam are ranked by their log-likelihood
+            minus this times the length (in hand widths) of the hand's straight ways between
+            keypoints inside obstacles (``row_plan.segment_collisions``).
     """
 
     mode: Mode = "fixed"
@@ -46,5 +49,6 @@ class PlannerConfig:
     classify_per_row: int = 6
     min_evidence: float = 0.05
     hand_width: float | None = None
-    beam: int = 4
+    beam: int = 3
     min_share: float = 0.05
+    collision_weight: float = 0.0

@@ -25,16 +25,15 @@ import numpy as np
 
 from hlp_drake.features import DIRECTION_FEATURES, direction_index
 from hlp_drake.features.direction import DirectionTable
-from hlp_drake.features.row_choice import RowCandidates, row_candidates
+from hlp_drake.features.row_choice import RowCandidates, RowChoiceScene
 from hlp_drake.learners.models import DecisionModels
 from hlp_drake.planner.config import PlannerConfig
 from hlp_drake.planner.plan import HighLevelPlan, PlanCandidate, PlanKeypoint
 from hlp_drake.planner.rollout import PrefixTree, arm_configurations, expected_collisions
 from hlp_drake.scene.rows import Row
 from hlp_drake.taskspace import DIRECTIONS, TaskSpace
-from hlp_drake.taskspace.band import band_coverage
 from hlp_drake.taskspace.relocation import relocated_array
-from hlp_drake.taskspace.routes import FreeRoutes
+from hlp_drake.taskspace.routes import segment_inside
 
 REACH_FRACTION = 0.25  # the hand stops this many hand widths short of the target's near face
 
@@ -47,7 +46,7 @@ class _Partial:
     hand: tuple[float, float]
     removed: frozenset[int]
     log_likelihood: float
-    scores: tuple[tuple[int, RowCandidates, np.ndarray, bool], ...]  # per row: candidates, p, evidence
+    scores: tuple[tuple[int, RowCandidates, np.ndarray, np.ndarray], ...]  # per row: candidates, p, novelty
 
 
 def planned_rows(space: TaskSpace, hand_width: float) -> list[Row]:
@@ -74,53 +73,58 @@ class _Expander:
     def __init__(self, space: TaskSpace, models: DecisionModels, config: PlannerConfig, hand_width: float,
                  mirror: bool) -> None:
         self.space, self.models, self.config, self.width, self.mirror = space, models, config, hand_width, mirror
-        self.routes = FreeRoutes(space.obstacle_bounds, space.scene.table.bounds, hand_width)
-        self.goal = np.asarray(space.target.center, float)
+        self.features = RowChoiceScene(space, hand_width)
         self.names = space.obstacle_names
         self.directions = DirectionTable(space, self.names, mode=config.mode)
         regions = relocated_array(space.obstacle_bounds, space.alpha)  # (n, 8, 4)
         self.releases = np.stack([(regions[..., 0] + regions[..., 2]) / 2.0,
                                   (regions[..., 1] + regions[..., 3]) / 2.0], axis=-1)
 
-    def candidates(self, beam: list[_Partial], row: Row) -> list[tuple[RowCandidates, np.ndarray, bool]]:
+    def candidates(self, beam: list[_Partial], row: Row) -> list[tuple[RowCandidates, np.ndarray, np.ndarray]]:
         """Per partial plan: the row's candidates from its hand, their probabilities (summing to 1)
-        and whether any carried evidence (Cr asked once for the whole beam)."""
-        per_plan = row_candidates(self.space, row.index, np.array([p.hand for p in beam]), self.goal,
-                                  hand_width=self.width, routes=self.routes, removed=[p.removed for p in beam],
-                                  mirror=self.mirror, limit=self.config.classify_per_row)
+        and their novelty (Cr asked once for the whole beam); where no candidate lies within the
+        demonstrations' range (novelty <= 1), the one-line rule's choice."""
+        per_plan = self.features.candidates(row.index, np.array([p.hand for p in beam]), [p.removed for p in beam],
+                                            mirror=self.mirror, limit=self.config.classify_per_row)
         X = np.vstack([c.X for c in per_plan])
         probability = self.models.row.predict_proba(X)[:, 1] if len(X) else np.zeros(0)
         novelty = self.models.row.novelty(X) if len(X) else np.zeros(0)
         result, start = [], 0
         for candidates in per_plan:
             end = start + len(candidates)
-            evidence = bool(np.any(novelty[start:end] <= 1.0))
-            p = probability[start:end] if evidence else _fallback(candidates)
-            result.append((candidates, p / max(float(p.sum()), 1e-300), evidence))
+            p = probability[start:end] if np.any(novelty[start:end] <= 1.0) else _fallback(candidates)
+            result.append((candidates, p / max(float(p.sum()), 1e-300), novelty[start:end]))
             start = end
         return result
 
-    def moves(self, hand: tuple[float, float], obstacles: np.ndarray) -> list[str]:
-        """Cd's direction for each obstacle approached from ``hand``."""
-        classes = [direction_index(self.directions.hand_direction(int(k), hand)) for k in obstacles]
-        X = self.directions.features(np.asarray(obstacles, int), np.asarray(classes, int)).reshape(-1, len(DIRECTION_FEATURES))
-        return [DIRECTIONS[int(label)] for label in self.models.direction.predict(X)]
+    def moves(self, hands: list[tuple[float, float]], obstacles: list[int]) -> list[str]:
+        """Cd's direction for each obstacle approached from its hand (one prediction for all)."""
+        if not obstacles:
+            return []
+        classes = [direction_index(self.directions.hand_direction(k, hand)) for k, hand in zip(obstacles, hands)]
+        X = self.directions.features(np.asarray(obstacles, int), np.asarray(classes, int))
+        return [DIRECTIONS[int(label)] for label in self.models.direction.predict(X.reshape(-1, len(DIRECTION_FEATURES)))]
 
     def grow(self, beam: list[_Partial], row: Row) -> list[_Partial]:
         """Every partial plan of ``beam`` grown by its likely choices at ``row``."""
-        return [child for partial, scored in zip(beam, self.candidates(beam, row))
-                for child in self.children(partial, row, *scored)]
-
-    def children(self, partial: _Partial, row: Row, candidates: RowCandidates, p: np.ndarray,
-                 evidence: bool) -> list[_Partial]:
-        scores = (*partial.scores, (row.index, candidates, p, evidence))
-        if len(candidates) == 0:
-            return [_Partial(partial.keypoints, partial.hand, partial.removed, partial.log_likelihood, scores)]
-        keep = [k for k in np.argsort(-p, kind="stable") if p[k] >= self.config.min_share] or [int(np.argmax(p))]
-        objects = [k for k in keep if candidates.kinds[k] == "object"]
-        directions = dict(zip(objects, self.moves(partial.hand, candidates.obstacles[objects]))) if objects else {}
+        chosen = []  # (partial, candidates, p, evidence, k) of every choice followed
+        for partial, (candidates, p, evidence) in zip(beam, self.candidates(beam, row)):
+            if len(candidates) == 0:
+                chosen.append((partial, candidates, p, evidence, None))
+                continue
+            keep = [k for k in np.argsort(-p, kind="stable") if p[k] >= self.config.min_share] or [int(np.argmax(p))]
+            chosen += [(partial, candidates, p, evidence, int(k)) for k in keep]
+        moved = [c for c in chosen if c[4] is not None and c[1].kinds[c[4]] == "object"]
+        directions = self.moves([c[0].hand for c in moved], [int(c[1].obstacles[c[4]]) for c in moved])
+        direction_of_move = {id(c): d for c, d in zip(moved, directions)}
         children = []
-        for k in keep:
+        for choice in chosen:
+            partial, candidates, p, evidence, k = choice
+            scores = (*partial.scores, (row.index, candidates, p, evidence))
+            if k is None:
+                children.append(_Partial(partial.keypoints, partial.hand, partial.removed, partial.log_likelihood,
+                                         scores))
+                continue
             log_likelihood = partial.log_likelihood + math.log(max(float(p[k]), 1e-300))
             point = tuple(float(v) for v in candidates.points[k])
             element = candidates.element(k, self.names)
@@ -128,7 +132,7 @@ class _Expander:
                 keypoints = (*partial.keypoints, PlanKeypoint("gap", point, row.index, element))
                 children.append(_Partial(keypoints, point, partial.removed, log_likelihood, scores))
                 continue
-            obstacle, direction = int(candidates.obstacles[k]), directions[k]
+            obstacle, direction = int(candidates.obstacles[k]), direction_of_move[id(choice)]
             release = tuple(float(v) for v in self.releases[obstacle, DIRECTIONS.index(direction)])
             keypoints = (*partial.keypoints, PlanKeypoint("move", point, row.index, element, direction),
                          PlanKeypoint("release", release, row.index, element, direction))
@@ -137,27 +141,36 @@ class _Expander:
 
 
 def segment_collisions(space: TaskSpace, keypoints: tuple[PlanKeypoint, ...], hand_width: float) -> list[dict]:
-    """The hand's straight ways between consecutive keypoints that pass over an obstacle, each as
-    ``{"segment": i, "obstacle": name, "covered": fraction}``: the hand's band (``hand_width``)
-    against the obstacles where they stand at that moment (a moved one at the centre of its
-    relocated region from its release on, and not on the ways to and with it)."""
-    bounds = space.obstacle_bounds.copy()
-    regions = relocated_array(space.obstacle_bounds, space.alpha)
-    found = []
+    """The hand's straight ways between consecutive keypoints that pass through an obstacle, each as
+    ``{"segment": i, "obstacle": name, "depth": m}``: the length of the way inside the obstacle
+    grown by half the hand's width, the obstacles where they stand at that moment (a moved one at
+    the centre of its relocated region from its release on, and not on the ways to and with it)."""
+    if len(keypoints) < 2:
+        return []
+    names, regions = space.obstacle_names, relocated_array(space.obstacle_bounds, space.alpha)
+    segments = len(keypoints) - 1
+    # Every place an obstacle stands, and the segments it stands there for: the original places
+    # until the obstacle's release, its relocated region after it.
+    rects, owners, spans = list(space.obstacle_bounds), list(range(len(names))), [[0, segments]] * len(names)
+    own = np.zeros((segments, len(names)), dtype=bool)  # the ways to and with the obstacle moved
     for i, (a, b) in enumerate(pairwise(keypoints)):
-        own = {space.obstacle_index[k.element] for k in (a, b) if k.action in ("move", "release")}
-        p0, p1 = np.asarray(a.position)[None], np.asarray(b.position)[None]
-        d = p1 - p0
-        length = float(np.hypot(*d[0]))
-        normal = np.array([[-d[0, 1], d[0, 0]]]) / (length if length > 0 else 1.0)
-        cover = band_coverage(p0, p1, normal, hand_width / 2.0, hand_width / 2.0, bounds)[0]
-        for k in np.flatnonzero(cover > 1e-9):
-            if int(k) not in own:
-                found.append({"segment": i, "obstacle": space.obstacle_names[k], "covered": float(cover[k])})
+        for k in (a, b):
+            if k.action in ("move", "release"):
+                own[i, space.obstacle_index[k.element]] = True
         if b.action == "release":
             k = space.obstacle_index[b.element]
-            bounds[k] = regions[k, DIRECTIONS.index(b.direction)]
-    return found
+            spans[k] = [0, i + 1]
+            rects.append(regions[k, DIRECTIONS.index(b.direction)])
+            owners.append(k)
+            spans.append([i + 1, segments])
+    spans = np.array(spans, dtype=int).reshape(-1, 2)
+    j = np.arange(segments)[:, None]
+    counted = (j >= spans[:, 0]) & (j < spans[:, 1]) & ~own[:, owners]
+    ends = np.array([k.position for k in keypoints], dtype=float)
+    grown = np.array(rects).reshape(-1, 4) + np.array([-hand_width, -hand_width, hand_width, hand_width]) / 2.0
+    inside = segment_inside(ends[:-1], ends[1:], grown) * counted
+    return [{"segment": int(i), "obstacle": names[owners[r]], "depth": float(inside[i, r])}
+            for i, r in zip(*np.nonzero(inside > 1e-9))]
 
 
 def plan_rows(space: TaskSpace, models: DecisionModels, config: PlannerConfig, q0: np.ndarray,
@@ -175,31 +188,36 @@ def plan_rows(space: TaskSpace, models: DecisionModels, config: PlannerConfig, q
     tree = PrefixTree.of(keypoints)
     arms = arm_configurations(models, tree, q0, links[0] + links[1], False)
     costs = expected_collisions(space, tree, arms, links, config.arm_band, False)
-    order = sorted(range(len(beam)), key=lambda i: (-beam[i].log_likelihood, costs[i]))
+    collisions = [segment_collisions(space, tuple(k), hand_width) for k in keypoints]
+    score = [beam[i].log_likelihood - config.collision_weight * sum(c["depth"] for c in collisions[i]) / hand_width
+             for i in range(len(beam))]
+    order = sorted(range(len(beam)), key=lambda i: (-score[i], costs[i]))
     best = order[0]
     chosen = tuple(
         PlanKeypoint(k.action, k.position, k.row, k.element, k.direction, (float(q[0]), float(q[1])))
         for k, q in zip(keypoints[best], arms[[0, *tree.paths[best]]].tolist()))
     alternatives = tuple(PlanCandidate(tuple(keypoints[i]), costs[i]) for i in order[1:])
     details = _details(space, beam[best], [beam[i].log_likelihood for i in order])
-    details["segment_collisions"] = segment_collisions(space, chosen, hand_width)
+    details["segment_collisions"] = collisions[best]
     return HighLevelPlan(scene.name, chosen, costs[best], alternatives, time.perf_counter() - started, None, details)
 
 
 def _details(space: TaskSpace, partial: _Partial, log_likelihoods: list[float]) -> dict:
     """What the chosen plan's rows looked like: per candidate its probability minus one half
     (``gap_scores``, ``object_scores``: > 0 means Cr takes it, the evaluation's raw labels), the
-    rows' candidates, which rows' scores carried evidence, and the beam's log-likelihoods."""
+    rows' candidates and their novelty, which rows' scores carried evidence (any candidate's
+    novelty <= 1), and the beam's log-likelihoods."""
     names = space.obstacle_names
-    gap_scores, object_scores, candidates, evidence = {}, {}, {}, {}
-    for row, row_candidates_, p, informed in partial.scores:
+    gap_scores, object_scores, candidates, evidence, novelty = {}, {}, {}, {}, {}
+    for row, row_candidates_, p, row_novelty in partial.scores:
         elements = [row_candidates_.element(k, names) for k in range(len(row_candidates_))]
         candidates[str(row)] = elements
-        evidence[str(row)] = informed
+        evidence[str(row)] = bool(np.any(row_novelty <= 1.0))
+        novelty[str(row)] = [float(v) for v in row_novelty]
         for k, element in enumerate(elements):
             if row_candidates_.kinds[k] == "gap":
                 gap_scores[f"{row}:{element}"] = float(p[k]) - 0.5
             else:
                 object_scores[element] = float(p[k]) - 0.5
     return {"gap_scores": gap_scores, "object_scores": object_scores, "candidates": candidates,
-            "evidence": evidence, "log_likelihoods": log_likelihoods}
+            "evidence": evidence, "novelty": novelty, "log_likelihoods": log_likelihoods}

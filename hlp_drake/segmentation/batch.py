@@ -11,9 +11,10 @@ from tqdm import tqdm
 
 from hlp_drake.dataset.dataset import Dataset
 from hlp_drake.dataset.records import STRUCTURED, TrialRecord, category_of
-from hlp_drake.segmentation.demonstration import Demonstration, Rejection
+from hlp_drake.segmentation.demonstration import NONE, OBJECT, Demonstration, Rejection
 from hlp_drake.segmentation.modes import DEFAULT_MODE, Mode, check_mode
 from hlp_drake.segmentation.segment import Rejected, segment_trial
+from hlp_drake.taskspace import TaskSpace
 
 _TRIAL_IN_PATH = re.compile(r"(sub_\d+)[/\\]T(\d{3})")
 
@@ -70,3 +71,22 @@ def segment_dataset(dataset: Dataset, *, mode: Mode = DEFAULT_MODE, records: lis
         except Rejected as rejected:
             result.rejections.append(Rejection(record.key, rejected.reason))
     return result
+
+
+def log_agreement(dataset: Dataset, result: SegmentationResult) -> float:
+    """Share of the decided rows whose decision and element match the interaction log: a row with a
+    PickedUp obstacle (the first one picked up there) is "move" that obstacle, one without is a gap
+    (rows the hand never crossed have no decision and do not count)."""
+    agree = total = 0
+    for demo in result.demonstrations:
+        row_of = {n: row.index for row in TaskSpace(demo.scene).rows for n in row.members}
+        first: dict[int, str] = {}
+        for event in dataset.trial(demo.key).interactions:
+            if event.kind == "PickedUp" and event.non_dominant in row_of:
+                first.setdefault(row_of[event.non_dominant], event.non_dominant)
+        for d in demo.decisions:
+            if d.decision == NONE:
+                continue
+            total += 1
+            agree += (d.decision == OBJECT) == (d.row in first) and (d.row not in first or first[d.row] == d.obstacle)
+    return agree / max(total, 1)

@@ -141,6 +141,19 @@ def free_fractions(blocks: np.ndarray, occluders: np.ndarray) -> np.ndarray:
     return 1.0 - occupied / area
 
 
+def table_walls(bounds: tuple[float, float, float, float], thickness: float) -> dict[str, Rect]:
+    """The four virtual walls just outside the table's edges (back, left, right, front; they do not
+    overlap each other)."""
+    x0, y0, x1, y1 = bounds
+    t = thickness
+    return {
+        "back": Rect(x1, y0 - t, x1 + t, y1 + t),
+        "left": Rect(x0, y1, x1, y1 + t),
+        "right": Rect(x0, y0 - t, x1, y0),
+        "front": Rect(x0 - t, y0 - t, x0, y1 + t),
+    }
+
+
 class TaskSpace:
     """The qualitative model of a scene (reference section 2), in the world frame.
 
@@ -158,14 +171,7 @@ class TaskSpace:
         bounds = {o.name: footprint_bounds(o) for o in scene.objects}
         self.rows: list[Row] = find_rows(scene, row_tolerance, bounds)
         self.rects: dict[str, Rect] = {name: Rect(*b) for name, b in bounds.items()}
-        x0, y0, x1, y1 = scene.table.bounds
-        t = wall_thickness
-        self.walls: dict[str, Rect] = {
-            "back": Rect(x1, y0 - t, x1 + t, y1 + t),
-            "left": Rect(x0, y1, x1, y1 + t),
-            "right": Rect(x0, y0 - t, x1, y0),
-            "front": Rect(x0 - t, y0 - t, x0, y1 + t),
-        }
+        self.walls: dict[str, Rect] = table_walls(scene.table.bounds, wall_thickness)
 
     @property
     def target(self) -> Rect:

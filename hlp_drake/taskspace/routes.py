@@ -1,20 +1,22 @@
-"""Shortest hand routes across the table among the obstacles (a visibility graph).
+"""Shortest hand routes to the target among the obstacles (a visibility graph).
 
 The hand is a disc of the hand's width: obstacles are their footprint rectangles grown by half of
 it, and the hand's centre keeps half of it from the table's back and side edges. The shortest
-route between two points then runs straight or from corner to corner of the grown rectangles. The
-corners' graph is built once per scene (``FreeRoutes``); routes between a few points of interest
-add those points' visibility of the corners (``RouteQuery``), and routes with some obstacles moved
-away reuse the same segment tests, so one query answers every "what if this one were moved".
+route between two points then runs straight or from corner to corner of the grown rectangles.
+``FreeRoutes`` builds the corners' graph once per scene and, per set of obstacles taken away
+(moved), the corners' distances to each other and to the goal (a moved obstacle's corners stay as
+points of the free space); ``Sight`` holds what a few points
+of interest see (the corners, the goal), so routes from them cost a few array operations.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Collection
+from dataclasses import dataclass
 
 import numpy as np
 
-CORNER_OFFSET = 1e-6  # corners sit just outside their grown rectangle, so they see along its sides
+CORNER_OFFSET = 1e-5  # hand widths: corners sit just outside their grown rectangle, so they see along its sides
 
 
 def _clip(p0: np.ndarray, p1: np.ndarray, rects: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -59,19 +61,41 @@ def all_pairs_shortest(graph: np.ndarray) -> np.ndarray:
     return d
 
 
+@dataclass(frozen=True, eq=False)
+class Sight:
+    """What some points see: per point and corner (and the goal) the straight length, and which
+    grown obstacles the straight way passes through.
+
+    Attributes:
+        points: (p, 2); corner_hits: (p, c, m); corner_length: (p, c); goal_hits: (p, m);
+        goal_length: (p,).
+    """
+
+    points: np.ndarray
+    corner_hits: np.ndarray
+    corner_length: np.ndarray
+    goal_hits: np.ndarray
+    goal_length: np.ndarray
+
+
 class FreeRoutes:
-    """The corner graph of a hand ``hand_width`` wide among ``rects`` on a table.
+    """The corner graph of a hand ``hand_width`` wide among obstacles, with routes to ``goal``.
 
     Args:
         rects: (m, 4) obstacle footprints (x_min, y_min, x_max, y_max).
+        ids: (m,) the obstacles' ids (e.g. positions in scene order), the ones ``removed`` names.
         table_bounds: (x_min, y_min, x_max, y_max) of the table top.
         hand_width: the hand's (gripper's) width, m.
+        goal: (2,) where every route ends.
     """
 
-    def __init__(self, rects: np.ndarray, table_bounds: tuple[float, float, float, float], hand_width: float) -> None:
+    def __init__(self, rects: np.ndarray, ids: np.ndarray, table_bounds: tuple[float, float, float, float],
+                 hand_width: float, goal: np.ndarray) -> None:
         half = hand_width / 2.0
         self.grown = np.asarray(rects, float).reshape(-1, 4) + np.array([-half, -half, half, half])
-        g, e = self.grown, CORNER_OFFSET
+        self.ids = np.asarray(ids, dtype=int).reshape(-1)
+        self.goal = np.asarray(goal, float)
+        g, e = self.grown, CORNER_OFFSET * hand_width
         corners = np.concatenate([
             np.column_stack([g[:, 0] - e, g[:, 1] - e]), np.column_stack([g[:, 0] - e, g[:, 3] + e]),
             np.column_stack([g[:, 2] + e, g[:, 1] - e]), np.column_stack([g[:, 2] + e, g[:, 3] + e])])
@@ -86,66 +110,93 @@ class FreeRoutes:
         self.corners, self.owner = corners[keep], owner[keep]
         n = len(self.corners)
         self._edge_hits = segment_hits(np.repeat(self.corners, n, axis=0), np.tile(self.corners, (n, 1)),
-                                       self.grown).reshape(n, n, -1)
+                                       self.grown).reshape(n, n, len(g))
         self._edge_length = np.linalg.norm(self.corners[:, None] - self.corners[None], axis=2)
-        self._distances: dict[frozenset[int], np.ndarray] = {}
+        self._corners_to_goal = self.sight(self.corners)
+        self._tables: dict[frozenset[int], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
-    def kept(self, removed: frozenset[int]) -> np.ndarray:
-        """(m,) which obstacles stand (not ``removed``)."""
-        kept = np.ones(len(self.grown), dtype=bool)
-        kept[list(removed)] = False
-        return kept
+    def kept(self, removed: Collection[int]) -> np.ndarray:
+        """(m,) which obstacles stand (their ids not in ``removed``)."""
+        return ~np.isin(self.ids, list(removed))
 
-    def corner_distances(self, removed: frozenset[int] = frozenset()) -> np.ndarray:
-        """(c, c) shortest route lengths between the corners, the ``removed`` obstacles taken away
-        (their own corners unusable: inf)."""
-        if removed not in self._distances:
+    def tables(self, removed: frozenset[int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(kept (m,), corner distances (c, c), corner route lengths to the goal (c,)) with the
+        ``removed`` obstacles taken away (their corners stay: points of the free space)."""
+        if removed not in self._tables:
             kept = self.kept(removed)
-            usable = kept[self.owner]
-            open_ = ~self._edge_hits[:, :, kept].any(axis=2) & usable[:, None] & usable[None, :]
-            self._distances[removed] = all_pairs_shortest(np.where(open_, self._edge_length, np.inf))
-        return self._distances[removed]
+            open_ = ~self._edge_hits[:, :, kept].any(axis=2)
+            distances = all_pairs_shortest(np.where(open_, self._edge_length, np.inf))
+            sight = self._corners_to_goal
+            straight = np.where(sight.goal_hits[:, kept].any(axis=1), np.inf, sight.goal_length)
+            to_goal = np.min(distances + straight[None, :], axis=1) if len(straight) else straight
+            self._tables[removed] = (kept, distances, to_goal)
+        return self._tables[removed]
 
-    def query(self, points: np.ndarray) -> RouteQuery:
-        """Routes between ``points`` (p, 2)."""
-        return RouteQuery(self, points)
+    def sight(self, points: np.ndarray, pairs: tuple[np.ndarray, np.ndarray] | None = None):
+        """What the ``points`` (p, 2) see; with ``pairs`` (starts (q, 2), ends (q, 2)) also which
+        grown obstacles each of those straight ways passes through, (q, m): ``(Sight, hits)``.
+        One segment test for all."""
+        points = np.asarray(points, float).reshape(-1, 2)
+        c, m = len(self.corners), len(self.grown)
+        ends = np.vstack([self.corners, self.goal[None]])
+        starts, stops = np.repeat(points, c + 1, axis=0), np.tile(ends, (len(points), 1))
+        if pairs is not None:
+            starts, stops = np.vstack([starts, pairs[0]]), np.vstack([stops, pairs[1]])
+        hits = segment_hits(starts, stops, self.grown)
+        seen = hits[: len(points) * (c + 1)].reshape(len(points), c + 1, m)
+        length = np.linalg.norm(points[:, None] - ends[None], axis=2)
+        sight = Sight(points, seen[:, :c], length[:, :c], seen[:, c], length[:, c])
+        return sight if pairs is None else (sight, hits[len(points) * (c + 1):])
 
-    def lengths(self, a: np.ndarray, b: np.ndarray, removed: Iterable[int] = ()) -> np.ndarray:
-        """(n, k) shortest route lengths from each of ``a`` (n, 2) to each of ``b`` (k, 2), the
-        obstacles ``removed`` taken away; inf where there is none."""
-        a, b = np.asarray(a, float).reshape(-1, 2), np.asarray(b, float).reshape(-1, 2)
-        return self.query(np.vstack([a, b])).lengths(removed)[: len(a), len(a) :]
-
-
-class RouteQuery:
-    """Shortest routes between a few points, with any obstacles taken away (``lengths``)."""
-
-    def __init__(self, routes: FreeRoutes, points: np.ndarray) -> None:
-        self.routes = routes
-        self.points = np.asarray(points, float).reshape(-1, 2)
-        p, c = len(self.points), len(routes.corners)
-        pairs = segment_hits(np.repeat(self.points, p, axis=0), np.tile(self.points, (p, 1)), routes.grown)
-        self._direct_hits = pairs.reshape(p, p, -1)
-        self._direct_length = np.linalg.norm(self.points[:, None] - self.points[None], axis=2)
-        reach = segment_hits(np.repeat(self.points, c, axis=0), np.tile(routes.corners, (p, 1)), routes.grown)
-        self._reach_hits = reach.reshape(p, c, -1)
-        self._reach_length = np.linalg.norm(self.points[:, None] - routes.corners[None], axis=2)
-
-    def lengths(self, removed: Iterable[int] = (), sources: np.ndarray | None = None,
-                targets: np.ndarray | None = None) -> np.ndarray:
-        """Shortest route lengths between the points (rows ``sources``, columns ``targets``: index
-        arrays, default all), the obstacles ``removed`` taken away; inf where there is none."""
-        removed = frozenset(int(k) for k in removed)
-        every = np.arange(len(self.points))
-        sources = every if sources is None else np.asarray(sources, int)
-        targets = every if targets is None else np.asarray(targets, int)
-        kept = self.routes.kept(removed)
-        direct = np.where(self._direct_hits[np.ix_(sources, targets)][:, :, kept].any(axis=2), np.inf,
-                          self._direct_length[np.ix_(sources, targets)])
-        if len(self.routes.corners) == 0:
+    def to_goal(self, sight: Sight, rows: np.ndarray, removed: frozenset[int]) -> np.ndarray:
+        """Route lengths from the points ``rows`` of ``sight`` to the goal (inf: no route)."""
+        kept, _, to_goal = self.tables(removed)
+        direct = np.where(sight.goal_hits[rows][:, kept].any(axis=1), np.inf, sight.goal_length[rows])
+        if len(self.corners) == 0:
             return direct
-        unusable = ~kept[self.routes.owner]
-        reach = np.where(self._reach_hits[:, :, kept].any(axis=2) | unusable[None], np.inf, self._reach_length)
-        to_corner = np.min(reach[sources, :, None] + self.routes.corner_distances(removed)[None], axis=1)
-        via = np.min(to_corner[:, None, :] + reach[targets][None, :, :], axis=2)
-        return np.minimum(direct, via)
+        reach = self._reach(sight, rows, kept)
+        return np.minimum(direct, np.min(reach + to_goal[None], axis=1))
+
+    def to_goal_without(self, sight: Sight, rows: np.ndarray, removed: frozenset[int], obstacle: int) -> np.ndarray:
+        """As ``to_goal`` with the obstacle of id ``obstacle`` taken away too, without a new corner
+        graph: the shortest route then crosses the obstacle's (convex) place at most once, along a
+        straight way that it alone blocked, between the point or a corner the route reaches with
+        it standing and a corner (or the goal) it reaches the goal from."""
+        kept, distances, to_goal = self.tables(removed)
+        base = self.to_goal(sight, rows, removed)
+        r = int(np.flatnonzero(self.ids == obstacle)[0])
+        if not kept[r]:
+            return base
+        others = kept.copy()
+        others[r] = False
+        def crossing(hits: np.ndarray) -> np.ndarray:  # blocked by the obstacle and by no other
+            return hits[..., r] & ~hits[..., others].any(axis=-1)
+
+        direct = np.where(crossing(sight.goal_hits[rows]), sight.goal_length[rows], np.inf)
+        best = np.minimum(base, direct)
+        if len(self.corners) == 0:
+            return best
+        reach = self._reach(sight, rows, kept)  # (n, c) with the obstacle standing
+        from_point = np.min(reach[:, :, None] + distances[None], axis=1)  # (n, c)
+        through = np.where(crossing(sight.corner_hits[rows]), sight.corner_length[rows], np.inf)
+        edge = np.where(crossing(self._edge_hits), self._edge_length, np.inf)
+        last = np.where(crossing(self._corners_to_goal.goal_hits), self._corners_to_goal.goal_length, np.inf)
+        via_edge = np.min(from_point[:, :, None] + edge[None] + to_goal[None, None, :], axis=(1, 2))
+        return np.minimum.reduce([best, np.min(through + to_goal[None], axis=1), np.min(from_point + last[None], axis=1),
+                                  via_edge])
+
+    def between(self, sight: Sight, sources: np.ndarray, targets: np.ndarray, direct_hits: np.ndarray,
+                removed: frozenset[int]) -> np.ndarray:
+        """Route lengths from the points ``sources`` to the points ``targets`` of ``sight``, pair
+        by pair; ``direct_hits`` (pairs, m): which grown obstacles each straight way passes through."""
+        kept, distances, _ = self.tables(removed)
+        straight = np.linalg.norm(sight.points[sources] - sight.points[targets], axis=1)
+        direct = np.where(direct_hits[:, kept].any(axis=1), np.inf, straight)
+        if len(self.corners) == 0:
+            return direct
+        reach = self._reach(sight, np.concatenate([sources, targets]), kept)
+        from_source = np.min(reach[: len(sources), :, None] + distances[None], axis=1)  # (pairs, c)
+        return np.minimum(direct, np.min(from_source + reach[len(sources):], axis=1))
+
+    def _reach(self, sight: Sight, rows: np.ndarray, kept: np.ndarray) -> np.ndarray:
+        return np.where(sight.corner_hits[rows][:, :, kept].any(axis=2), np.inf, sight.corner_length[rows])

@@ -1,0 +1,101 @@
+"""People's plans written out, for tests of the blocks downstream of the planner (transfer, IK, optimiser).
+
+``human_plan`` lays a list of decisions out as the planners do: a gap at its centre, a move at the
+obstacle's centre and its release at the centre of its relocated region, then the target. The
+plans below are the ones the bundled models of the previous release made for those scenes; a test
+that pins them tests its block, whatever the planner now makes of the scene.
+"""
+
+from __future__ import annotations
+
+from hlp_drake.planner import HighLevelPlan, PlanCandidate, PlanKeypoint
+from hlp_drake.scene.model import Scene
+from hlp_drake.taskspace import TaskSpace
+from hlp_drake.taskspace.relocation import relocated
+
+Step = tuple[str, str | int, str | None]  # ("gap", row, gap index) or ("move", obstacle, direction)
+
+
+def keypoints(scene: Scene, steps: list[Step]) -> tuple[PlanKeypoint, ...]:
+    space = TaskSpace(scene)
+    row_of = {n: row.index for row in space.rows for n in row.members}
+    out = [PlanKeypoint("start", (float(scene.start[0]), float(scene.start[1])))]
+    for kind, what, how in steps:
+        if kind == "gap":
+            gap = space.gaps[int(what) - 1][int(how) - 1]
+            out.append(PlanKeypoint("gap", gap.center, int(what), str(how)))
+        else:
+            rect, row = space.rects[what], row_of[what]
+            out += [PlanKeypoint("move", rect.center, row, what, how),
+                    PlanKeypoint("release", relocated(rect, how, space.alpha).center, row, what, how)]
+    out.append(PlanKeypoint("target", space.target.center, None, scene.target.name))
+    return tuple(out)
+
+
+def human_plan(scene: Scene, steps: list[Step], alternatives: list[list[Step]] = ()) -> HighLevelPlan:
+    """The plan of ``steps`` (and its next candidates ``alternatives``, best first)."""
+    return HighLevelPlan(scene.name, keypoints(scene, steps),
+                         alternatives=tuple(PlanCandidate(keypoints(scene, a), 0.0) for a in alternatives))
+
+
+# gen1 seed 27: a backward move with no room for the robot's sideways push, then a push to the right.
+GEN1_27 = [("move", "FailOnTouchObstacleMed", "BL"), ("move", "FailOnTouchObstacleLong-1", "RR")]
+# gen1 seed 19: through gap 2, then FailOnTouchObstacleLong-1 forwards, over the table.
+GEN1_19 = [("gap", 1, 2), ("move", "FailOnTouchObstacleLong-1", "FF")]
+# gen2 seed 12, 9 objects.
+GEN2_9_12 = [("move", "obstacle_4", "BL"), ("gap", 2, 2), ("move", "obstacle_1", "RR"), ("gap", 4, 3), ("gap", 5, 2)]
+# gen2 seed 39, 9 objects, and its next four candidates.
+GEN2_9_39 = [("move", "obstacle_1", "FF"), ("move", "obstacle_9", "LL"), ("move", "obstacle_6", "FF"),
+             ("move", "obstacle_3", "LL"), ("gap", 5, 1)]
+GEN2_9_39_NEXT = [
+    [("gap", 1, 3), ("move", "obstacle_9", "LL"), ("move", "obstacle_6", "FF"), ("move", "obstacle_3", "LL"),
+     ("gap", 5, 1)],
+    [("gap", 1, 3), ("move", "obstacle_9", "LL"), ("gap", 3, 2), ("move", "obstacle_3", "LL"), ("gap", 5, 1)],
+    [("move", "obstacle_1", "FF"), ("move", "obstacle_9", "LL"), ("gap", 3, 2), ("move", "obstacle_3", "LL"),
+     ("gap", 5, 1)],
+    [("gap", 1, 3), ("move", "obstacle_9", "LL"), ("move", "obstacle_6", "FF"), ("gap", 4, 2),
+     ("move", "obstacle_5", "LL")],
+]
+# gen1 seed 15: both moves; on the way to the first push start open fingers straddle a small obstacle.
+GEN1_15 = [("move", "FailOnTouchObstacleLong", "BL"), ("move", "FailOnTouchObstacleMed-1", "RR")]
+
+
+def plan_chain(scenario, human: HighLevelPlan, pool=None):
+    """The planning diagram's chain after the planner, fed a fixed person's plan: a constant plan
+    source -> RobotPlanTransfer -> KeypointIk (-> the optimiser, with a ``pool``); the scene is the
+    scenario's, fixed. Outputs as ``make_planning_diagram``'s (but ``plan``)."""
+    from pydrake.common.value import AbstractValue
+    from pydrake.systems.framework import DiagramBuilder
+    from pydrake.systems.primitives import ConstantValueSource
+
+    from hlp_drake.systems import KeypointIk, RobotPlanTransfer, StochasticTrajectoryOptimiser
+
+    builder = DiagramBuilder()
+    source = builder.AddSystem(ConstantValueSource(AbstractValue.Make(human)))
+    scene = builder.AddSystem(ConstantValueSource(AbstractValue.Make(scenario.scene)))
+    transfer = builder.AddNamedSystem("robot_plan_transfer", RobotPlanTransfer(scenario))
+    ik = builder.AddNamedSystem("keypoint_ik", KeypointIk(scenario))
+    builder.Connect(source.get_output_port(), transfer.get_plan_input_port())
+    builder.Connect(scene.get_output_port(), transfer.get_scene_input_port())
+    builder.Connect(transfer.get_robot_plan_output_port(), ik.get_plan_input_port())
+    builder.Connect(transfer.get_robot_alternatives_output_port(), ik.get_alternatives_input_port())
+    builder.ExportOutput(transfer.get_robot_plan_output_port(), "robot_plan")
+    builder.ExportOutput(ik.get_trajectory_output_port(), "trajectory")
+    if pool is not None:
+        optimiser = builder.AddNamedSystem("optimiser", StochasticTrajectoryOptimiser(scenario, pool))
+        builder.Connect(scene.get_output_port(), optimiser.get_scene_input_port())
+        builder.Connect(ik.get_trajectory_output_port(), optimiser.get_initial_trajectory_input_port())
+        builder.Connect(ik.get_alternative_trajectories_output_port(), optimiser.get_alternatives_input_port())
+        builder.ExportOutput(optimiser.get_result_output_port(), "optimisation")
+    return builder.Build()
+
+
+def chain_first_rollout(scenario, human: HighLevelPlan):
+    """The optimiser's first rollout of the initial trajectory of ``human``'s robot plan."""
+    from hlp_drake.systems.control_sequence import ControlSequence
+    from hlp_drake.systems.scene_rollouts import SceneRollouts
+
+    diagram = plan_chain(scenario, human)
+    trajectory = diagram.GetOutputPort("trajectory").Eval(diagram.CreateDefaultContext())
+    sequence = ControlSequence.from_trajectory(trajectory, scenario.optimiser.step_duration)
+    return SceneRollouts(scenario).rollout(sequence)

@@ -1,0 +1,104 @@
+"""Row-choice features and free-space routes on constructed scenes (no dataset)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from hlp_drake.features.row_choice import ROW_CHOICE_FEATURES, RowChoiceScene
+from hlp_drake.scene.generators import generate_scene
+from hlp_drake.scene.model import Scene, SceneObject, Table
+from hlp_drake.taskspace import TaskSpace
+from hlp_drake.taskspace.routes import FreeRoutes, segment_hits, segment_inside
+
+COLUMN = {name: k for k, name in enumerate(ROW_CHOICE_FEATURES)}
+
+
+def _wall_scene(gap_left: float, gap_right: float) -> Scene:
+    """A 1 m table with one row of two boxes at x = 0.5 leaving a gap between y = gap_right and
+    y = gap_left, the start and the target on the centre line."""
+    table = Table(1.0, 1.0, 0.7)
+    left = SceneObject("left", "box", 0.5, (gap_left + 0.5) / 2.0, (0.05, 0.5 - gap_left, 0.1))
+    right = SceneObject("right", "box", 0.5, (gap_right - 0.5) / 2.0, (0.05, gap_right + 0.5, 0.1))
+    return Scene(table, (0.1, 0.0), SceneObject("Target", "cylinder", 0.9, 0.0, (0.05, 0.05, 0.1)), (left, right))
+
+
+def _scaled(scene: Scene, s: float) -> Scene:
+    def obj(o: SceneObject) -> SceneObject:
+        return replace(o, x=o.x * s, y=o.y * s, size=(o.size[0] * s, o.size[1] * s, o.size[2]))
+
+    return Scene(Table(scene.table.length * s, scene.table.width * s, scene.table.height),
+                 (scene.start[0] * s, scene.start[1] * s), obj(scene.target), tuple(obj(o) for o in scene.obstacles))
+
+
+def test_segments_through_rectangles():
+    rects = np.array([[0.0, 0.0, 1.0, 1.0]])
+    starts, ends = np.array([[-1.0, 0.5], [-1.0, 1.0], [0.5, 0.5]]), np.array([[2.0, 0.5], [2.0, 1.0], [0.5, 2.0]])
+    assert segment_hits(starts, ends, rects)[:, 0].tolist() == [True, False, True]  # along an edge: no hit
+    assert segment_inside(starts, ends, rects)[:, 0] == pytest.approx([1.0, 0.0, 0.5])
+
+
+def test_routes_go_round_the_obstacles_or_through_a_gap():
+    # A wall across the table with a gap 0.2 m wide on the left; the hand 0.05 m wide.
+    scene = _wall_scene(gap_left=0.3, gap_right=0.1)
+    space = TaskSpace(scene)
+    goal = np.array(space.target.center)
+    routes = FreeRoutes(space.obstacle_bounds, np.arange(2), scene.table.bounds, 0.05, goal)
+    start = np.array(scene.start)
+    sight = routes.sight(start)
+    # Round the right box grown by half the hand's width (x 0.45-0.55, y up to 0.125).
+    corner_front, corner_back = np.array([0.45, 0.125]), np.array([0.55, 0.125])
+    expected = np.linalg.norm(corner_front - start) + 0.1 + np.linalg.norm(goal - corner_back)
+    assert routes.to_goal(sight, np.array([0]), frozenset())[0] == pytest.approx(expected, abs=1e-5)
+    # With the blocking box moved away the way is straight.
+    assert routes.to_goal(sight, np.array([0]), frozenset({1}))[0] == pytest.approx(np.linalg.norm(goal - start))
+    # A gap narrower than the hand closes the way: no route at all.
+    closed = _wall_scene(gap_left=0.12, gap_right=0.1)
+    space = TaskSpace(closed)
+    routes = FreeRoutes(space.obstacle_bounds, np.arange(2), closed.table.bounds, 0.05, goal)
+    assert not np.isfinite(routes.to_goal(routes.sight(start), np.array([0]), frozenset())[0])
+
+
+def test_candidates_of_a_row_and_their_features():
+    scene = _wall_scene(gap_left=0.3, gap_right=0.1)
+    features = RowChoiceScene(TaskSpace(scene), 0.05)
+    candidates, = features.candidates(1, np.array(scene.start))
+    assert candidates.kinds == ("gap", "object", "object")  # the one gap, then the boxes from left to right
+    X = candidates.X
+    middle = 0
+    assert candidates.points[middle] == pytest.approx([0.5, 0.125])  # nearest the line where the hand fits
+    assert X[middle, COLUMN["size"]] == pytest.approx(4.0)  # 0.2 m in hand widths
+    assert X[middle, COLUMN["offset"]] == pytest.approx(2.5)  # 0.125 m off the line
+    assert X[1:, COLUMN["is_object"]].tolist() == [1.0, 1.0]
+    right = 2
+    assert candidates.obstacles[right] == 1 and X[right, COLUMN["corridor_overlap"]] == pytest.approx(1.0)
+    assert X[right, COLUMN["route_gain"]] > 0.0 and X[1, COLUMN["route_gain"]] == 0.0  # only the one in the way
+    assert X[middle, COLUMN["route_via"]] == pytest.approx(1.0)  # the shortest route passes through it
+    assert X[:, COLUMN["row_best_offset"]] == pytest.approx(2.5)
+
+
+def test_features_mean_the_same_on_any_table():
+    """Scaling a scene and the hand's width alike leaves every feature unchanged."""
+    scene = generate_scene("unstructured", 4)
+    for s in (0.5, 1.7):
+        a, b = RowChoiceScene(TaskSpace(scene), 0.05), RowChoiceScene(TaskSpace(_scaled(scene, s)), 0.05 * s)
+        for row in range(1, len(TaskSpace(scene).rows) + 1):
+            hand = np.array(scene.start)
+            (x,), (y,) = a.candidates(row, hand), b.candidates(row, hand * s)
+            assert x.kinds == y.kinds
+            np.testing.assert_allclose(x.X, y.X, atol=1e-7)
+
+
+def test_one_call_for_several_hands_equals_one_call_each():
+    scene = generate_scene("gen2", 5, 9)
+    features = RowChoiceScene(TaskSpace(scene), 0.08)
+    hands = np.array([scene.start, (0.2, 0.1), (0.3, -0.2)])
+    removed = [frozenset(), frozenset({0}), frozenset({1, 2})]
+    together = features.candidates(2, hands, removed, limit=3)
+    for hand, gone, batch in zip(hands, removed, together):
+        alone, = features.candidates(2, hand, [gone], limit=3)
+        assert alone.kinds == batch.kinds
+        np.testing.assert_allclose(alone.X, batch.X)
+        np.testing.assert_allclose(alone.points, batch.points)

@@ -46,6 +46,15 @@ class ProgressListener:
             self._bar.close()
             self._bar = None
 
+    def perceived(self, perception, seconds: float) -> None:
+        if perception.ok:
+            what = f"{len(perception.objects)} objects, the target {perception.objects[0].name}"
+        else:
+            what = f"failed: {perception.reason}"
+        self._line(
+            f"perceive: {what} ({seconds:.2f} s: perception {perception.perception_s:.3f} s, the rest rendering)"
+        )
+
     def planned(self, plan, seconds: float) -> None:
         what = f"plan: {plan_steps(plan)}" if plan.ok else f"plan: none ({plan.reason})"
         self._line(f"{what} ({seconds:.2f} s)")

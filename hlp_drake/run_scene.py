@@ -1,10 +1,12 @@
 """Plan a scene with the human-like planner (or the straight line), optimise it with the STO and run it in Drake.
 
     python -m hlp_drake.run_scene [--scene FILE | --kind vr|gen1|gen2|unstructured --seed N [--objects K]]
-        [--planner hlp|sto] [--config SCENARIO.yaml] [--workers N] [--meshcat] [--html FILE]
-        [--contact-forces] [--json FILE] [--quiet]
+        [--planner hlp|sto] [--perception truth|camera] [--config SCENARIO.yaml] [--workers N]
+        [--meshcat] [--html FILE] [--contact-forces] [--json FILE] [--quiet]
 
-With no arguments it runs the bundled default scene with the bundled models. Each stage is printed
+With no arguments it runs the bundled default scene with the bundled models. With --perception camera
+the planner, IK and optimiser work on the scene the world's cameras see (ScenePerception) while the
+simulation runs the true one; the JSON's perception record compares the two. Each stage is printed
 as it happens (plan, IK, the optimiser's rollouts, the execution's simulated time), then a summary.
 Exit status: 0 on success, 1 when the run failed (the reason is printed), 2 on bad input.
 """
@@ -22,6 +24,8 @@ from hlp_drake.cli import add_quiet, make_parser, run_cli
 from hlp_drake.errors import HlpError
 from hlp_drake.scene.generators import KINDS, generate_scene
 from hlp_drake.scene.io import DEFAULT_SCENE_FILE, load_scene
+
+PERCEPTION_SOURCES = ("truth", "camera")  # hlp_drake.systems.perception_config's, without importing Drake
 
 DEFAULT_SCENE = DEFAULT_SCENE_FILE
 PROG = "python -m hlp_drake.run_scene"
@@ -66,6 +70,11 @@ def _parser():
         "baseline's straight line (sto)",
     )
     parser.add_argument(
+        "--perception",
+        choices=PERCEPTION_SOURCES,
+        help="plan on the true scene (truth, the default) or on what the scenario's cameras see (camera)",
+    )
+    parser.add_argument(
         "--config",
         metavar="SCENARIO.yaml",
         help="scenario settings (see hlp_drake.systems.Scenario); --scene or --kind replace its scene",
@@ -104,6 +113,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         scene=scene or scenario.scene,
         planner=replace(scenario.planner, kind=args.planner or scenario.planner.kind),
         optimiser=replace(scenario.optimiser, workers=args.workers or scenario.optimiser.workers),
+        perception=replace(scenario.perception, source=args.perception or scenario.perception.source),
     )
     if scene is None:
         _print(

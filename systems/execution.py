@@ -1,8 +1,10 @@
 """Plan, solve IK, optimise and execute in the physics world: what ``python -m hlp_drake.run_scene`` runs.
 
 ``plan_and_execute(scenario, pool=...)`` builds one diagram: the world (the scenario's plant at its
-own time step), ``SceneFromPlant`` on its body poses feeding the planning diagram, and a trajectory
-source driving the robot. It evaluates the plan, the keyframes and the optimisation at the start,
+own time step), the scene source feeding the planning diagram (``SceneFromPlant`` on the world's
+body poses, or with ``perception.source: camera`` ``ScenePerception`` on its cameras: the planner,
+IK and optimiser then work on the perceived scene while the world simulates the true one), and a
+trajectory source driving the robot. It evaluates the plan, the keyframes and the optimisation at the start,
 plays the optimised trajectory, checks the reach, then closes the gripper and lifts. A
 ``RunListener`` hears of every stage as it happens.
 """
@@ -25,14 +27,17 @@ from hlp_drake.scene.model import Scene
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.grasp import grasp_knots
 from hlp_drake.systems.keyframes import Keyframes
-from hlp_drake.systems.meshcat_view import draw_plan, frame_table
+from hlp_drake.systems.meshcat_view import draw_perception, draw_plan, frame_table
 from hlp_drake.systems.optimiser import StoResult
+from hlp_drake.systems.perception import Perception
+from hlp_drake.systems.perception_errors import perception_record
 from hlp_drake.systems.planning_diagram import make_planning_diagram
 from hlp_drake.systems.robot import TCP_FRAME
 from hlp_drake.systems.rollout_cost import pregrasp_check, reach_problem
 from hlp_drake.systems.rollout_pool import RolloutPool
 from hlp_drake.systems.rollout_world import simulation_failure
 from hlp_drake.systems.scene_models import fallen_objects, object_body, object_planar_poses
+from hlp_drake.systems.scene_perception import add_scene_perception
 from hlp_drake.systems.scene_source import SCENE_PORT, SceneFromPlant
 from hlp_drake.systems.start_pose import tcp_keypoint_height
 from hlp_drake.systems.world import add_position_trajectory, make_world_diagram, world_plant
@@ -47,6 +52,9 @@ RECORDING_FPS = 32.0  # frames per second of a MeshCat recording
 
 class RunListener:
     """Hears of a run's stages as they happen (every method does nothing here; override what you need)."""
+
+    def perceived(self, perception: Perception, seconds: float) -> None:
+        """The cameras' frame is perceived (``seconds`` with the rendering; ``perception_s`` without)."""
 
     def planned(self, plan: HighLevelPlan, seconds: float) -> None:
         """The planner's plan is ready."""
@@ -90,6 +98,7 @@ class ExecutionResult:
     rollouts: int = 0
     optimisation: dict[str, Any] = field(default_factory=dict)
     grasp_held: bool | None = None
+    perception: dict[str, Any] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -109,6 +118,7 @@ class ExecutionResult:
             "rollouts": self.rollouts,
             "optimisation": self.optimisation,
             "grasp_held": self.grasp_held,
+            **({} if self.perception is None else {"perception": self.perception}),
         }
 
 
@@ -138,22 +148,36 @@ def plan_and_execute(
     """
     listener = listener or RunListener()
     scene = scenario.scene
+    camera = scenario.perception.source == "camera"
     builder = DiagramBuilder()
-    world = builder.AddSystem(make_world_diagram(scenario, meshcat=meshcat, contact_forces=contact_forces))
+    world = builder.AddSystem(
+        make_world_diagram(scenario, meshcat=meshcat, contact_forces=contact_forces, cameras=camera)
+    )
     plant, robot = world_plant(world)
     started = time.perf_counter()
     planning = builder.AddNamedSystem("planning", make_planning_diagram(scenario, pool=pool, models=models))
-    source = builder.AddNamedSystem("scene_from_plant", SceneFromPlant(plant, scene))
-    builder.Connect(world.GetOutputPort("body_poses"), source.get_body_poses_input_port())
+    if camera:
+        source = add_scene_perception(builder, world, scenario)
+    else:
+        source = builder.AddNamedSystem("scene_from_plant", SceneFromPlant(plant, scene))
+        builder.Connect(world.GetOutputPort("body_poses"), source.get_body_poses_input_port())
     builder.Connect(source.get_scene_output_port(), planning.GetInputPort(SCENE_PORT))
     start = plant.GetPositions(plant.CreateDefaultContext(), robot)
     hold = ControlSequence(np.array([0.0, 1.0]), np.vstack([start, start]))
     trajectory_source = add_position_trajectory(builder, world, hold.to_trajectory())
     simulator = Simulator(builder.Build())
+    perception, perceive_s = None, 0.0
+    if camera:  # rendering and perception, timed apart from the planner
+        seen = time.perf_counter()
+        perception = source.get_perception_output_port().Eval(
+            source.GetMyContextFromRoot(simulator.get_context())
+        )
+        perceive_s = time.perf_counter() - seen
+        listener.perceived(perception, perceive_s)
     context = planning.GetMyContextFromRoot(simulator.get_mutable_context())
     plan: HighLevelPlan = planning.GetOutputPort("plan").Eval(context)
     planned = time.perf_counter()
-    listener.planned(plan, planned - started)
+    listener.planned(plan, planned - started - perceive_s)
     keyframes: Keyframes = planning.GetOutputPort("keyframes").Eval(context)
     trajectory = planning.GetOutputPort("trajectory").Eval(context)
     solved = time.perf_counter()
@@ -161,8 +185,13 @@ def plan_and_execute(
     result = ExecutionResult(
         scenario.planner.kind, scene, plan, keyframes, planning.GetOutputPort("robot_plan").Eval(context)
     )
-    result.timings = {"plan_s": planned - started, "ik_s": solved - planned, "optimise_s": 0.0}
-    if not plan.ok:
+    result.timings = {"plan_s": planned - started - perceive_s, "ik_s": solved - planned, "optimise_s": 0.0}
+    if camera:
+        result.perception = perception_record(scene, perception)
+        result.timings["perceive_s"] = perceive_s
+    if perception is not None and not perception.ok:
+        result.failure_reason = f"perception failed: {perception.reason}"
+    elif not plan.ok:
         result.failure_reason = f"no plan: {plan.reason}"
     elif not keyframes.ok:
         result.failure_reason = "IK failed: " + "; ".join(keyframes.failures)
@@ -188,6 +217,8 @@ def plan_and_execute(
         }
         draw_plan(meshcat, plan, path="plan", markers=False, **heights)
         draw_plan(meshcat, result.robot_plan, path="robot_plan", **heights)
+        if perception is not None:
+            draw_perception(meshcat, perception)
     _execute(result, simulator, trajectory_source, sequence, scenario, meshcat, listener)
     executed = time.perf_counter()
     result.success = result.failure_reason is None

@@ -1,13 +1,16 @@
-"""What a run shows in MeshCat: the camera framed on the table, the plans as path lines with keypoint markers."""
+"""What a run shows in MeshCat: the camera framed on the table, the plans as path lines with keypoint
+markers, and what the cameras perceived (the point cloud and the fitted objects)."""
 
 from __future__ import annotations
 
 import numpy as np
-from pydrake.geometry import Meshcat, Rgba, Sphere
-from pydrake.math import RigidTransform
+from pydrake.geometry import Box, Cylinder, Meshcat, Rgba, Sphere
+from pydrake.math import RigidTransform, RotationMatrix
 
 from hlp_drake.planner import HighLevelPlan
 from hlp_drake.scene.model import Scene
+from hlp_drake.systems.perception import Perception
+from hlp_drake.systems.scene_perception import perception_cloud
 
 ACTION_COLOURS = {
     "start": Rgba(0.1, 0.1, 0.1, 1),
@@ -21,6 +24,10 @@ ACTION_COLOURS = {
 MARKER_RADIUS = 0.02
 """Keypoint markers, m: visible from the framed view across a robot-sized table."""
 PATH_COLOURS = {"plan": Rgba(0.2, 0.2, 0.2, 1), "robot_plan": Rgba(0.1, 0.45, 0.9, 1)}
+PERCEIVED_COLOURS = {"target": Rgba(1.0, 0.55, 0.0, 0.45), "obstacle": Rgba(0.95, 0.85, 0.1, 0.45)}
+"""The fitted objects, translucent over the true ones."""
+CLOUD_VOXEL = 0.005
+"""The drawn point cloud is Drake's voxel down-sampling of the frame's at this size, m."""
 
 
 def frame_table(meshcat: Meshcat, scene: Scene) -> None:
@@ -64,3 +71,21 @@ def draw_plan(
             name, Sphere(MARKER_RADIUS), ACTION_COLOURS.get(keypoint.action, Rgba(0.5, 0.5, 0.5, 1))
         )
         meshcat.SetTransform(name, RigidTransform(point))
+
+
+def draw_perception(meshcat: Meshcat, perception: Perception, *, path: str = "perception") -> None:
+    """``perception`` under ``path``: the frame's point cloud (``points``, coloured by class) and
+    each fitted object (``objects/<name>``: a translucent box or cylinder on the fitted table)."""
+    meshcat.Delete(path)
+    cloud = perception_cloud(perception).VoxelizedDownSample(voxel_size=CLOUD_VOXEL)
+    meshcat.SetObject(f"{path}/points", cloud, point_size=0.004)
+    if perception.table is None:
+        return
+    for obj in perception.objects:
+        sx, sy, height = obj.size
+        shape = Cylinder(sx / 2.0, height) if obj.shape == "cylinder" else Box(sx, sy, height)
+        role = "target" if obj is perception.objects[0] and perception.ok else "obstacle"
+        name = f"{path}/objects/{obj.name or 'unnamed'}"
+        meshcat.SetObject(name, shape, PERCEIVED_COLOURS[role])
+        z = perception.table.height_at(obj.x, obj.y) + height / 2.0
+        meshcat.SetTransform(name, RigidTransform(RotationMatrix.MakeZRotation(obj.yaw), [obj.x, obj.y, z]))

@@ -101,7 +101,7 @@ class RolloutWorld:
         self.welded_objects = frozenset(welded_objects)
         builder = DiagramBuilder()
         world = builder.AddSystem(
-            make_world_diagram(rollout_scenario(scenario), welded_objects=self.welded_objects)
+            make_world_diagram(rollout_scenario(scenario), welded_objects=self.welded_objects, cameras=False)
         )
         plant, robot = world_plant(world)
         start = plant.GetPositions(plant.CreateDefaultContext(), robot)

@@ -34,6 +34,7 @@ from hlp_drake.scene.io import default_scene
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.validation import scene_problems
 from hlp_drake.systems.optimiser_config import StoConfig
+from hlp_drake.systems.perception_config import PerceptionConfig
 from hlp_drake.systems.scenario_checks import scenario_problems
 from hlp_drake.systems.transfer_geometry import TransferConfig
 from hlp_drake.systems.world_settings import (
@@ -85,6 +86,8 @@ class Scenario:
         transfer: the push transfer's margins (the robot's sizes come from its model).
         optimiser: the stochastic trajectory optimiser.
         grasp: the grasp and lift after the reach.
+        perception: where the planning blocks' scene comes from (the plant, or the cameras through
+            ``ScenePerception``), the world's cameras and the perception block's settings.
     """
 
     scene: Scene = field(default_factory=default_scene)
@@ -98,6 +101,7 @@ class Scenario:
     transfer: TransferConfig = field(default_factory=TransferConfig)
     optimiser: StoConfig = field(default_factory=StoConfig)
     grasp: GraspConfig = field(default_factory=GraspConfig)
+    perception: PerceptionConfig = field(default_factory=PerceptionConfig)
 
     @cached_property
     def yaml(self) -> str:

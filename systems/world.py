@@ -45,6 +45,7 @@ from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import MatrixGain, TrajectorySource
 from pydrake.trajectories import Trajectory
 
+from hlp_drake.systems.cameras import add_cameras, label_classes
 from hlp_drake.systems.robot import ARM_JOINTS, BASE_JOINTS, GRIPPER_JOINTS, ROBOT_MODEL_NAME, add_robot
 from hlp_drake.systems.scene_models import add_scene
 from hlp_drake.systems.start_pose import robot_position_names, start_configuration
@@ -171,6 +172,7 @@ def make_world_diagram(
     meshcat: Meshcat | None = None,
     contact_forces: bool = False,
     welded_objects: Iterable[str] = (),
+    cameras: bool | None = None,
 ) -> Diagram:
     """Build the world of ``scenario`` (its scene, plant, contact, bodies, controller and start pose):
     see the module's docstring for the ports.
@@ -181,6 +183,11 @@ def make_world_diagram(
         welded_objects: names of scene objects welded to the world at their scene poses instead of
             free (a reduced model: they neither move nor join the contact problem with the table);
             ``state`` then holds only the free objects' states.
+        cameras: add the scenario's cameras (``perception.cameras``; their ports: see
+            ``hlp_drake.systems.cameras``), rendered only when their images are evaluated; None (the
+            default): when the scenario perceives the scene through them (``perception.source:
+            camera``). Even unrendered, a camera costs ~10 % of the simulation's time (the render
+            engine follows every pose).
     """
     scene = scenario.scene
     builder = DiagramBuilder()
@@ -188,8 +195,13 @@ def make_world_diagram(
     instance = add_robot(plant)
     _set_robot_contact(plant, scene_graph, instance, scenario.contact)
     _set_pd_gains(plant, instance, scenario.controller)
-    add_scene(plant, scene, contact=scenario.contact, bodies=scenario.bodies, welded_objects=welded_objects)
+    models = add_scene(
+        plant, scene, contact=scenario.contact, bodies=scenario.bodies, welded_objects=welded_objects
+    )
     plant.Finalize()
+    if cameras or (cameras is None and scenario.perception.source == "camera"):
+        label_classes(plant, scene_graph, instance, models, scene)
+        add_cameras(builder, scene_graph, scenario)
     plant.SetDefaultPositions(instance, start_configuration(scene, scenario.ik, plant, instance))
 
     if scenario.controller.gravity_compensation:

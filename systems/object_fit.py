@@ -1,0 +1,207 @@
+"""The objects on the table from the points above it: clusters in plan view, their silhouettes, and
+an upright box (with yaw) or cylinder fitted to each.
+
+Seen from above, every point of an upright object (its top and the sides facing the camera) lies
+over its footprint, and the pixels where the object ends against something further away (the
+table, the background, a lower object) lie over the footprint's boundary: its *silhouette*.
+Where something nearer hides it (a taller object, the robot), the object's end in the image is an
+*occlusion* boundary, not its own. Shapes are fitted to the silhouette only, so a partly hidden
+object keeps the outline of what shows: a circle (least squares) or the rectangle, over the yaws,
+whose sides the silhouette lies on best; the one that fits better decides the shape.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import ConvexHull, cKDTree
+
+from hlp_drake.systems.depth_points import CameraView, Points, valid_depth
+
+NEARER = 0.005
+"""A neighbour pixel this much nearer the camera (m) hides what lies beyond: an occlusion boundary."""
+YAW_STEPS = 90
+"""Yaws tried over a quarter turn (1 degree apart) ..."""
+FINE_STEPS = 20
+"""... and on each side of the best of them (0.05 degrees apart)."""
+NEIGHBOURS = ((0, 1), (0, -1), (1, 0), (-1, 0))
+TOP_BAND = 0.005
+"""An object's top: its points within this (m) below the 99th percentile of their heights."""
+
+
+@dataclass(frozen=True)
+class Cluster:
+    """One object's points: its ``points`` and, per point, whether its pixel lies on the silhouette,
+    on an occlusion boundary or at the image's border."""
+
+    points: Points
+    silhouette: np.ndarray
+    occluded: np.ndarray
+    at_border: np.ndarray
+
+
+@dataclass(frozen=True)
+class Fit:
+    """An upright shape fitted to a cluster.
+
+    Attributes:
+        shape: "box" or "cylinder".
+        x, y, yaw: the footprint's centre and heading (a cylinder's yaw is 0), m and rad.
+        size: (own x, own y, height), m.
+        residual: root-mean-square distance of the silhouette from the fitted outline, m.
+    """
+
+    shape: str
+    x: float
+    y: float
+    yaw: float
+    size: tuple[float, float, float]
+    residual: float
+
+
+def cluster_points(points: Points, *, radius: float, min_points: int) -> list[np.ndarray]:
+    """Indices into ``points`` of each object's cluster (at least ``min_points`` points), largest first.
+
+    Single linkage in plan view: points closer than ``radius`` in x and y are one object's
+    (scipy's k-d tree pairs, then the graph's connected components). Objects stand apart on the
+    table and an upright object's points all lie over its footprint, so its top and its sides
+    join however tall it is, and two objects join only if their footprints come within ``radius``.
+    """
+    n = len(points)
+    if n < min_points:
+        return []
+    pairs = cKDTree(points.xyz[:, :2]).query_pairs(radius, output_type="ndarray")
+    graph = coo_matrix((np.ones(len(pairs), bool), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    _, labels = connected_components(graph, directed=False)
+    groups = np.split(np.argsort(labels, kind="stable"), np.cumsum(np.bincount(labels))[:-1])
+    return sorted((g for g in groups if len(g) >= min_points), key=len, reverse=True)
+
+
+def boundaries(
+    views: list[CameraView], points: Points, groups: list[np.ndarray], border: int
+) -> list[Cluster]:
+    """Each group of ``points`` with its silhouette, occlusion and border pixels (4-neighbours in
+    its camera's image: another group's pixel or the robot nearer by ``NEARER`` occludes; a pixel
+    without a depth tells nothing; anything else ends the object)."""
+    owner = [np.full(v.depth.shape, -1) for v in views]
+    for g, members in enumerate(groups):
+        for k in range(len(views)):
+            mine = members[points.camera[members] == k]
+            owner[k][points.row[mine], points.col[mine]] = g
+    clusters = []
+    for g, members in enumerate(groups):
+        sub = points.subset(members)
+        silhouette = np.zeros(len(sub), bool)
+        occluded = np.zeros(len(sub), bool)
+        at_border = np.zeros(len(sub), bool)
+        for k, view in enumerate(views):
+            here = sub.camera == k
+            if not here.any():
+                continue
+            h, w = view.depth.shape
+            row, col = sub.row[here], sub.col[here]
+            own = view.depth[row, col]
+            at_border[here] = (row < border) | (col < border) | (row >= h - border) | (col >= w - border)
+            sil, occ = np.zeros(len(row), bool), np.zeros(len(row), bool)
+            for dr, dc in NEIGHBOURS:
+                r, c = row + dr, col + dc
+                inside = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+                r, c = np.clip(r, 0, h - 1), np.clip(c, 0, w - 1)
+                other = owner[k][r, c] != g
+                depth = view.depth[r, c]
+                known = valid_depth(depth) | np.isposinf(depth)
+                nearer = (depth < own - NEARER) | (depth == 0)
+                occ |= inside & other & nearer
+                sil |= inside & other & known & ~nearer
+            silhouette[here], occluded[here] = sil & ~occ, occ
+        clusters.append(Cluster(sub, silhouette, occluded, at_border))
+    return clusters
+
+
+def _circle(xy: np.ndarray) -> tuple[float, float, float, float]:
+    """(x, y, radius, rms residual) of the least-squares circle through ``xy`` (Kasa's fit)."""
+    A = np.column_stack([2.0 * xy, np.ones(len(xy))])
+    (a, b, c), *_ = np.linalg.lstsq(A, (xy**2).sum(axis=1), rcond=None)
+    r = float(np.sqrt(max(c + a * a + b * b, 0.0)))
+    residual = float(np.sqrt(np.mean((np.hypot(xy[:, 0] - a, xy[:, 1] - b) - r) ** 2)))
+    return float(a), float(b), r, residual
+
+
+def _rectangles(yaws: np.ndarray, hull: np.ndarray, edge: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per yaw (k,): the RMS distance of the ``edge`` points from the nearest side of the rectangle
+    at that yaw around the ``hull`` points, and the rectangles' bounds (k, 4: u0, v0, u1, v1) in
+    their rotated frames."""
+    c, s = np.cos(yaws)[:, None], np.sin(yaws)[:, None]
+    hu, hv = hull[:, 0] * c + hull[:, 1] * s, -hull[:, 0] * s + hull[:, 1] * c
+    eu, ev = edge[:, 0] * c + edge[:, 1] * s, -edge[:, 0] * s + edge[:, 1] * c
+    lo_u, hi_u, lo_v, hi_v = (
+        hu.min(1, keepdims=True),
+        hu.max(1, keepdims=True),
+        hv.min(1, keepdims=True),
+        hv.max(1, keepdims=True),
+    )
+    d = np.minimum(np.minimum(eu - lo_u, hi_u - eu), np.minimum(ev - lo_v, hi_v - ev))
+    bounds = np.column_stack([lo_u[:, 0], lo_v[:, 0], hi_u[:, 0], hi_v[:, 0]])
+    return np.sqrt(np.mean(d**2, axis=1)), bounds
+
+
+def _rectangle(xy: np.ndarray, edge: np.ndarray) -> tuple[float, np.ndarray, float]:
+    """(yaw, bounds in the frame turned by it, rms residual) of the rectangle whose sides
+    ``edge`` lies on best: yaws 1 degree apart, then 0.05 degrees apart around the best."""
+    hull = xy[ConvexHull(xy).vertices] if len(xy) >= 3 else xy
+    step = (np.pi / 2) / YAW_STEPS
+    coarse = np.arange(YAW_STEPS) * step
+    best = coarse[int(np.argmin(_rectangles(coarse, hull, edge)[0]))]
+    fine = best + np.linspace(-step, step, 2 * FINE_STEPS + 1)
+    residuals, bounds = _rectangles(fine, hull, edge)
+    k = int(np.argmin(residuals))
+    return float(fine[k]), bounds[k], float(residuals[k])
+
+
+def _top(heights: np.ndarray) -> tuple[float, np.ndarray]:
+    """(height, per point whether it is on the top) of an object from its points' heights above
+    the table: its top is the points within ``TOP_BAND`` below the 99th percentile, its height their
+    median."""
+    on_top = heights >= np.percentile(heights, 99) - TOP_BAND
+    return float(np.median(heights[on_top])), on_top
+
+
+def fit_object(cluster: Cluster, heights: np.ndarray, pixel: float, *, cylinder: bool | None = None) -> Fit:
+    """The upright box or cylinder of ``cluster`` (a cylinder if ``cylinder`` is True, a box if
+    False, the better fit if None), as tall as its top above the table (``heights``: per point).
+
+    The silhouette's pixels on the top's edge lie inside the footprint by half a pixel (``pixel``
+    wide, m) on average, those on a side facing the camera on it: each side of the outline grows
+    by half a pixel times the share of its silhouette on the top.
+    """
+    xy = cluster.points.xyz[:, :2]
+    height, on_top = _top(heights)
+    enough = cluster.silhouette.sum() >= 8
+    edge = xy[cluster.silhouette] if enough else xy
+    top = on_top[cluster.silhouette] if enough else on_top
+    cx, cy, r, circle_residual = _circle(edge)
+    yaw, bounds, box_residual = (0.0, None, np.inf) if cylinder else _rectangle(xy, edge)
+    if cylinder or (cylinder is None and circle_residual < box_residual):
+        d = 2.0 * (r + pixel / 2.0 * float(np.mean(top)))
+        return Fit("cylinder", cx, cy, 0.0, (d, d, height), circle_residual)
+    c, s = np.cos(yaw), np.sin(yaw)
+    uv = edge @ np.array([[c, -s], [s, c]])
+    near = np.abs(uv[:, :, None] - bounds.reshape(2, 2).T[None, :, :]) <= max(pixel / 2.0, 1e-3)
+    grow = [
+        pixel / 2.0 * (float(np.mean(top[near[:, i % 2, i // 2]])) if near[:, i % 2, i // 2].any() else 0.0)
+        for i in range(4)
+    ]
+    u0, v0, u1, v1 = bounds - np.array(grow[:2] + [0, 0]) + np.array([0, 0] + grow[2:])
+    u, v = (u0 + u1) / 2.0, (v0 + v1) / 2.0
+    sides = [float(u1 - u0), float(v1 - v0)]
+    turns = round(yaw / (np.pi / 2))  # the same box with its yaw in [-pi/4, pi/4], sides swapped if odd
+    if turns % 2:
+        sides.reverse()
+    x, y = float(c * u - s * v), float(s * u + c * v)
+    return Fit("box", x, y, yaw - turns * np.pi / 2, (*sides, height), box_residual)
+
+
+__all__ = ["Cluster", "Fit", "boundaries", "cluster_points", "fit_object"]

@@ -1,0 +1,238 @@
+"""The cameras and ``ScenePerception`` on their own: a known scene rendered once (small images), its
+depth and label images fixed on the block's inputs, and synthetic frames for the bad-input cases."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.sensors import ImageDepth32F, ImageLabel16I
+
+from hlp_drake.scene.model import Scene, SceneObject, Table
+from hlp_drake.systems.cameras import TABLE_LABEL, TARGET_LABEL, DepthNoise, camera_pose
+from hlp_drake.systems.perception_config import CameraSettings, PerceptionConfig
+from hlp_drake.systems.perception_errors import perception_record
+from hlp_drake.systems.scenario import Scenario, load_scenario
+from hlp_drake.systems.scene_perception import ScenePerception, add_scene_perception
+from hlp_drake.systems.world import make_world_diagram
+
+CAMERA = CameraSettings(width=320, height=240, depth_noise=0.001, dropout=0.01, seed=4)
+SCENE = Scene(
+    name="perceived",
+    table=Table(length=0.8, width=0.9, height=0.75),
+    start=(0.1, 0.0),
+    target=SceneObject("Target", "cylinder", 0.6, 0.1, (0.066, 0.066, 0.12)),
+    obstacles=(
+        SceneObject("tilted_box", "box", 0.35, -0.2, (0.06, 0.15, 0.10), yaw=0.4),
+        SceneObject("box", "box", 0.55, -0.15, (0.08, 0.05, 0.14)),
+        SceneObject("can", "cylinder", 0.3, 0.2, (0.07, 0.07, 0.09)),
+    ),
+)
+SCENARIO = Scenario(scene=SCENE, perception=PerceptionConfig(source="camera", cameras=(CAMERA,)))
+
+
+@pytest.fixture(scope="module")
+def frame() -> dict[str, object]:
+    """The world's camera ports evaluated once at time 0: depth, label image and camera pose."""
+    world = make_world_diagram(SCENARIO)
+    context = world.CreateDefaultContext()
+    return {
+        port: world.GetOutputPort(f"{CAMERA.name}.{port}").Eval(context)
+        for port in ("depth_image", "label_image", "camera_pose")
+    }
+
+
+def perceive_fixed(depth, labels, pose, scenario: Scenario = SCENARIO):
+    """``ScenePerception``'s ``perception`` and ``scene`` outputs with its inputs fixed."""
+    block = ScenePerception(scenario)
+    context = block.CreateDefaultContext()
+    name = scenario.perception.cameras[0].name
+    block.GetInputPort(f"{name}.depth_image").FixValue(context, depth)
+    block.GetInputPort(f"{name}.label_image").FixValue(context, labels)
+    block.GetInputPort(f"{name}.camera_pose").FixValue(context, pose)
+    return block.get_perception_output_port().Eval(context), block.get_scene_output_port().Eval(context)
+
+
+def images(depth: np.ndarray, labels: np.ndarray) -> tuple[ImageDepth32F, ImageLabel16I]:
+    h, w = depth.shape
+    depth_image, label_image = ImageDepth32F(w, h), ImageLabel16I(w, h)
+    depth_image.mutable_data[:, :, 0] = depth
+    label_image.mutable_data[:, :, 0] = labels
+    return depth_image, label_image
+
+
+def synthetic_table(rows: slice, cols: slice, depth: float = 1.6) -> tuple[np.ndarray, np.ndarray]:
+    """A level table straight below the camera (constant depth) over ``rows`` x ``cols``, nothing
+    elsewhere (+inf: out of range)."""
+    d = np.full((CAMERA.height, CAMERA.width), np.inf, np.float32)
+    labels = np.zeros(d.shape, np.int16)
+    d[rows, cols], labels[rows, cols] = depth, TABLE_LABEL
+    return d, labels
+
+
+def test_scene_perception_finds_every_object_with_its_pose_size_and_shape(frame):
+    perception, scene = perceive_fixed(frame["depth_image"], frame["label_image"], frame["camera_pose"])
+    assert perception.ok, perception.reason
+    record = perception_record(SCENE, perception)
+    assert record["missed"] == [] and record["invented"] == []
+    assert scene.target.name == "Target" and len(scene.obstacles) == 3
+    errors = {o["name"]: o for o in record["objects"]}
+    for true in SCENE.objects:
+        error = errors[true.name]
+        assert error["perceived_shape"] == true.shape, true.name
+        assert error["position_error_m"] < 0.004, true.name  # a pixel is ~5 mm wide at 320 x 240
+        assert error["size_error_m"] < 0.006, true.name
+    assert errors["tilted_box"]["yaw_error_rad"] < math.radians(3)
+    assert abs(scene.table.height - SCENE.table.height) < 0.002
+    assert abs(scene.table.length - SCENE.table.length) < 0.01
+    assert scene.start == SCENE.start
+    assert perception.perception_s > 0 and perception.pixels == CAMERA.width * CAMERA.height
+
+
+def test_scene_perception_reads_through_missing_depth_and_tells_of_nan_pixels(frame):
+    depth = np.array(frame["depth_image"].data[:, :, 0], copy=True)
+    rng = np.random.default_rng(0)
+    depth[rng.random(depth.shape) < 0.2] = np.nan
+    perception, _ = perceive_fixed(
+        images(depth, frame["label_image"].data[:, :, 0])[0], frame["label_image"], frame["camera_pose"]
+    )
+    assert perception.ok, perception.reason
+    assert perception.nan_pixels == int(np.isnan(depth).sum()) > 0.15 * depth.size
+    record = perception_record(SCENE, perception)
+    assert record["missed"] == [] and max(o["position_error_m"] for o in record["objects"]) < 0.006
+
+
+def test_a_frame_without_a_table_gives_the_reason(frame):
+    pose = frame["camera_pose"]
+    nothing = np.full((CAMERA.height, CAMERA.width), np.inf, np.float32)
+    perception, scene = perceive_fixed(*images(nothing, np.zeros(nothing.shape, np.int16)), pose)
+    assert not perception.ok and perception.reason.startswith("no table plane found")
+    assert scene.target is None and scene.obstacles == () and scene.start == SCENE.start
+    all_nan = np.full(nothing.shape, np.nan, np.float32)
+    perception, _ = perceive_fixed(*images(all_nan, np.zeros(nothing.shape, np.int16)), pose)
+    assert perception.reason.startswith("no table plane found")
+    assert perception.nan_pixels == all_nan.size
+    # A wall: the depth grows down the image (a plane tilted 60 degrees), no horizontal plane.
+    rows = np.arange(CAMERA.height, dtype=np.float32)[:, None]
+    wall = np.broadcast_to(1.0 + 0.01 * rows, nothing.shape).astype(np.float32)
+    perception, _ = perceive_fixed(*images(wall, np.zeros(nothing.shape, np.int16)), pose)
+    assert perception.reason == "no table plane found (the largest plane is not horizontal)"
+
+
+def test_an_empty_table_and_an_object_at_the_border_give_their_reasons(frame):
+    pose = frame["camera_pose"]
+    depth, labels = synthetic_table(slice(30, 210), slice(40, 280))
+    perception, scene = perceive_fixed(*images(depth, labels), pose)
+    assert perception.reason == "no target found (nothing stands on the table)"
+    assert perception.table is not None and scene.target is None
+    # The table reaches the image's left border with a box standing on it there.
+    depth, labels = synthetic_table(slice(30, 210), slice(0, 280))
+    depth[100:130, 0:20], labels[100:130, 0:20] = 1.5, TARGET_LABEL
+    perception, _ = perceive_fixed(*images(depth, labels), pose)
+    assert perception.reason.startswith("object at the image border (")
+    # The table goes on out of view.
+    depth, labels = synthetic_table(slice(30, 210), slice(40, CAMERA.width))
+    depth[100:130, 100:130], labels[100:130, 100:130] = 1.5, TARGET_LABEL
+    perception, _ = perceive_fixed(*images(depth, labels), pose)
+    assert perception.reason.startswith("the table reaches out of the cameras' view")
+
+
+def test_unlabelled_objects_and_a_wrong_image_size_give_their_reasons(frame):
+    pose = frame["camera_pose"]
+    depth, labels = synthetic_table(slice(30, 210), slice(40, 280))
+    depth[100:130, 100:130] = 1.5  # labelled as the table, not the target
+    perception, _ = perceive_fixed(*images(depth, labels), pose)
+    assert perception.reason == "no target found (no object is labelled the target)"
+    small = ImageDepth32F(160, 120)
+    perception, _ = perceive_fixed(small, frame["label_image"], pose)
+    assert (
+        perception.reason == "camera table_camera: its depth image is 160 x 120, its settings say 320 x 240"
+    )
+
+
+def test_an_unconnected_input_is_a_wiring_error():
+    block = ScenePerception(SCENARIO)
+    with pytest.raises(RuntimeError, match="connect or fix table_camera.depth_image"):
+        block.get_scene_output_port().Eval(block.CreateDefaultContext())
+
+
+def test_perception_record_reports_missed_and_invented_objects(frame):
+    perception, scene = perceive_fixed(frame["depth_image"], frame["label_image"], frame["camera_pose"])
+    moved = replace(
+        SCENE, obstacles=(SCENE.obstacles[0], SCENE.obstacles[1].moved(0.2, -0.35), SCENE.obstacles[2])
+    )
+    record = perception_record(moved, perception)
+    assert record["missed"] == ["box"] and record["invented"] == [
+        o.name for o in scene.obstacles if abs(o.x - 0.55) < 0.01
+    ]
+
+
+def test_depth_noise_is_seeded_by_the_time_and_drops_the_asked_share():
+    camera = CameraSettings(width=160, height=120, depth_noise=0.002, dropout=0.1, seed=7)
+    block = DepthNoise(camera)
+    context = block.CreateDefaultContext()
+    clean = ImageDepth32F(160, 120)
+    clean.mutable_data[:] = 1.0
+    block.get_input_port().FixValue(context, clean)
+
+    def draw(time: float) -> np.ndarray:
+        context.SetTime(time)
+        return np.array(block.get_output_port().Eval(context).data[:, :, 0], copy=True)
+
+    first, again, later = draw(0.0), draw(0.0), draw(0.5)
+    np.testing.assert_array_equal(first, again)
+    assert not np.array_equal(np.isnan(first), np.isnan(later))
+    assert np.isnan(first).mean() == pytest.approx(0.1, abs=0.01)
+    assert np.nanstd(first) == pytest.approx(0.002, rel=0.05) and np.nanmean(first) == pytest.approx(
+        1.0, abs=1e-3
+    )
+
+
+def test_camera_pose_looks_at_the_table_and_rejects_a_parallel_up():
+    pose = camera_pose(CameraSettings(), SCENE)
+    np.testing.assert_allclose(pose.translation(), [0.4, 0.0, 0.75 + 1.6])
+    np.testing.assert_allclose(pose.rotation().matrix()[:, 2], [0, 0, -1], atol=1e-12)  # looking down
+    np.testing.assert_allclose(pose.rotation().matrix()[:, 1], [-1, 0, 0], atol=1e-12)  # +x up the image
+    with pytest.raises(ValueError, match="parallel to its view"):
+        camera_pose(CameraSettings(up=(0.0, 0.0, 1.0)), SCENE)
+
+
+def test_the_scenario_file_sets_the_cameras_and_the_perception_block_follows_it():
+    scenario = load_scenario(
+        data="perception: {source: camera, cameras: [{name: top, width: 160, height: 120}, {name: side}]}"
+    )
+    assert scenario.perception.source == "camera" and [c.name for c in scenario.perception.cameras] == [
+        "top",
+        "side",
+    ]
+    assert scenario.perception.cameras[0].depth_noise == CameraSettings().depth_noise
+    block = ScenePerception(scenario)
+    ports = {block.get_input_port(i).get_name() for i in range(block.num_input_ports())}
+    assert ports == {
+        f"{c}.{p}" for c in ("top", "side") for p in ("depth_image", "label_image", "camera_pose")
+    }
+    assert {block.get_output_port(i).get_name() for i in range(block.num_output_ports())} == {
+        "scene",
+        "perception",
+        "point_cloud",
+    }
+
+
+def test_add_scene_perception_wires_the_worlds_cameras():
+    builder = DiagramBuilder()
+    scenario = replace(
+        SCENARIO, perception=replace(SCENARIO.perception, cameras=(replace(CAMERA, width=160, height=120),))
+    )
+    world = builder.AddSystem(make_world_diagram(scenario))
+    block = add_scene_perception(builder, world, scenario)
+    diagram = builder.Build()
+    context = diagram.CreateDefaultContext()
+    mine = block.GetMyContextFromRoot(context)
+    perception = block.get_perception_output_port().Eval(mine)
+    assert perception.ok, perception.reason
+    cloud = block.get_point_cloud_output_port().Eval(mine)  # every pixel with a depth, coloured
+    assert cloud.size() == perception.pixels - perception.no_depth_pixels > 0.2 * 160 * 120
+    assert cloud.has_rgbs() and np.all(np.isfinite(cloud.xyzs()))

@@ -1,0 +1,52 @@
+"""``python -m hlp_drake.run_scene --perception camera`` end to end: planning on the perceived scene,
+the JSON's ``perception`` record and the MeshCat recording of the point cloud and fitted objects."""
+
+from __future__ import annotations
+
+import json
+
+from conftest import run_module
+from test_run_scene import recorded
+
+from hlp_drake.scene.generators import generate_scene
+
+
+def test_run_scene_plans_on_the_perceived_scene_and_reports_its_errors(tmp_path):
+    out, html = tmp_path / "run.json", tmp_path / "run.html"
+    args = ("--kind", "vr", "--seed", "1", "--workers", "1", "--perception", "camera")
+    result = run_module("hlp_drake.run_scene", *args, "--json", str(out), "--html", str(html))
+    assert result.returncode in (0, 1), result.stderr
+    assert "perceive: 7 objects, the target Target" in result.stdout
+    report = json.loads(out.read_text())
+    record = report["perception"]
+    assert record["ok"] and record["reason"] is None
+    assert record["missed"] == [] and record["invented"] == []
+    true = generate_scene("vr", 1)
+    assert sorted(o["name"] for o in record["objects"]) == sorted(o.name for o in true.objects)
+    for error in record["objects"]:
+        assert error["position_error_m"] < 0.005 and error["size_error_m"] < 0.005, error
+        assert error["yaw_error_rad"] is None or error["yaw_error_rad"] < 0.05, error
+    # The plan names the perceived obstacles; the simulation moves the true ones.
+    moved = {k["element"] for k in report["plan"]["keypoints"] if k["action"] == "move"}
+    assert moved <= {o["name"] for o in record["perceived"]}
+    assert set(report["objects_moved"]) <= {o.name for o in true.objects}
+    assert report["timings"]["perceive_s"] > record["perception_s"] > 0
+    commands = recorded(html.read_text())
+    for path in (b"/drake/perception/points", b"/drake/perception/objects/Target", b"/drake/robot_plan/path"):
+        assert path in commands, path
+
+
+def test_run_scene_with_a_camera_that_sees_no_table_fails_with_the_reason(tmp_path):
+    config, out = tmp_path / "sky.yaml", tmp_path / "run.json"
+    config.write_text(
+        "perception:\n  cameras: [{name: sky_camera, width: 160, height: 120, look_at: [0.0, 0.0, 3.0]}]\n"
+    )
+    args = ("--perception", "camera", "--config", str(config), "--workers", "1", "--json", str(out))
+    result = run_module("hlp_drake.run_scene", *args)
+    assert result.returncode == 1 and "Traceback" not in result.stderr
+    reason = "perception failed: no table plane found (too few pixels with a depth)"
+    assert f"failure: {reason}" in result.stdout
+    report = json.loads(out.read_text())
+    assert report["failure_reason"] == reason and not report["success"]
+    assert report["perception"]["ok"] is False and "Target" in report["perception"]["missed"]
+    assert report["rollouts"] == 0

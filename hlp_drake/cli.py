@@ -3,7 +3,8 @@
 Every command (``python -m hlp_drake.X`` or ``hlp-drake X``) builds its parser with ``make_parser``:
 the help shows the module's docstring without reStructuredText markup, ``--version`` prints the
 package's version, and a usage error is one ``error: ...`` line with exit status 2. Commands with
-progress bars take ``--quiet`` (``add_quiet``) to turn them off.
+progress bars take ``--quiet`` (``add_quiet``) to turn them off; commands that plan take
+``--perception`` (``add_perception``).
 """
 
 from __future__ import annotations
@@ -49,6 +50,20 @@ def make_parser(prog: str, doc: str | None, **kwargs) -> Parser:
 def add_quiet(parser: argparse.ArgumentParser) -> None:
     """``--quiet``: no progress bars (they are shown by default, on stderr)."""
     parser.add_argument("--quiet", action="store_true", help="no progress bars")
+
+
+PERCEPTION_SOURCES = ("truth", "camera")
+"""``perception.source``'s values (``hlp_drake.systems.perception_config``'s, without importing Drake)."""
+
+
+def add_perception(parser: argparse.ArgumentParser) -> None:
+    """``--perception truth|camera``: override the scenario's ``perception.source``."""
+    parser.add_argument(
+        "--perception",
+        choices=PERCEPTION_SOURCES,
+        help="plan on the true scene (truth, the default) or on what the scenario's cameras see "
+        "(camera: ScenePerception; the simulation still runs the true scene)",
+    )
 
 
 def run_cli(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | None = None) -> int:

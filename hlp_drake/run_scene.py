@@ -20,12 +20,10 @@ from collections.abc import Sequence
 from dataclasses import replace
 
 from hlp_drake.atomic import write_text_atomic
-from hlp_drake.cli import add_quiet, make_parser, run_cli
+from hlp_drake.cli import add_perception, add_quiet, make_parser, run_cli
 from hlp_drake.errors import HlpError
 from hlp_drake.scene.generators import KINDS, generate_scene
 from hlp_drake.scene.io import DEFAULT_SCENE_FILE, load_scene
-
-PERCEPTION_SOURCES = ("truth", "camera")  # hlp_drake.systems.perception_config's, without importing Drake
 
 DEFAULT_SCENE = DEFAULT_SCENE_FILE
 PROG = "python -m hlp_drake.run_scene"
@@ -69,11 +67,7 @@ def _parser():
         help="initialise the optimiser with the human-like plan (hlp, the default) or the "
         "baseline's straight line (sto)",
     )
-    parser.add_argument(
-        "--perception",
-        choices=PERCEPTION_SOURCES,
-        help="plan on the true scene (truth, the default) or on what the scenario's cameras see (camera)",
-    )
+    add_perception(parser)
     parser.add_argument(
         "--config",
         metavar="SCENARIO.yaml",

@@ -425,3 +425,29 @@ def test_a_drake_check_failing_in_a_job_is_that_jobs_crash_and_a_real_exit_is_no
     monkeypatch.setattr(execution, "plan_and_execute", exiting)
     with pytest.raises(SystemExit):
         run_job(job)
+
+
+def test_perception_camera_is_part_of_the_runs_scenario_and_summary(tmp_path, capsys):
+    argv = ["gen2", "--scenes", "1", "--objects", "3", "--workers", "1", "--quiet", "--out", str(tmp_path)]
+    assert run_cli(lambda a: main(a, job=cheap_job), [*argv, "--perception", "camera"]) == 0
+    assert "through the cameras (perception: camera)" in capsys.readouterr().out
+    run = json.loads((tmp_path / "run.json").read_text())
+    assert "source: camera" in run["scenario"]
+    # The same directory with the true scenes is another run: refused.
+    assert run_cli(lambda a: main(a, job=never_called), [*argv, "--perception", "truth"]) == 2
+    assert "different scenario" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_gen2_on_perceived_scenes_with_the_real_planners(tmp_path):
+    config = tmp_path / "scenario.yaml"
+    config.write_text("optimiser:\n  max_iterations: 2\n  samples: 2\n  time_budget_s: 10.0\n  workers: 1\n")
+    out = tmp_path / "out"
+    args = ("gen2", "--scenes", "1", "--objects", "9", "--workers", "1", "--quiet", "--config", str(config))
+    result = run_module("hlp_drake.experiments", *args, "--perception", "camera", "--out", str(out))
+    assert result.returncode == 0, result.stderr
+    rows = assert_well_formed(out / "results.csv")
+    assert [(r["scene"], r["planner"]) for r in rows] == [("gen2-9-0", "hlp"), ("gen2-9-0", "sto")]
+    for row in rows:
+        assert not row["failure_reason"].startswith(("crashed", "perception failed")), row["failure_reason"]
+    assert "perception: camera" in (out / "summary.md").read_text()

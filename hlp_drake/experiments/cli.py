@@ -1,15 +1,16 @@
 """The paper's Generalization I and II experiments (Tables II and III), resumable, local or on dask.
 
     python -m hlp_drake.experiments {gen1,gen2} [--scenes 100] [--objects 5 7 9] [--seed S]
-        [--workers N] [--executor local|dask] [--scheduler ADDRESS] [--config SCENARIO.yaml] [--fresh]
-        [--quiet] --out DIR
+        [--workers N] [--executor local|dask] [--scheduler ADDRESS] [--config SCENARIO.yaml]
+        [--perception truth|camera] [--fresh] [--quiet] --out DIR
 
 Every scene is planned and executed with both planners (HLP and STO's straight line); scene i has
 seed S + i (gen2: for each object count). Writes DIR/results.csv (resumable: run the same command
 again after an interrupt), run.json, summary.md/.json (Table II or III beside the paper's numbers),
 success.png and times.png. Times are planning times (plan + IK + optimisation), without the
 simulated execution; run with --workers 1 for times comparable to the paper's (parallel jobs share
-the cores).
+the cores). With --perception camera both planners plan on the scene the world's cameras see
+(ScenePerception) while the simulation runs the true one: Table III on perceived scenes.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from hlp_drake.cli import add_quiet, make_parser
+from hlp_drake.cli import add_perception, add_quiet, make_parser
 from hlp_drake.errors import HlpError
 from hlp_drake.experiments.executors import EXECUTORS
 from hlp_drake.experiments.experiment import DERIVED, RESULTS, ExperimentSettings, run_experiment
@@ -62,6 +63,7 @@ def _parser() -> argparse.ArgumentParser:
         metavar="SCENARIO.yaml",
         help="scenario settings (see hlp_drake.systems.Scenario); each job has its own scene",
     )
+    add_perception(parser)
     parser.add_argument("--fresh", action="store_true", help="discard DIR's earlier results and start over")
     add_quiet(parser)
     parser.add_argument(
@@ -90,6 +92,7 @@ def main(argv: Sequence[str] | None = None, *, job: JobFunction = run_job) -> in
         executor=args.executor,
         scheduler=args.scheduler,
         config_yaml=config_yaml,
+        perception=args.perception,
         fresh=args.fresh,
         progress=not args.quiet,
     )

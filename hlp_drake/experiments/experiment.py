@@ -15,7 +15,7 @@ import time
 from contextlib import closing
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from tqdm import tqdm
 
@@ -27,6 +27,9 @@ from hlp_drake.experiments.plots import write_plots
 from hlp_drake.experiments.results import ResultsFile, read_results, row_key
 from hlp_drake.experiments.runner import KINDS, Job, JobFunction, make_jobs, run_job
 from hlp_drake.experiments.summary import summarise, write_summary
+
+if TYPE_CHECKING:
+    from hlp_drake.systems.scenario import Scenario
 
 RESULTS, CONFIG, RUN = "results.csv", "config.json", "run.json"
 DERIVED = ("summary.md", "summary.json", "success.png", "times.png")
@@ -48,6 +51,8 @@ class ExperimentSettings:
         scheduler: the dask scheduler's address (None: start a ``LocalCluster`` of ``workers``).
         config_yaml: the scenario settings as YAML text (None: ``Scenario()``'s defaults; its scene is
             replaced by each job's).
+        perception: overrides the scenario's ``perception.source`` ("truth" or "camera"; None: the
+            scenario's).
         fresh: start over, discarding the directory's earlier results.
     """
 
@@ -59,6 +64,7 @@ class ExperimentSettings:
     executor: str = "local"
     scheduler: str | None = None
     config_yaml: str | None = None
+    perception: str | None = None
     fresh: bool = False
     progress: bool = True
 
@@ -90,20 +96,25 @@ class ExperimentSettings:
         return problems
 
 
-def scenario_yamls(text: str | None, *, single_process_rollouts: bool = False) -> tuple[str, str]:
-    """The scenario of ``text`` (None: the defaults), read once and written out in full: as given
-    (the run's identity) and as the jobs run it (``optimiser.workers = 1`` if ``single_process_rollouts``)."""
+def scenario_yamls(
+    text: str | None, *, single_process_rollouts: bool = False, perception: str | None = None
+) -> tuple[Scenario, str]:
+    """The scenario of ``text`` (None: the defaults; ``perception.source`` set to ``perception``
+    unless None), read once: the scenario (its ``yaml`` is the run's identity) and, written out in full,
+    as the jobs run it (``optimiser.workers = 1`` if ``single_process_rollouts``)."""
     from dataclasses import replace
 
     from hlp_drake.systems.scenario import load_scenario
 
     scenario = load_scenario(data=text, where="--config")
+    if perception is not None:
+        scenario = replace(scenario, perception=replace(scenario.perception, source=perception))
     jobs = (
         replace(scenario, optimiser=replace(scenario.optimiser, workers=1))
         if single_process_rollouts
         else scenario
     )
-    return scenario.yaml, jobs.yaml
+    return scenario, jobs.yaml
 
 
 def _check_directory(out: Path, identity: dict[str, Any], fresh: bool) -> None:
@@ -246,7 +257,10 @@ def run_experiment(
         raise HlpError(*problems)
     check_executor(settings.executor, settings.scheduler)
     out = Path(out)
-    config_yaml, job_yaml = scenario_yamls(settings.config_yaml, single_process_rollouts=settings.parallel)
+    scenario, job_yaml = scenario_yamls(
+        settings.config_yaml, single_process_rollouts=settings.parallel, perception=settings.perception
+    )
+    config_yaml = scenario.yaml
     jobs = make_jobs(
         settings.kind, range(settings.seed, settings.seed + settings.scenes), settings.objects, job_yaml
     )
@@ -275,7 +289,10 @@ def run_experiment(
             jobs={**record["jobs"], "rows": len(results.rows)},
         )
         write_text_atomic(out / RUN, json.dumps(record, indent=2) + "\n")
-    summary = summarise(settings.kind, results.rows.values(), _measured_on(record["machine"], settings))
+    measured_on = _measured_on(record["machine"], settings)
+    if scenario.perception.source == "camera":
+        measured_on += "; the planners saw the scenes through the cameras (perception: camera)"
+    summary = summarise(settings.kind, results.rows.values(), measured_on)
     write_summary(out, summary)
     write_plots(out, summary)
     return summary

@@ -1,0 +1,177 @@
+"""How well and how fast ``ScenePerception`` sees Generalization II scenes through the default camera.
+
+    python benchmarks/perception.py [--objects 9 15] [--scenes 100 30] [--seed 0] [--width 640]
+        [--height 480] [--json OUT] [--csv OUT] [--png OUT]
+
+Per object count K (with --scenes N for it: scenes gen2-K-seed .. seed+N-1), every scene's world is
+built with the scenario's default camera (640 x 480, 1.6 m above the table, its seeded depth noise
+and dropout) and one frame rendered and perceived. Reported per count: position, size and yaw
+(boxes) error, median and p95, over the matched objects; the share of scenes with every object
+found (none missed, none invented, perception ok); the share of the human-like plan's row decisions
+on the perceived scene equal to those on the true scene; the perception time per frame (median,
+p95) with the rendering timed separately. The issue's targets are printed beside. Times depend on
+the machine's load: the load average is recorded.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from tqdm import tqdm
+
+from hlp_drake.learners.bundled import default_models
+from hlp_drake.planner import plan
+from hlp_drake.plotting import new_figure, save_png
+from hlp_drake.scene.generators import generate_scene
+from hlp_drake.systems.perception_config import CameraSettings, PerceptionConfig
+from hlp_drake.systems.perception_errors import match_objects, perception_record, same_decisions
+from hlp_drake.systems.scenario import Scenario
+from hlp_drake.systems.scene_perception import ScenePerception
+from hlp_drake.systems.world import make_world_diagram
+
+TARGETS = {
+    "position_median_mm": 5.0,
+    "position_p95_mm": 15.0,
+    "size_median_mm": 5.0,
+    "yaw_median_deg": 5.0,
+    "all_found": {9: 0.99, 15: 0.97},
+    "same_decisions": 0.95,
+    "perception_median_ms": 100.0,
+}
+
+
+def perceive_scene(kind_seed: tuple[int, int], camera: CameraSettings, models) -> tuple[dict, list[dict]]:
+    """One scene's frame: its summary row and its objects' error rows."""
+    objects, seed = kind_seed
+    scene = generate_scene("gen2", seed, objects)
+    scenario = Scenario(scene=scene, perception=PerceptionConfig(source="camera", cameras=(camera,)))
+    world = make_world_diagram(scenario)
+    context = world.CreateDefaultContext()
+    started = time.perf_counter()
+    frame = {
+        p: world.GetOutputPort(f"{camera.name}.{p}").Eval(context) for p in ("depth_image", "label_image")
+    }
+    render_s = time.perf_counter() - started
+    block = ScenePerception(scenario)
+    block_context = block.CreateDefaultContext()
+    for port, value in frame.items():
+        block.GetInputPort(f"{camera.name}.{port}").FixValue(block_context, value)
+    pose = world.GetOutputPort(f"{camera.name}.camera_pose").Eval(context)
+    block.GetInputPort(f"{camera.name}.camera_pose").FixValue(block_context, pose)
+    started = time.perf_counter()
+    perception = block.get_perception_output_port().Eval(block_context)
+    block_s = time.perf_counter() - started
+    record = perception_record(scene, perception)
+    same, rows = 0, 0
+    if perception.ok:
+        same, rows = same_decisions(
+            plan(scene, models), plan(perception.scene, models), match_objects(scene, perception.scene)
+        )
+    row = {
+        "scene": scene.name,
+        "objects": objects,
+        "ok": perception.ok,
+        "reason": perception.reason,
+        "missed": len(record["missed"]),
+        "invented": len(record["invented"]),
+        "render_ms": 1e3 * render_s,
+        "perception_ms": 1e3 * perception.perception_s,
+        "block_ms": 1e3 * block_s,
+        "same_rows": same,
+        "rows": rows,
+    }
+    errors = [{"scene": scene.name, "objects": objects, **o} for o in record["objects"]]
+    return row, errors
+
+
+def summarise(scenes: pd.DataFrame, errors: pd.DataFrame) -> dict:
+    """Per object count, the figures of the module's docstring."""
+    out = {}
+    for count, group in scenes.groupby("objects"):
+        e = errors[errors["objects"] == count]
+        yaw = np.degrees(e["yaw_error_rad"].dropna().astype(float))
+        found = group["ok"] & (group["missed"] == 0) & (group["invented"] == 0)
+        out[int(count)] = {
+            "scenes": len(group),
+            "objects_matched": len(e),
+            "position_median_mm": 1e3 * float(e["position_error_m"].median()),
+            "position_p95_mm": 1e3 * float(e["position_error_m"].quantile(0.95)),
+            "size_median_mm": 1e3 * float(e["size_error_m"].median()),
+            "size_p95_mm": 1e3 * float(e["size_error_m"].quantile(0.95)),
+            "yaw_median_deg": float(yaw.median()),
+            "yaw_p95_deg": float(yaw.quantile(0.95)),
+            "all_found": float(found.mean()),
+            "failures": sorted({r for r in group["reason"].dropna()}),
+            "same_decisions": float(group["same_rows"].sum() / max(group["rows"].sum(), 1)),
+            "perception_median_ms": float(group["perception_ms"].median()),
+            "perception_p95_ms": float(group["perception_ms"].quantile(0.95)),
+            "render_median_ms": float(group["render_ms"].median()),
+        }
+    return out
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--objects", type=int, nargs="+", default=[9, 15])
+    parser.add_argument("--scenes", type=int, nargs="+", default=[100, 30], help="one per --objects")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--width", type=int, default=640)
+    parser.add_argument("--height", type=int, default=480)
+    parser.add_argument("--json", type=Path)
+    parser.add_argument("--csv", type=Path, help="the objects' errors, one row each")
+    parser.add_argument("--png", type=Path)
+    args = parser.parse_args()
+    if len(args.scenes) != len(args.objects):
+        parser.error("give one --scenes per --objects")
+    camera = CameraSettings(width=args.width, height=args.height)
+    models = default_models()
+    todo = [(k, args.seed + i) for k, n in zip(args.objects, args.scenes) for i in range(n)]
+    load = os.getloadavg()
+    rows, errors = [], []
+    for item in tqdm(todo, unit="scene", desc="perceive"):
+        row, objects = perceive_scene(item, camera, models)
+        rows.append(row)
+        errors += objects
+    scenes, errors = pd.DataFrame(rows), pd.DataFrame(errors)
+    summary = summarise(scenes, errors)
+    report = {
+        "camera": f"{args.width} x {args.height}",
+        "load_before": load,
+        "load_after": os.getloadavg(),
+        "targets": {k: v for k, v in TARGETS.items() if k != "all_found"},
+        "by_objects": summary,
+    }
+    print(json.dumps(report, indent=2))
+    for count, figures in summary.items():
+        target = TARGETS["all_found"].get(count)
+        print(
+            f"{count} objects: every object found in {figures['all_found']:.0%} of scenes"
+            + (f" (target >= {target:.0%})" if target else "")
+        )
+    if args.json:
+        args.json.write_text(json.dumps(report, indent=2) + "\n")
+    if args.csv:
+        errors.to_csv(args.csv, index=False)
+    if args.png:
+        figure, axes = new_figure(7.0, 4.0)
+        for count in summary:
+            e = errors[errors["objects"] == count]["position_error_m"] * 1e3
+            axes.hist(e, bins=40, histtype="step", label=f"{count} objects")
+        axes.axvline(TARGETS["position_median_mm"], linestyle="--", color="grey")
+        axes.set_xlabel("position error, mm")
+        axes.set_ylabel("objects")
+        axes.legend()
+        save_png(figure, args.png)
+    if not math.isfinite(sum(f["position_median_mm"] for f in summary.values())):
+        raise SystemExit("no object was matched")
+
+
+if __name__ == "__main__":
+    main()

@@ -8,7 +8,8 @@ built with the scenario's default camera (640 x 480, 1.6 m above the table, its 
 and dropout) and one frame rendered and perceived. Reported per count: position, size and yaw
 (boxes) error, median and p95, over the matched objects; the share of scenes with every object
 found (none missed, none invented, perception ok); the share of the human-like plan's row decisions
-on the perceived scene equal to those on the true scene; the perception time per frame (median,
+on the perceived scene equal to those on the true scene, beside the same share for the true scene
+changed by seeded noise of about the perception's errors (``JITTER``: the planner's own sensitivity); the perception time per frame (median,
 p95) with the rendering timed separately. The issue's targets are printed beside. Times depend on
 the machine's load: the load average is recorded.
 """
@@ -20,6 +21,7 @@ import json
 import math
 import os
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +32,7 @@ from hlp_drake.learners.bundled import default_models
 from hlp_drake.planner import plan
 from hlp_drake.plotting import new_figure, save_png
 from hlp_drake.scene.generators import generate_scene
+from hlp_drake.scene.model import Scene, SceneObject
 from hlp_drake.systems.perception_config import CameraSettings, PerceptionConfig
 from hlp_drake.systems.perception_errors import match_objects, perception_record, same_decisions
 from hlp_drake.systems.scenario import Scenario
@@ -45,6 +48,31 @@ TARGETS = {
     "same_decisions": 0.95,
     "perception_median_ms": 100.0,
 }
+JITTER = {"position_m": 0.0005, "size_m": 0.001, "yaw_rad": 0.002, "table_m": 0.001}
+"""The decisions' control: the true scene with noise of about the perception's errors (standard
+deviations per axis)."""
+
+
+def jitter(scene: Scene, seed: int) -> Scene:
+    """``scene`` changed by seeded Gaussian noise of ``JITTER``'s sizes: every object's x, y, size
+    and (boxes) yaw, and the table's length and width."""
+    rng = np.random.default_rng(seed)
+
+    def changed(o: SceneObject) -> SceneObject:
+        dx, dy = rng.normal(0.0, JITTER["position_m"], 2)
+        ds = rng.normal(0.0, JITTER["size_m"], 3)
+        size = (
+            (o.size[0] + ds[0], o.size[0] + ds[0], o.size[2] + ds[2])
+            if o.shape == "cylinder"
+            else tuple(np.add(o.size, ds))
+        )
+        yaw = o.yaw + (rng.normal(0.0, JITTER["yaw_rad"]) if o.shape == "box" else 0.0)
+        return replace(o, x=o.x + dx, y=o.y + dy, size=size, yaw=yaw)
+
+    dl, dw = rng.normal(0.0, JITTER["table_m"], 2)
+    table = replace(scene.table, length=scene.table.length + dl, width=scene.table.width + dw)
+    target, *obstacles = (changed(o) for o in scene.objects)
+    return replace(scene, table=table, target=target, obstacles=tuple(obstacles))
 
 
 def perceive_scene(kind_seed: tuple[int, int], camera: CameraSettings, models) -> tuple[dict, list[dict]]:
@@ -70,10 +98,15 @@ def perceive_scene(kind_seed: tuple[int, int], camera: CameraSettings, models) -
     block_s = time.perf_counter() - started
     record = perception_record(scene, perception)
     same, rows = 0, 0
+    true_plan = plan(scene, models)
     if perception.ok:
         same, rows = same_decisions(
-            plan(scene, models), plan(perception.scene, models), match_objects(scene, perception.scene)
+            true_plan, plan(perception.scene, models), match_objects(scene, perception.scene)
         )
+    jittered = jitter(scene, seed)
+    jitter_same, jitter_rows = same_decisions(
+        true_plan, plan(jittered, models), {o.name: o.name for o in scene.objects}
+    )
     row = {
         "scene": scene.name,
         "objects": objects,
@@ -86,6 +119,8 @@ def perceive_scene(kind_seed: tuple[int, int], camera: CameraSettings, models) -
         "block_ms": 1e3 * block_s,
         "same_rows": same,
         "rows": rows,
+        "jitter_same_rows": jitter_same,
+        "jitter_rows": jitter_rows,
     }
     errors = [{"scene": scene.name, "objects": objects, **o} for o in record["objects"]]
     return row, errors
@@ -110,6 +145,9 @@ def summarise(scenes: pd.DataFrame, errors: pd.DataFrame) -> dict:
             "all_found": float(found.mean()),
             "failures": sorted({r for r in group["reason"].dropna()}),
             "same_decisions": float(group["same_rows"].sum() / max(group["rows"].sum(), 1)),
+            "same_decisions_jittered_truth": float(
+                group["jitter_same_rows"].sum() / max(group["jitter_rows"].sum(), 1)
+            ),
             "perception_median_ms": float(group["perception_ms"].median()),
             "perception_p95_ms": float(group["perception_ms"].quantile(0.95)),
             "render_median_ms": float(group["render_ms"].median()),

@@ -100,6 +100,30 @@ def _rays(width: int, height: int, fx: float, fy: float, cx: float, cy: float) -
     return np.dstack([(col - cx) / fx, (row - cy) / fy, np.ones((height, width))])
 
 
+def _pixel_rays(views: list[CameraView], points: Points) -> tuple[np.ndarray, np.ndarray]:
+    """Per point (n, 3): its pixel's ray in the world (the point at unit depth, relative to the
+    camera) and its camera's position."""
+    rays, origins = np.zeros((len(points), 3)), np.zeros((len(points), 3))
+    for k, view in enumerate(views):
+        mine = points.camera == k
+        info, X = view.info, view.X_WC
+        grid = _rays(info.width(), info.height(), info.focal_x(), info.focal_y(), info.center_x(), info.center_y())
+        rays[mine] = grid[points.row[mine], points.col[mine]] @ X.rotation().matrix().T
+        origins[mine] = X.translation()
+    return rays, origins
+
+
+def on_plane(points: Points, views: list[CameraView], coefficients: tuple[float, float, float]) -> np.ndarray:
+    """(n, 3): where each point's pixel ray meets the plane z = a x + b y + c (its depth's noise
+    left out)."""
+    a, b, c = coefficients
+    rays, origins = _pixel_rays(views, points)
+    normal = np.array([-a, -b, 1.0])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (c - np.einsum("ij,j->i", origins, normal)) / (rays @ normal)
+    return origins + t[:, None] * rays
+
+
 def view_points(views: list[CameraView]) -> tuple[Points, int]:
     """Every pixel with a depth as a world point, and the number of pixels without one."""
     parts, missing = [], 0
@@ -127,7 +151,8 @@ class TablePlane:
 
     Attributes:
         coefficients: (a, b, c).
-        bounds: (x_min, y_min, x_max, y_max) of the table top, from its points grown by half a pixel.
+        bounds: (x_min, y_min, x_max, y_max) of the table top: where its pixels' rays meet the plane
+            (not its noisy points: their extremes lie beyond the edges), grown by half a pixel.
         inliers: how many points lie on it.
         pixel: the width of a pixel seen on it (the median over its points), m.
         unseen_edges: the edges (``EDGES``) the cameras did not see past (the table may go on there).
@@ -193,7 +218,7 @@ def fit_table(
         return "no table plane found (no plane holds enough of the points)"
     if np.hypot(a, b) > MAX_TILT:
         return "no table plane found (the largest plane is not horizontal)"
-    xy = points.xyz[on, :2]
+    xy = on_plane(points.subset(on), views, (a, b, c))[:, :2]
     focal = np.array([v.info.focal_x() for v in views])
     pixel = float(np.median(points.depth[chosen] / focal[points.camera[chosen]]))
     bounds = (*(xy.min(axis=0) - pixel / 2.0), *(xy.max(axis=0) + pixel / 2.0))
@@ -229,6 +254,7 @@ __all__ = [
     "Points",
     "TablePlane",
     "fit_table",
+    "on_plane",
     "unseen_edges",
     "valid_depth",
     "view_points",

@@ -236,3 +236,31 @@ def test_add_scene_perception_wires_the_worlds_cameras():
     cloud = block.get_point_cloud_output_port().Eval(mine)  # every pixel with a depth, coloured
     assert cloud.size() == perception.pixels - perception.no_depth_pixels > 0.2 * 160 * 120
     assert cloud.has_rgbs() and np.all(np.isfinite(cloud.xyzs()))
+
+
+def test_an_object_partly_hidden_by_a_taller_one_is_found_with_the_outline_that_shows():
+    """Off the camera's axis a tall box hides the near side of a short one behind it: the short box
+    is found, a third of its outline reported occluded, its seen extents right and its hidden one
+    a lower bound (what shows of it)."""
+    short = SceneObject("short", "box", 0.4, -0.40, (0.08, 0.06, 0.05))
+    tall = SceneObject("tall", "box", 0.4, -0.32, (0.08, 0.06, 0.2))
+    scene = replace(SCENE, obstacles=(short, tall))
+    scenario = replace(SCENARIO, scene=scene)
+    world = make_world_diagram(scenario)
+    context = world.CreateDefaultContext()
+    ports = [
+        world.GetOutputPort(f"{CAMERA.name}.{p}").Eval(context)
+        for p in ("depth_image", "label_image", "camera_pose")
+    ]
+    perception, _ = perceive_fixed(*ports, scenario)
+    assert perception.ok, perception.reason
+    record = perception_record(scene, perception)
+    assert record["missed"] == [] and record["invented"] == []
+    errors = {o["name"]: o for o in record["objects"]}
+    seen = {o.name: o for o in perception.objects}
+    hidden = seen[errors["short"]["perceived_as"]]
+    assert hidden.occluded > 0.2 and seen[errors["tall"]["perceived_as"]].occluded == 0.0
+    along_x, _, height = errors["short"]["size_errors_m"]  # absolute errors
+    assert along_x < 0.005 and height < 0.002
+    assert -0.03 < hidden.size[1] - short.size[1] < 0.001  # the hidden side: what shows
+    assert errors["tall"]["position_error_m"] < 0.002 and errors["tall"]["size_error_m"] < 0.004

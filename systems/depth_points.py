@@ -25,13 +25,15 @@ MIN_TABLE_SHARE = 0.1
 """The table plane holds at least this many points and this share of the points with a depth."""
 EDGE_SAMPLES = 7
 """Points sampled along each table edge for the visibility test."""
+EDGE_BAND = 0.005
+"""The table's edge pixels lie within this (m) of its noisy points' extremes."""
 EDGES = ("front", "right", "back", "left")
+"""The table's edges in the order of its bounds (x_min, y_min, x_max, y_max), as seen from the start."""
 RENDERED_PIXEL_CENTRE = 0.5
 """Where Drake's VTK renderer samples pixel (col, row): at (col + 0.5, row + 0.5) of ``CameraInfo``'s
 model, whose documentation puts pixel centres at whole coordinates (drake#10190). Measured: the
 depths of a tilted view of a plane fit the model with the principal point half a pixel up and left
 of ``CameraInfo``'s and its focal length exactly, to 1e-7 m, on Drake 1.51 and 1.58."""
-"""The table's edges in the order of its bounds (x_min, y_min, x_max, y_max), as seen from the start."""
 
 
 @dataclass(frozen=True)
@@ -107,7 +109,9 @@ def _pixel_rays(views: list[CameraView], points: Points) -> tuple[np.ndarray, np
     for k, view in enumerate(views):
         mine = points.camera == k
         info, X = view.info, view.X_WC
-        grid = _rays(info.width(), info.height(), info.focal_x(), info.focal_y(), info.center_x(), info.center_y())
+        grid = _rays(
+            info.width(), info.height(), info.focal_x(), info.focal_y(), info.center_x(), info.center_y()
+        )
         rays[mine] = grid[points.row[mine], points.col[mine]] @ X.rotation().matrix().T
         origins[mine] = X.translation()
     return rays, origins
@@ -218,7 +222,10 @@ def fit_table(
         return "no table plane found (no plane holds enough of the points)"
     if np.hypot(a, b) > MAX_TILT:
         return "no table plane found (the largest plane is not horizontal)"
-    xy = on_plane(points.subset(on), views, (a, b, c))[:, :2]
+    xy = points.xyz[on, :2]  # the extremes, where the pixels' rays meet the plane
+    lo, hi = xy.min(axis=0) + EDGE_BAND, xy.max(axis=0) - EDGE_BAND
+    edge = np.flatnonzero(on)[np.any((xy < lo) | (xy > hi), axis=1)]
+    xy = on_plane(points.subset(edge), views, (a, b, c))[:, :2]
     focal = np.array([v.info.focal_x() for v in views])
     pixel = float(np.median(points.depth[chosen] / focal[points.camera[chosen]]))
     bounds = (*(xy.min(axis=0) - pixel / 2.0), *(xy.max(axis=0) + pixel / 2.0))

@@ -1,7 +1,8 @@
 """Drake blocks of hlp_drake (imported as ``hlp_drake.systems``) and the model package they load.
 
 Every builder and block takes one typed ``Scenario`` (``load_scenario``); the planning blocks take
-the scene from their ``scene`` input port (``SceneFromPlant`` reads it from a plant). Resources
+the scene from their ``scene`` input port (``SceneFromPlant`` reads it from a plant,
+``ScenePerception`` from the world's depth cameras). Resources
 (``RolloutPool``) belong to the caller, who closes them.
 """
 
@@ -10,11 +11,14 @@ from hlp_drake.systems.execution import ExecutionResult, RunListener, plan_and_e
 from hlp_drake.systems.hlp_planner_system import HlpPlannerSystem
 from hlp_drake.systems.keyframes import Keyframes
 from hlp_drake.systems.keypoint_ik import KeypointIk
-from hlp_drake.systems.meshcat_view import draw_plan, frame_table
+from hlp_drake.systems.meshcat_view import draw_perception, draw_plan, frame_table
 from hlp_drake.systems.model_package import MODELS_PACKAGE, configure_parser, models_directory
 from hlp_drake.systems.optimiser import StoResult, optimise
 from hlp_drake.systems.optimiser_config import StoConfig
 from hlp_drake.systems.optimiser_system import StochasticTrajectoryOptimiser
+from hlp_drake.systems.perception import PerceivedObject, Perception, perceive
+from hlp_drake.systems.perception_config import CameraSettings, PerceptionConfig
+from hlp_drake.systems.perception_errors import perception_record
 from hlp_drake.systems.planning_diagram import first_rollout, initial_sequence, make_planning_diagram
 from hlp_drake.systems.planning_model import PlanningModel
 from hlp_drake.systems.push_transfer import ROBOT_ACTIONS, robot_alternatives, robot_plan
@@ -43,6 +47,7 @@ from hlp_drake.systems.scene_models import (
     scene_from_plant,
     set_object_poses,
 )
+from hlp_drake.systems.scene_perception import ScenePerception, add_scene_perception
 from hlp_drake.systems.scene_rollouts import SceneRollouts
 from hlp_drake.systems.scene_source import SceneFromPlant
 from hlp_drake.systems.start_pose import robot_base_pose, robot_position_names, start_configuration
@@ -74,6 +79,7 @@ __all__ = [
     "ROBOT_ACTIONS",
     "ROBOT_URL",
     "TCP_FRAME",
+    "CameraSettings",
     "ControlSequence",
     "ExecutionResult",
     "GraspConfig",
@@ -81,6 +87,9 @@ __all__ = [
     "HlpPlannerSystem",
     "Keyframes",
     "KeypointIk",
+    "PerceivedObject",
+    "Perception",
+    "PerceptionConfig",
     "PlannerSettings",
     "PlanningModel",
     "PushRules",
@@ -92,6 +101,7 @@ __all__ = [
     "Scenario",
     "SceneFromPlant",
     "SceneModels",
+    "ScenePerception",
     "SceneRollouts",
     "StoConfig",
     "StoResult",
@@ -101,8 +111,10 @@ __all__ = [
     "add_position_trajectory",
     "add_robot",
     "add_scene",
+    "add_scene_perception",
     "configure_parser",
     "desired_state_from_robot_state",
+    "draw_perception",
     "draw_plan",
     "fallen_objects",
     "first_rollout",
@@ -115,6 +127,8 @@ __all__ = [
     "models_directory",
     "object_planar_poses",
     "optimise",
+    "perceive",
+    "perception_record",
     "plan_and_execute",
     "push_rules",
     "robot_alternatives",

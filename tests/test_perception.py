@@ -264,3 +264,27 @@ def test_an_object_partly_hidden_by_a_taller_one_is_found_with_the_outline_that_
     assert along_x < 0.005 and height < 0.002
     assert -0.03 < hidden.size[1] - short.size[1] < 0.001  # the hidden side: what shows
     assert errors["tall"]["position_error_m"] < 0.002 and errors["tall"]["size_error_m"] < 0.004
+
+
+def test_two_tilted_cameras_frames_are_perceived_together():
+    cameras = (
+        CameraSettings(name="left", width=320, height=240, position=(0.0, 0.5, 1.5), look_at=(0.0, 0.1, 0.0)),
+        CameraSettings(
+            name="right", width=320, height=240, position=(0.0, -0.5, 1.5), look_at=(0.0, -0.1, 0.0), seed=1
+        ),
+    )
+    scenario = replace(SCENARIO, perception=replace(SCENARIO.perception, cameras=cameras))
+    builder = DiagramBuilder()
+    world = builder.AddSystem(make_world_diagram(scenario))
+    block = add_scene_perception(builder, world, scenario)
+    diagram = builder.Build()
+    perception = block.get_perception_output_port().Eval(
+        block.GetMyContextFromRoot(diagram.CreateDefaultContext())
+    )
+    assert perception.ok, perception.reason
+    assert perception.pixels == 2 * 320 * 240
+    record = perception_record(SCENE, perception)
+    assert record["missed"] == [] and record["invented"] == []
+    for error in record["objects"]:
+        assert error["perceived_shape"] == error["shape"], error
+        assert error["position_error_m"] < 0.003 and error["size_error_m"] < 0.005, error

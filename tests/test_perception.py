@@ -17,7 +17,7 @@ from hlp_drake.systems.perception_config import CameraSettings, PerceptionConfig
 from hlp_drake.systems.perception_errors import perception_record
 from hlp_drake.systems.scenario import Scenario, load_scenario
 from hlp_drake.systems.scene_perception import ScenePerception, add_scene_perception
-from hlp_drake.systems.world import make_world_diagram
+from hlp_drake.systems.world import make_world_diagram, world_plant
 
 CAMERA = CameraSettings(width=320, height=240, depth_noise=0.001, dropout=0.01, seed=4)
 SCENE = Scene(
@@ -288,3 +288,22 @@ def test_two_tilted_cameras_frames_are_perceived_together():
     for error in record["objects"]:
         assert error["perceived_shape"] == error["shape"], error
         assert error["position_error_m"] < 0.003 and error["size_error_m"] < 0.005, error
+
+
+def test_the_perceived_scene_follows_an_object_moved_in_the_plant():
+    """What a re-planning controller needs: the same diagram perceives again when an object moves."""
+    builder = DiagramBuilder()
+    world = builder.AddSystem(make_world_diagram(SCENARIO))
+    block = add_scene_perception(builder, world, SCENARIO)
+    diagram = builder.Build()
+    context = diagram.CreateDefaultContext()
+    mine = block.GetMyContextFromRoot(context)
+    can = next(o for o in block.get_scene_output_port().Eval(mine).obstacles if o.shape == "cylinder")
+    plant = world_plant(world)[0]
+    plant_context = plant.GetMyMutableContextFromRoot(context)
+    body = plant.GetBodyByName("can")
+    pose = plant.GetFreeBodyPose(plant_context, body)
+    pose.set_translation(pose.translation() + [0.05, 0.0, 0.0])
+    plant.SetFreeBodyPose(plant_context, body, pose)
+    moved = next(o for o in block.get_scene_output_port().Eval(mine).obstacles if o.shape == "cylinder")
+    assert moved.x - can.x == pytest.approx(0.05, abs=0.002) and moved.y == pytest.approx(can.y, abs=0.002)

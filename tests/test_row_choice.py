@@ -40,6 +40,26 @@ def test_segments_through_rectangles():
     assert segment_inside(starts, ends, rects)[:, 0] == pytest.approx([1.0, 0.0, 0.5])
 
 
+def test_segment_hits_agree_with_the_clipped_length_on_a_grid():
+    """The separating-axis test says "hit" exactly where the clipped length inside is more than
+    1e-9 of the way, on a grid of 1/64 m (exact in binary: ways along edges, through corners, from
+    a side)."""
+    rng = np.random.default_rng(3)
+    low = rng.integers(0, 26, (12, 2)) / 64.0
+    rects = np.hstack([low, low + rng.integers(1, 10, (12, 2)) / 64.0])
+    starts, ends = rng.integers(-3, 40, (3000, 2)) / 64.0, rng.integers(-3, 40, (3000, 2)) / 64.0
+    ends[:50] = starts[:50]  # points: inside a rectangle or not
+    length = np.linalg.norm(ends - starts, axis=1)[:, None]
+    clipped = segment_inside(starts, ends, rects) > 1e-9 * length
+    points = length[:, 0] == 0.0
+    inside = (starts[points, None, 0] > rects[None, :, 0]) & (starts[points, None, 0] < rects[None, :, 2])
+    inside &= (starts[points, None, 1] > rects[None, :, 1]) & (starts[points, None, 1] < rects[None, :, 3])
+    clipped[points] = inside
+    hits = segment_hits(starts, ends, rects)
+    assert np.array_equal(hits, clipped)
+    assert 0 < hits.sum() < hits.size
+
+
 def test_routes_go_round_the_obstacles_or_through_a_gap():
     # A wall across the table with a gap 0.2 m wide on the left; the hand 0.05 m wide.
     scene = _wall_scene(gap_left=0.3, gap_right=0.1)

@@ -39,6 +39,7 @@ def test_evaluate_one_split(dataset_path, tmp_path):
                 "shlp_plan"):
         assert set(planners["hlp"][key]) == {"mean", "std"} and 0.0 <= planners["hlp"][key]["mean"] <= 1.0
     hlp, rule = planners["hlp"], planners["nearest_gap"]
+    assert hlp["planning_time_s"]["median"] > 0.0 and "planning_time_s" not in rule  # only the planner is timed
     assert hlp["shlp"]["mean"] > 0.6 and hlp["gap_accuracy"]["mean"] > 0.85  # well above chance
     assert hlp["shlp_plan"]["mean"] > rule["shlp_plan"]["mean"] + 0.2  # people mostly move obstacles here
     test_subjects = set(figures["splits_subjects"]["19/5"][0]["test"])

@@ -40,9 +40,24 @@ def _clip(p0: np.ndarray, p1: np.ndarray, rects: np.ndarray) -> tuple[np.ndarray
 
 def segment_hits(p0: np.ndarray, p1: np.ndarray, rects: np.ndarray) -> np.ndarray:
     """(n, m): whether segment p0[i] -> p1[i] passes through the open interior of rectangle j
-    (touching its boundary does not count)."""
-    low, high = _clip(p0, p1, rects)
-    return high - low > 1e-9
+    (touching its boundary does not count).
+
+    The separating-axis test: the segment meets the open rectangle unless their projections on x,
+    on y or on the segment's normal do not overlap (a third of the operations of a clip)."""
+    a, b = np.asarray(p0, float).reshape(-1, 2), np.asarray(p1, float).reshape(-1, 2)
+    r = np.asarray(rects, float).reshape(-1, 4)
+    d = b - a
+    # A way that only touches within 1e-9 of its length does not count (as in the clip).
+    tolerance = 1e-9 * np.abs(d)
+    low, high = np.minimum(a, b) + tolerance, np.maximum(a, b) - tolerance
+    hits = (low[:, 0, None] < r[None, :, 2]) & (high[:, 0, None] > r[None, :, 0])
+    hits &= (low[:, 1, None] < r[None, :, 3]) & (high[:, 1, None] > r[None, :, 1])
+    centre, half = (r[:, :2] + r[:, 2:]) / 2.0, (r[:, 2:] - r[:, :2]) / 2.0
+    across = d[:, 0, None] * (centre[None, :, 1] - a[:, 1, None]) - d[:, 1, None] * (centre[None, :, 0] - a[:, 0, None])
+    spread = np.abs(d[:, 0, None]) * half[None, :, 1] + np.abs(d[:, 1, None]) * half[None, :, 0]
+    length = np.hypot(d[:, 0], d[:, 1])[:, None]
+    hits &= (np.abs(across) < spread - 1e-9 * length * (half[None, :, 0] + half[None, :, 1])) | (length == 0.0)
+    return hits
 
 
 def segment_inside(p0: np.ndarray, p1: np.ndarray, rects: np.ndarray) -> np.ndarray:
@@ -109,8 +124,10 @@ class FreeRoutes:
             keep &= ~inside.any(axis=1)
         self.corners, self.owner = corners[keep], owner[keep]
         n = len(self.corners)
-        self._edge_hits = segment_hits(np.repeat(self.corners, n, axis=0), np.tile(self.corners, (n, 1)),
-                                       self.grown).reshape(n, n, len(g))
+        upper = np.triu_indices(n, k=1)  # a straight way hits what its reverse hits
+        self._edge_hits = np.zeros((n, n, len(g)), dtype=bool)
+        self._edge_hits[upper] = segment_hits(self.corners[upper[0]], self.corners[upper[1]], self.grown)
+        self._edge_hits |= self._edge_hits.transpose(1, 0, 2)
         self._edge_length = np.linalg.norm(self.corners[:, None] - self.corners[None], axis=2)
         self._corners_to_goal = self.sight(self.corners)
         self._tables: dict[frozenset[int], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}

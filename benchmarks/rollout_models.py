@@ -15,7 +15,7 @@
    success verdicts agree, and how far apart the costs are.
 
 The models (``MODELS``): the full model at 5 ms (the issue's reference), the reduced model (objects
-nothing comes near welded) at 5 and 10 ms, the full model at 10 ms, each contact trim alone on the
+nothing comes near asleep) at 5 and 10 ms, the full model at 10 ms, each contact trim alone on the
 reduced 10 ms model, and the default (``Scenario().optimiser``). Writes ``DIR/rollout_models.json``
 and ``DIR/rollout_models.png``.
 """

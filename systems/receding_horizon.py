@@ -14,7 +14,8 @@ unrestricted update: the simulation waits for it), the controller reads the meas
 commanded sequence there (the warm start: its remainder, starting where the robot is commanded now)
 and runs ``optimise`` from the measured state (``RolloutStart``) with the budget of
 ``closed_loop.iterations`` and ``closed_loop.rollouts``; the result's sequence is commanded from then
-on (the optimiser's acceptance is monotone: the remainder unless a candidate is cheaper or passes).
+on (the optimiser's acceptance is monotone: the remainder unless a candidate is cheaper or passes;
+re-optimisations do not verify on the execution model: the execution itself goes on from there).
 When an object is farther than ``closed_loop.replan_distance`` from where the current sequence's
 rollout put it, and an ``initialiser`` is given, its sequence for the measured states (e.g. the
 planner's on the observed scene) is optimised instead, the remainder its alternative. The commanded

@@ -5,7 +5,7 @@
 
 1. Rollout throughput: rollouts of a 3 s horizon per second on a 9-object Generalization II scene,
    on 1 and on 2 worker processes (the same noisy sequences), with the full and with the reduced
-   rollout model (``sto.reduced_model``: unreachable objects welded) side by side, repeated; and
+   rollout model (``sto.reduced_model``: objects nothing comes near asleep) side by side, repeated; and
    the real-time factor of one rollout at the rollout time steps and at the execution time step.
 2. The rollout models against each other: the same sequences (noisy copies of both planners'
    initial sequences on the default scene, the throughput scene's noisy 3 s sequences, and both
@@ -116,7 +116,7 @@ def throughput(count: int, steps: tuple[float, ...], repeats: int) -> dict:
                                     "wall_s": elapsed,
                                     "cpu_s_per_rollout": cpu / count if workers == 1 else None,
                                     "load": os.getloadavg()[0],
-                                    "welded_mean": float(np.mean([len(o.welded) for o in outcomes])),
+                                    "asleep_mean": float(np.mean([len(o.asleep) for o in outcomes])),
                                     "switches": [o.switches for o in outcomes],
                                     "costs": [o.cost for o in outcomes],
                                 }
@@ -209,7 +209,7 @@ def model_agreement(triples: list[tuple], steps: tuple[float, ...]) -> dict:
             "reduced_vs_reference": int(sum(r[reduced].success == r["reference"].success for r in rows)),
             "successes_full": int(sum(r[full].success for r in rows)),
             "successes_reduced": int(sum(r[reduced].success for r in rows)),
-            "welded_at_end_mean": float(np.mean([len(r[reduced].welded) for r in rows])),
+            "asleep_at_end_mean": float(np.mean([len(r[reduced].asleep) for r in rows])),
             "objects_mean": float(np.mean([r["objects"] for r in rows])),
             "switches": int(sum(r[reduced].switches for r in rows)),
             "wall_s_full": float(sum(r[full].wall_s for r in rows)),
@@ -236,7 +236,7 @@ def model_agreement(triples: list[tuple], steps: tuple[float, ...]) -> dict:
                 k: {
                     "success": o.success,
                     "cost": o.cost,
-                    "welded": len(o.welded),
+                    "asleep": len(o.asleep),
                     "switches": o.switches,
                     "wall_s": o.wall_s,
                 }
@@ -358,8 +358,8 @@ def print_throughput(t: dict, steps: tuple[float, ...]) -> None:
                 + " s"
             )
             print(
-                f"  {step * 1000:g} ms, {model} model: welded at the end "
-                f"{entry['workers_1']['cold'][0]['welded_mean']:.1f} objects on average; same costs on 1 and 2 "
+                f"  {step * 1000:g} ms, {model} model: asleep at the end "
+                f"{entry['workers_1']['cold'][0]['asleep_mean']:.1f} objects on average; same costs on 1 and 2 "
                 f"workers, cold and warm: {entry['same_costs_everywhere']}"
             )
     print(
@@ -378,7 +378,7 @@ def print_agreement(a: dict, steps: tuple[float, ...]) -> None:
         e = a[f"step_{step * 1000:g}ms"]
         print(
             f"  {step * 1000:g} ms: verdicts agree with the reference: full {e['full_vs_reference']}/{n}, "
-            f"reduced {e['reduced_vs_reference']}/{n}; welded at the end {e['welded_at_end_mean']:.1f} of "
+            f"reduced {e['reduced_vs_reference']}/{n}; asleep at the end {e['asleep_at_end_mean']:.1f} of "
             f"{e['objects_mean']:.1f} objects, {e['switches']} switches; wall {e['wall_s_full']:.0f} s full, "
             f"{e['wall_s_reduced']:.0f} s reduced"
         )

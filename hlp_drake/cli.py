@@ -66,6 +66,26 @@ def add_perception(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def add_conditions(parser: argparse.ArgumentParser) -> None:
+    """``--execution open|closed`` and ``--uncertainty [SEED]`` (``Scenario.closed_loop``,
+    ``Scenario.uncertainty``; applied by ``hlp_drake.systems.scenario.with_conditions``)."""
+    parser.add_argument(
+        "--execution",
+        choices=("open", "closed"),
+        help="open: play the optimised trajectory; closed: re-optimise it every closed_loop.replan_period s "
+        "of simulated time on the measured state (default: as the scenario says, open)",
+    )
+    parser.add_argument(
+        "--uncertainty",
+        type=int,
+        nargs="?",
+        const=0,
+        metavar="SEED",
+        help="execute in a world with seeded model error the planners do not know of (object poses, "
+        "masses, friction: the scenario's uncertainty); SEED defaults to 0",
+    )
+
+
 def run_cli(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | None = None) -> int:
     """Run ``main(argv)``; print each problem of an ``HlpError`` as ``error: ...`` and return 2."""
     try:

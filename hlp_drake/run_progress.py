@@ -33,6 +33,7 @@ class ProgressListener:
         self._quiet, self._stream = quiet, stream
         self._bar: tqdm | None = None
         self._shown = 0.0
+        self._optimising = False  # the bar counts rollouts (not the closed loop's, during the execution)
 
     def _line(self, text: str) -> None:
         print(text, flush=True)
@@ -69,14 +70,16 @@ class ProgressListener:
 
     def optimising(self) -> None:
         self._open(desc="optimise", unit="rollout")
+        self._optimising = True
 
     def rollout(self, outcome) -> None:
-        if self._bar is not None:
+        if self._bar is not None and self._optimising:
             self._bar.set_postfix_str(f"cost {outcome.cost:.3g}", refresh=False)
             self._bar.update()
 
     def optimised(self, result) -> None:
         self._close()
+        self._optimising = False
         verdict = "success" if result.success else f"no success ({result.failure_reason})"
         self._line(
             f"optimise: {verdict} after {result.iterations} iterations, {result.rollouts} rollouts "

@@ -2,7 +2,8 @@
 
     python -m hlp_drake.run_scene [--scene FILE | --kind vr|gen1|gen2|unstructured --seed N [--objects K]]
         [--planner hlp|sto] [--perception truth|camera] [--config SCENARIO.yaml] [--workers N]
-        [--meshcat] [--html FILE] [--contact-forces] [--json FILE] [--quiet]
+        [--meshcat] [--html FILE] [--contact-forces] [--execution open|closed] [--uncertainty [SEED]]
+        [--json FILE] [--quiet]
 
 With no arguments it runs the bundled default scene with the bundled models. With --perception camera
 the planner, IK and optimiser work on the scene the world's cameras see (ScenePerception) while the
@@ -20,7 +21,7 @@ from collections.abc import Sequence
 from dataclasses import replace
 
 from hlp_drake.atomic import write_text_atomic
-from hlp_drake.cli import add_perception, add_quiet, make_parser, run_cli
+from hlp_drake.cli import add_conditions, add_perception, add_quiet, make_parser, run_cli
 from hlp_drake.errors import HlpError
 from hlp_drake.scene.generators import KINDS, generate_scene
 from hlp_drake.scene.io import DEFAULT_SCENE_FILE, load_scene
@@ -40,6 +41,14 @@ def summary(result) -> str:
         else "not optimised"
     )
     grasp = {None: "not attempted", True: "held", False: "did not hold"}[result.grasp_held]
+    verified = (result.optimisation or {}).get("verifications", 0)
+    if verified:
+        optimiser += (
+            f", {verified} verified on the execution model ({result.optimisation['rejected']} rejected)"
+        )
+    loop = result.closed_loop
+    if loop:
+        optimiser += f"; closed loop: {loop['replans']} re-optimisations, {loop['rollouts']} rollouts"
     lines = [
         (
             f"timings: plan {t['plan_s']:.3f} s, IK {t['ik_s']:.2f} s, {optimiser}, execute {t['execute_s']:.1f} s "
@@ -81,6 +90,7 @@ def _parser():
     )
     parser.add_argument("--html", metavar="FILE", help="write a self-contained MeshCat recording of the run")
     parser.add_argument("--contact-forces", action="store_true", help="draw the contact forces in MeshCat")
+    add_conditions(parser)
     parser.add_argument("--json", metavar="FILE", help="write the result as JSON")
     add_quiet(parser)
     return parser
@@ -99,7 +109,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if scene is not None:
         _print(f"scene {scene.name}: {len(scene.obstacles)} obstacles, planner {args.planner or 'hlp'}")
 
-    from hlp_drake.systems.scenario import load_scenario  # Drake is imported from here on
+    from hlp_drake.systems.scenario import load_scenario, with_conditions  # Drake is imported from here on
 
     scenario = load_scenario(args.config)
     scenario = replace(
@@ -109,6 +119,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         optimiser=replace(scenario.optimiser, workers=args.workers or scenario.optimiser.workers),
         perception=replace(scenario.perception, source=args.perception or scenario.perception.source),
     )
+    scenario = with_conditions(scenario, execution=args.execution, uncertainty=args.uncertainty)
     if scene is None:
         _print(
             f"scene {scenario.scene.name}: {len(scenario.scene.obstacles)} obstacles, "
@@ -157,7 +168,11 @@ def _run(scenario, args, started: float):
         if workers > 1:
             _print(f"rollout workers ready ({pool.startup_s:.1f} s)")
         result = plan_and_execute(
-            scenario, pool=pool, meshcat=meshcat, contact_forces=args.contact_forces, listener=listener
+            scenario,
+            pool=pool,
+            meshcat=meshcat,
+            contact_forces=args.contact_forces,
+            listener=listener,
         )
     return result, meshcat
 

@@ -3,10 +3,13 @@
 ``plan_and_execute(scenario, pool=...)`` builds one diagram: the world (the scenario's plant at its
 own time step), the scene source feeding the planning diagram (``SceneFromPlant`` on the world's
 body poses, or with ``perception.source: camera`` ``ScenePerception`` on its cameras: the planner,
-IK and optimiser then work on the perceived scene while the world simulates the true one), and a
-trajectory source driving the robot. It evaluates the plan, the keyframes and the optimisation at the start,
-plays the optimised trajectory, checks the reach, then closes the gripper and lifts. A
-``RunListener`` hears of every stage as it happens.
+IK and optimiser then work on the perceived scene while the world simulates the true one), and
+what drives the robot: open loop a trajectory source, closed loop (``scenario.closed_loop.enabled``)
+a ``RecedingHorizonController`` re-optimising on the measured state. It evaluates the plan, the
+keyframes and the optimisation at the start, plays the optimised trajectory, checks the reach, then
+closes the gripper and lifts. With ``scenario.uncertainty.enabled`` the world differs from what the
+planners believe (``model_error``): without cameras the planning diagram then plans on the
+scenario's scene, not the plant's. A ``RunListener`` hears of every stage as it happens.
 """
 
 from __future__ import annotations
@@ -28,11 +31,15 @@ from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.grasp import grasp_knots
 from hlp_drake.systems.keyframes import Keyframes
 from hlp_drake.systems.meshcat_view import draw_perception, draw_plan, frame_table
+from hlp_drake.systems.model_error import sample_model_error
+from hlp_drake.systems.observed_planning import ObservedScenePlanner
 from hlp_drake.systems.optimiser import StoResult
 from hlp_drake.systems.perception import Perception
 from hlp_drake.systems.perception_errors import perception_record
 from hlp_drake.systems.planning_diagram import make_planning_diagram
+from hlp_drake.systems.receding_horizon import RecedingHorizonController
 from hlp_drake.systems.robot import TCP_FRAME
+from hlp_drake.systems.robot_command import ClosedLoopCommand, OpenLoopCommand
 from hlp_drake.systems.rollout_cost import pregrasp_check, reach_problem
 from hlp_drake.systems.rollout_pool import RolloutPool
 from hlp_drake.systems.rollout_world import simulation_failure
@@ -40,12 +47,18 @@ from hlp_drake.systems.scene_models import fallen_objects, object_body, object_p
 from hlp_drake.systems.scene_perception import add_scene_perception
 from hlp_drake.systems.scene_source import SCENE_PORT, SceneFromPlant
 from hlp_drake.systems.start_pose import tcp_keypoint_height
-from hlp_drake.systems.world import add_position_trajectory, make_world_diagram, world_plant
+from hlp_drake.systems.world import (
+    add_position_trajectory,
+    connect_robot_command,
+    make_world_diagram,
+    world_plant,
+)
+from hlp_drake.systems.world_settings import EXECUTION_SETTLE_S
 
 if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
 
-SETTLE_S = 1.0  # simulated time after the trajectory ends, before objects are checked
+SETTLE_S = EXECUTION_SETTLE_S  # simulated time after the trajectory ends, before objects are checked
 MOVED_TOLERANCE = 0.01  # m: an object displaced further than this counts as moved
 RECORDING_FPS = 32.0  # frames per second of a MeshCat recording
 
@@ -99,6 +112,13 @@ class ExecutionResult:
     optimisation: dict[str, Any] = field(default_factory=dict)
     grasp_held: bool | None = None
     perception: dict[str, Any] | None = None
+    execution: str = "open"
+    closed_loop: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def rollout_passed_execution_failed(self) -> bool:
+        """The optimiser accepted a sequence (its rollout passed), and the execution failed."""
+        return bool(self.optimisation.get("success")) and not self.success
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -119,6 +139,9 @@ class ExecutionResult:
             "optimisation": self.optimisation,
             "grasp_held": self.grasp_held,
             **({} if self.perception is None else {"perception": self.perception}),
+            "execution": self.execution,
+            "closed_loop": self.closed_loop,
+            "rollout_passed_execution_failed": self.rollout_passed_execution_failed,
         }
 
 
@@ -134,8 +157,8 @@ def plan_and_execute(
     """Plan ``scenario``'s scene with its planner, solve IK, optimise with the STO, execute with
     contact, and grasp.
 
-    Success (the paper's test): the optimiser found a sequence whose rollout passes, and in the
-    execution (the world at its own time step) the target ends inside the gripper's pre-grasp region
+    Success (the paper's test): the optimiser found a sequence whose rollout passes (open loop; closed
+    loop the controller may rescue one that does not), and in the execution (the world at its own time step) the target ends inside the gripper's pre-grasp region
     (the tcp within the target's radius + ``optimiser.cost.pregrasp_margin`` horizontally, at grasp
     height) with no object off the table. Then the fingers close and the tcp lifts;
     ``grasp_held`` says whether the target came up with it (not part of success).
@@ -145,26 +168,45 @@ def plan_and_execute(
         meshcat: record the execution there, framed on the table, with the human and robot plans.
         contact_forces: draw the contact forces in MeshCat too.
         listener: told of every stage as it happens.
+
+    Open loop plays the optimised sequence; closed loop (``scenario.closed_loop.enabled``) hands it
+    to a ``RecedingHorizonController``.
     """
+    execution = "closed" if scenario.closed_loop.enabled else "open"
     listener = listener or RunListener()
     scene = scenario.scene
     camera = scenario.perception.source == "camera"
+    error = sample_model_error(scenario.uncertainty, scene) if scenario.uncertainty.enabled else None
     builder = DiagramBuilder()
     world = builder.AddSystem(
-        make_world_diagram(scenario, meshcat=meshcat, contact_forces=contact_forces, cameras=camera)
+        make_world_diagram(
+            scenario, meshcat=meshcat, contact_forces=contact_forces, cameras=camera, model_error=error
+        )
     )
     plant, robot = world_plant(world)
     started = time.perf_counter()
     planning = builder.AddNamedSystem("planning", make_planning_diagram(scenario, pool=pool, models=models))
-    if camera:
+    if camera:  # the planners see what the cameras see of the (true) world
         source = add_scene_perception(builder, world, scenario)
-    else:
+        builder.Connect(source.get_scene_output_port(), planning.GetInputPort(SCENE_PORT))
+    elif error is None:  # the planners see the plant's scene
         source = builder.AddNamedSystem("scene_from_plant", SceneFromPlant(plant, scene))
         builder.Connect(world.GetOutputPort("body_poses"), source.get_body_poses_input_port())
-    builder.Connect(source.get_scene_output_port(), planning.GetInputPort(SCENE_PORT))
-    start = plant.GetPositions(plant.CreateDefaultContext(), robot)
-    hold = ControlSequence(np.array([0.0, 1.0]), np.vstack([start, start]))
-    trajectory_source = add_position_trajectory(builder, world, hold.to_trajectory())
+        builder.Connect(source.get_scene_output_port(), planning.GetInputPort(SCENE_PORT))
+    if execution == "closed":
+        replanner = ObservedScenePlanner(scenario, models=models)  # when objects have moved far
+        controller = builder.AddNamedSystem(
+            "controller", RecedingHorizonController(scenario, plant, pool, initialiser=replanner)
+        )
+        builder.Connect(world.GetOutputPort("state"), controller.GetInputPort("state"))
+        builder.Connect(planning.GetOutputPort("optimisation"), controller.GetInputPort("initial"))
+        connect_robot_command(
+            builder, world, controller.GetOutputPort("desired_trajectory_state"), name="controller"
+        )
+    else:
+        start = plant.GetPositions(plant.CreateDefaultContext(), robot)
+        hold = ControlSequence(np.array([0.0, 1.0]), np.vstack([start, start]))
+        trajectory_source = add_position_trajectory(builder, world, hold.to_trajectory())
     simulator = Simulator(builder.Build())
     perception, perceive_s = None, 0.0
     if camera:  # rendering and perception, timed apart from the planner
@@ -175,6 +217,8 @@ def plan_and_execute(
         perceive_s = time.perf_counter() - seen
         listener.perceived(perception, perceive_s)
     context = planning.GetMyContextFromRoot(simulator.get_mutable_context())
+    if error is not None and not camera:  # the scene the planners believe in
+        planning.GetInputPort(SCENE_PORT).FixValue(context, scene)
     plan: HighLevelPlan = planning.GetOutputPort("plan").Eval(context)
     planned = time.perf_counter()
     listener.planned(plan, planned - started - perceive_s)
@@ -183,7 +227,12 @@ def plan_and_execute(
     solved = time.perf_counter()
     listener.solved(keyframes, trajectory, solved - planned)
     result = ExecutionResult(
-        scenario.planner.kind, scene, plan, keyframes, planning.GetOutputPort("robot_plan").Eval(context)
+        scenario.planner.kind,
+        scene,
+        plan,
+        keyframes,
+        planning.GetOutputPort("robot_plan").Eval(context),
+        execution=execution,
     )
     result.timings = {"plan_s": planned - started - perceive_s, "ik_s": solved - planned, "optimise_s": 0.0}
     if camera:
@@ -203,12 +252,16 @@ def plan_and_execute(
         result.iterations, result.rollouts = optimisation.iterations, optimisation.rollouts
         result.optimisation = optimisation.to_dict()
         result.timings["optimise_s"] = optimisation.optimise_s
-        if not optimisation.success:
+        if not optimisation.success and execution == "open":  # closed loop: the controller may rescue it
             result.failure_reason = f"the optimiser found no solution: {optimisation.failure_reason}"
     else:  # nothing to optimise: the (partial) IK trajectory is executed for inspection only
         sequence = ControlSequence.from_trajectory(trajectory, scenario.optimiser.step_duration)
     optimised = time.perf_counter()
-    trajectory_source.UpdateTrajectory(sequence.to_trajectory())
+    if execution == "closed":
+        command = ClosedLoopCommand(controller)
+    else:
+        trajectory_source.UpdateTrajectory(sequence.to_trajectory())
+        command = OpenLoopCommand(trajectory_source, sequence)
     if meshcat is not None:
         frame_table(meshcat, scene)
         heights = {
@@ -219,7 +272,10 @@ def plan_and_execute(
         draw_plan(meshcat, result.robot_plan, path="robot_plan", **heights)
         if perception is not None:
             draw_perception(meshcat, perception)
-    _execute(result, simulator, trajectory_source, sequence, scenario, meshcat, listener)
+    if execution == "open" or result.failure_reason is None:  # closed loop: only an optimised sequence
+        _execute(result, simulator, command, scenario, meshcat, listener)
+    if execution == "closed" and result.failure_reason is None:
+        result.closed_loop = controller.record(simulator.get_context()).to_dict()
     executed = time.perf_counter()
     result.success = result.failure_reason is None
     result.timings.update(
@@ -232,27 +288,31 @@ def plan_and_execute(
 def _execute(
     result: ExecutionResult,
     simulator: Simulator,
-    source,
-    sequence: ControlSequence,
+    command: OpenLoopCommand | ClosedLoopCommand,
     scenario: Scenario,
     meshcat: Meshcat | None,
     listener: RunListener,
 ) -> None:
-    """Simulate ``sequence`` in the world, check the reach, then grasp and lift; fills ``result``."""
+    """Simulate the commanded reach in the world, check it, then grasp and lift; fills ``result``."""
     scene = result.scene
     world = simulator.get_system().GetSubsystemByName("world")
     plant, robot = world_plant(world)
     grasp = scenario.grasp
-    listener.executing(sequence.duration + SETTLE_S + grasp.close_s + grasp.lift_s + grasp.hold_s)
-    simulator.set_monitor(lambda context: listener.simulated(context.get_time()) or EventStatus.DidNothing())
     simulator.Initialize()
+    root = simulator.get_mutable_context()
+    listener.executing(command.end(root) + SETTLE_S + grasp.close_s + grasp.lift_s + grasp.hold_s)
+    simulator.set_monitor(lambda context: listener.simulated(context.get_time()) or EventStatus.DidNothing())
     plant_context = plant.GetMyContextFromRoot(simulator.get_context())
     names = [o.name for o in scene.objects]
     before = object_planar_poses(plant, plant_context, names)
     if meshcat is not None:
         meshcat.StartRecording(frames_per_second=RECORDING_FPS)
     try:
-        simulator.AdvanceTo(sequence.duration + SETTLE_S)
+        end = command.end(root)
+        while simulator.get_context().get_time() < end:  # closed loop: a re-plan may move the end
+            simulator.AdvanceTo(end)
+            end = command.end(root)
+        simulator.AdvanceTo(end + SETTLE_S)
         after = object_planar_poses(plant, plant_context, names)
         result.objects_moved = [
             n
@@ -273,7 +333,9 @@ def _execute(
         if problem is not None and result.failure_reason is None:
             result.failure_reason = f"in execution: {problem}"
         if problem is None:
-            result.grasp_held = _grasp(simulator, source, sequence, scenario, plant, plant_context, scene)
+            result.grasp_held = _grasp(
+                simulator, command, end + SETTLE_S, scenario, plant, plant_context, scene
+            )
     except (RuntimeError, SystemExit) as error:
         failure = simulation_failure(error)
         if result.failure_reason is None:
@@ -286,18 +348,16 @@ def _execute(
             meshcat.PublishRecording()
 
 
-def _grasp(simulator, source, sequence, scenario, plant, plant_context, scene) -> bool:
-    """Close the fingers at the reach's end pose and lift; whether the target rose with the gripper."""
-    grasp = grasp_knots(sequence.knots[-1], scenario.grasp)
+def _grasp(simulator, command, t0, scenario, plant, plant_context, scene) -> bool:
+    """Close the fingers at the reach's end pose (from ``t0``) and lift; whether the target rose
+    with the gripper."""
+    root = simulator.get_mutable_context()
+    grasp = grasp_knots(command.final(root), scenario.grasp)
     if grasp is None:
         return False
     times, knots = grasp
-    source.UpdateTrajectory(
-        sequence.followed_by(
-            np.concatenate([[SETTLE_S], SETTLE_S + times]), np.vstack([sequence.knots[-1], knots])
-        )
-    )
+    command.then(root, t0, times, knots)
     target = object_body(plant, scene.target.name)
     z0 = target.EvalPoseInWorld(plant_context).translation()[2]
-    simulator.AdvanceTo(sequence.duration + SETTLE_S + times[-1])
+    simulator.AdvanceTo(t0 + times[-1])
     return bool(target.EvalPoseInWorld(plant_context).translation()[2] - z0 >= scenario.grasp.held_height)

@@ -157,25 +157,36 @@ class KeypointSolver:
         self._plant.SetPositions(plant_context, self._robot, q)
         return self._tcp.CalcPoseInWorld(plant_context).translation().copy()
 
-    def solve(self, plant_context: Context, plan: HighLevelPlan) -> Keyframes:
-        """The keyframes of ``plan``, solved in ``plant_context`` (the plant's part of ``new_context()``)."""
+    def solve(
+        self, plant_context: Context, plan: HighLevelPlan, start: np.ndarray | None = None
+    ) -> Keyframes:
+        """The keyframes of ``plan``, solved in ``plant_context`` (the plant's part of ``new_context()``).
+
+        Args:
+            start: the robot's 11 positions at the plan's "start" keypoint (default: the start
+                configuration; the receding-horizon controller's plans start where the robot is).
+        """
+        first = self._start if start is None else np.asarray(start, dtype=float)
         if plan.scene and self._scene.name and plan.scene != self._scene.name:
             return Keyframes.empty(
                 self._start, f"the plan is for scene {plan.scene!r}, this KeypointIk for {self._scene.name!r}"
             )
         if any(k.action == "move" for k in plan.keypoints) and not plan.details.get(TRANSFERRED):
             return Keyframes.empty(
-                self._start,
+                first,
                 "the plan's moves are a person's (the obstacles' centres): put a "
                 "RobotPlanTransfer between the planner and KeypointIk",
             )
         if not plan.ok:
-            return Keyframes.empty(self._start, f"no plan: {plan.reason or 'fewer than two keypoints'}")
+            return Keyframes.empty(first, f"no plan: {plan.reason or 'fewer than two keypoints'}")
         started = time.perf_counter()
         positions, success, messages = [], [], []
-        previous = self._start
+        previous = first
         for index, keypoint in enumerate(plan.keypoints):
-            q, message = self._solve_keypoint(plant_context, index, keypoint, previous)
+            if start is not None and keypoint.action == "start":
+                q, message = first.copy(), ""
+            else:
+                q, message = self._solve_keypoint(plant_context, index, keypoint, previous)
             positions.append(q)
             success.append(message == "")
             messages.append(message)
@@ -188,7 +199,7 @@ class KeypointSolver:
             success=tuple(success),
             messages=tuple(messages),
             tcp_positions=np.array([self.tcp_position(plant_context, q) for q in positions]),
-            start=self._start.copy(),
+            start=first.copy(),
             solve_time_s=time.perf_counter() - started,
         )
 
@@ -324,10 +335,10 @@ class KeypointSolver:
         return q
 
     def trajectory(self, plant_context: Context, keyframes: Keyframes) -> PiecewisePolynomial:
-        """The first-order hold from the start through ``keyframes``' successful keyframes, timed by
+        """The first-order hold from ``keyframes.start`` through their successful keyframes, timed by
         ``motion`` (the tcp's path computed in ``plant_context``)."""
         motion = self._config.motion
-        knots, lifted = [self._start], [False]
+        knots, lifted = [keyframes.start], [False]
         for q, ok, keypoint in zip(keyframes.positions, keyframes.success, keyframes.keypoints):
             if not ok:
                 continue
@@ -340,7 +351,7 @@ class KeypointSolver:
                 knots.append(q)
                 lifted.append(keypoint.height is not None)  # lifted clear of the objects
         if len(knots) == 1:
-            knots.append(self._start)  # hold the start
+            knots.append(keyframes.start)  # hold the start
             lifted.append(False)
         times = [0.0]
         tcp = [self.tcp_position(plant_context, q) for q in knots]

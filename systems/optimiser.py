@@ -5,9 +5,12 @@
 sequence in the contact simulation (``RolloutWorld``), the noise being Gaussian per-step velocities
 of the holonomic base; the update keeps the cheapest copy ("greedy") or the cost-weighted mean of
 the noise, w_k = exp(-h (c_k - c_min) / (c_max - c_min)) ("mppi", rolled out once more); a candidate
-replaces the current sequence only if its cost is lower (monotone acceptance). It stops at the first
-successful rollout (target in the pre-grasp region, nothing fell), at ``max_iterations``, or when
-the next iteration would end past ``time_budget_s``. Beyond the paper: when the initial sequence's
+replaces the current sequence only if its cost is lower (monotone acceptance). A rollout that passes
+the success test (target in the pre-grasp region, nothing fell) is simulated again on the execution
+model (``verify``); the optimisation succeeds when it passes there too, else that outcome replaces
+the rollout's and it goes on. The budget counts rollouts and iterations (``max_rollouts``,
+``max_iterations``), so a result does not depend on the machine's speed or load; seconds
+(``time_budget_s``) are only an optional safety cap. Beyond the paper: when the initial sequence's
 rollout fails and the planner has alternatives (the HLP's next candidate plans), they are rolled
 out once each before the first iteration; a successful one ends the optimisation (the best-ranked
 first), else the cheapest of them all becomes the current sequence.
@@ -19,7 +22,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -30,6 +33,7 @@ from hlp_drake.systems.rollout_cost import RolloutOutcome
 from hlp_drake.systems.rollout_pool import RolloutPool
 
 if TYPE_CHECKING:
+    from hlp_drake.systems.rollout_world import RolloutStart
     from hlp_drake.systems.scenario import Scenario
 
 
@@ -49,6 +53,8 @@ class StoResult:
             any) and after every iteration.
         initial_cost: the initial sequence's cost.
         start: which sequence the result grew from: 0 the initial one, i >= 1 the i-th alternative.
+        verifications: passing rollouts simulated again on the execution model (not in ``rollouts``).
+        rejected: of those, how many failed there (their rollout passed, the execution model's did not).
     """
 
     sequence: ControlSequence
@@ -61,6 +67,8 @@ class StoResult:
     costs: list[float] = field(default_factory=list)
     initial_cost: float | None = None
     start: int = 0
+    verifications: int = 0
+    rejected: int = 0
 
     def to_dict(self) -> dict:
         return {
@@ -71,6 +79,8 @@ class StoResult:
             "optimise_s": self.optimise_s,
             "initial_cost": self.initial_cost,
             "start": self.start,
+            "verifications": self.verifications,
+            "rejected": self.rejected,
             "final_cost": self.outcome.cost if self.outcome is not None else None,
             "cost_terms": dict(self.outcome.terms) if self.outcome is not None else {},
             "costs": list(self.costs),
@@ -91,6 +101,12 @@ def sample_base_noise(
     return velocity - (1.0 - noise.end_fraction) * drift[:, None, :] / sequence.duration
 
 
+EMPTY_RESULT = StoResult(
+    ControlSequence(np.array([0.0, 1.0]), np.zeros((2, 11))), None, False, "not optimised"
+)
+"""A placeholder result (an abstract port's model value)."""
+
+
 def mppi_weights(costs: np.ndarray, temperature: float) -> np.ndarray:
     """Normalised weights exp(-h (c - c_min) / (c_max - c_min)) of the rollouts' costs."""
     costs = np.asarray(costs, dtype=float)
@@ -101,6 +117,88 @@ def mppi_weights(costs: np.ndarray, temperature: float) -> np.ndarray:
     return weights / np.sum(weights)
 
 
+@dataclass(frozen=True)
+class Budget:
+    """How much one optimisation may do (``Budget.of(scenario.optimiser)`` by default; the
+    receding-horizon controller gives its replans smaller ones).
+
+    Attributes:
+        samples: noisy rollouts per iteration.
+        max_iterations, max_rollouts: the iteration and rollout budgets (no iteration starts that
+            would pass ``max_rollouts``).
+        time_budget_s: the optional wall-clock cap, s (0: none).
+        alternatives: the planner's alternatives tried when the initial rollout fails (0: none).
+        verify: verify a passing rollout on the execution model before declaring success.
+        max_verifications: verifications at most.
+        seed: seed of the noise.
+    """
+
+    samples: int
+    max_iterations: int
+    max_rollouts: int
+    time_budget_s: float = 0.0
+    alternatives: int = 0
+    verify: bool = False
+    max_verifications: int = 0
+    seed: int = 0
+
+    @classmethod
+    def of(cls, sto: StoConfig) -> Budget:
+        return cls(
+            sto.samples,
+            sto.max_iterations,
+            sto.max_rollouts,
+            sto.time_budget_s,
+            sto.alternatives,
+            sto.verify,
+            sto.max_verifications,
+            sto.seed,
+        )
+
+
+class _Run:
+    """One optimisation's rollouts and verifications, counted into its ``StoResult``."""
+
+    def __init__(
+        self, scenario: Scenario, pool: RolloutPool, budget: Budget, start: RolloutStart | None
+    ) -> None:
+        self.scenario, self.pool, self.budget, self.start = scenario, pool, budget, start
+        self.rollouts = self.verifications = self.rejected = 0
+
+    def roll(self, sequences: list[ControlSequence]) -> list[RolloutOutcome]:
+        """The rollouts of ``sequences`` (on the rollout model, from the run's start)."""
+        outcomes = self.pool.rollouts(self.scenario, sequences, start=self.start)
+        self.rollouts += len(sequences)
+        return outcomes
+
+    def settle(self, sequences: list[ControlSequence], outcomes: list[RolloutOutcome], order) -> None:
+        """Verify the passing outcomes in ``order`` (indices) on the execution model until one
+        passes there too (or the verifications run out); each one that fails is replaced by its
+        verification's outcome, and once they run out no passing rollout is trusted."""
+        if not self.budget.verify:
+            return
+        for i in order:
+            if not outcomes[i].success:
+                continue
+            if self.verifications >= self.budget.max_verifications:
+                outcomes[i] = replace(
+                    outcomes[i],
+                    success=False,
+                    failure_reason="passed its rollout, but the verifications ran out",
+                )
+                continue
+            (verified,) = self.pool.rollouts(self.scenario, [sequences[i]], start=self.start, verify=True)
+            self.verifications += 1
+            if verified.success:
+                outcomes[i] = replace(outcomes[i], verification=verified)
+                return
+            self.rejected += 1
+            outcomes[i] = replace(
+                verified,
+                failure_reason=f"passed its rollout, failed its verification: {verified.failure_reason}",
+            )
+
+
 def optimise(
     scenario: Scenario,
     initial: ControlSequence,
@@ -108,18 +206,24 @@ def optimise(
     *,
     alternatives: Callable[[], Sequence[ControlSequence]] | None = None,
     progress: Callable[[int, float], None] | None = None,
+    budget: Budget | None = None,
+    start: RolloutStart | None = None,
 ) -> StoResult:
     """Improve ``initial`` on ``scenario``'s scene (see the module's docstring); never raises for a bad scene.
 
     Args:
         pool: the rollout workers (the caller's, who closes them).
         alternatives: returns the planner's other initial sequences, best first; called only if
-            the initial rollout fails and ``optimiser.alternatives`` > 0 (the first that many are used).
+            the initial rollout fails and the budget has alternatives (the first that many are used).
         progress: called as ``progress(iteration, cost)`` after every iteration.
+        budget: what the optimisation may spend (default: ``Budget.of(scenario.optimiser)``).
+        start: roll out from this state rather than the scene's (the receding-horizon controller's
+            measured state; the robot's start is then not checked for collisions: it may be pushing).
     """
     sto: StoConfig = scenario.optimiser
+    budget = budget or Budget.of(sto)
     started = time.perf_counter()
-    collisions = pool.world(scenario).start_collisions
+    collisions = () if start is not None else pool.world(scenario).start_collisions
     if collisions:
         return StoResult(
             initial,
@@ -128,23 +232,25 @@ def optimise(
             f"the robot starts in collision with {', '.join(collisions)}",
             optimise_s=time.perf_counter() - started,
         )
-    rng = np.random.default_rng(sto.seed)
+    run = _Run(scenario, pool, budget, start)
+    rng = np.random.default_rng(budget.seed)
     best = initial
-    (outcome,) = pool.rollouts(scenario, [best])
+    outcomes = run.roll([best])
+    run.settle([best], outcomes, [0])
+    (outcome,) = outcomes
     result = StoResult(
         best,
         outcome,
         outcome.success,
         outcome.failure_reason,
-        rollouts=1,
         costs=[outcome.cost],
         initial_cost=outcome.cost,
     )
-    if not result.success and alternatives is not None and sto.alternatives > 0:
-        others = list(alternatives())[: sto.alternatives]
+    if not result.success and alternatives is not None and budget.alternatives > 0:
+        others = list(alternatives())[: budget.alternatives]
         if others:
-            outcomes = pool.rollouts(scenario, others)
-            result.rollouts += len(others)
+            outcomes = run.roll(others)
+            run.settle(others, outcomes, range(len(others)))
             passed = [i for i, o in enumerate(outcomes) if o.success]
             i = passed[0] if passed else int(np.argmin([o.cost for o in outcomes]))
             if passed or outcomes[i].cost < outcome.cost:
@@ -153,24 +259,33 @@ def optimise(
                 result.success, result.failure_reason = outcome.success, outcome.failure_reason
             result.costs.append(outcome.cost)
     last_iteration_s = 0.0
-    while not result.success and result.iterations < sto.max_iterations:
+    per_iteration = budget.samples + (1 if sto.update == "mppi" else 0)
+    while not result.success and result.iterations < budget.max_iterations:
+        if run.rollouts + per_iteration > budget.max_rollouts:
+            result.failure_reason = (
+                f"{outcome.failure_reason} (rollout budget of {budget.max_rollouts} spent)"
+            )
+            break
         elapsed = time.perf_counter() - started
-        if elapsed + last_iteration_s > sto.time_budget_s:
-            result.failure_reason = f"{outcome.failure_reason} (time budget of {sto.time_budget_s:g} s spent)"
+        if budget.time_budget_s > 0 and elapsed + last_iteration_s > budget.time_budget_s:
+            result.failure_reason = (
+                f"{outcome.failure_reason} (time budget of {budget.time_budget_s:g} s spent)"
+            )
             break
         iteration_started = time.perf_counter()
-        noise = sample_base_noise(rng, best, sto.noise, sto.samples)
+        noise = sample_base_noise(rng, best, sto.noise, budget.samples)
         candidates = [best.with_base_velocity(v) for v in noise]
-        outcomes = pool.rollouts(scenario, candidates)
-        result.rollouts += len(candidates)
+        outcomes = run.roll(candidates)
         if sto.update == "mppi":
             weights = mppi_weights(np.array([o.cost for o in outcomes]), sto.mppi_temperature)
             mean = best.with_base_velocity(np.einsum("k,knj->nj", weights, noise))
             candidates.append(mean)
-            outcomes.extend(pool.rollouts(scenario, [mean]))
-            result.rollouts += 1
-        i = int(np.argmin([o.cost for o in outcomes]))
-        if outcomes[i].cost < outcome.cost:  # monotone acceptance
+            outcomes.extend(run.roll([mean]))
+        run.settle(candidates, outcomes, np.argsort([o.cost for o in outcomes], kind="stable"))
+        costs = [o.cost for o in outcomes]
+        passing = [j for j, o in enumerate(outcomes) if o.success]  # verified, or none
+        i = min(passing, key=costs.__getitem__) if passing else int(np.argmin(costs))
+        if passing or outcomes[i].cost < outcome.cost:  # monotone acceptance, a pass first
             best, outcome = candidates[i], outcomes[i]
         result.iterations += 1
         result.sequence, result.outcome = best, outcome
@@ -179,10 +294,14 @@ def optimise(
         last_iteration_s = time.perf_counter() - iteration_started
         if progress is not None:
             progress(result.iterations, outcome.cost)
-    if not result.success and result.iterations >= sto.max_iterations and result.failure_reason:
+        if budget.verify and run.verifications >= budget.max_verifications and not result.success:
+            result.failure_reason = f"{result.failure_reason} (verifications spent)"
+            break
+    if not result.success and result.iterations >= budget.max_iterations and result.failure_reason:
         result.failure_reason = f"{result.failure_reason} (after {result.iterations} iterations)"
+    result.rollouts, result.verifications, result.rejected = run.rollouts, run.verifications, run.rejected
     result.optimise_s = time.perf_counter() - started
     return result
 
 
-__all__ = ["StoResult", "mppi_weights", "optimise", "sample_base_noise"]
+__all__ = ["EMPTY_RESULT", "Budget", "StoResult", "mppi_weights", "optimise", "sample_base_noise"]

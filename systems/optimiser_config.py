@@ -65,37 +65,72 @@ class StoCost:
 
 
 @dataclass(frozen=True)
+class RolloutTrims:
+    """How the rollout model's contact geometry and plant differ from the world's (the execution
+    model), besides its time step and the sleeping objects; chosen with ``benchmarks/rollout_models.py``.
+
+    Attributes:
+        top_spheres: keep the contact spheres on the objects' top corners and rims (the objects
+            stand upright: only the bottom ones carry them on the table).
+        rim_spheres: spheres on each rim of a cylinder (the world's ``contact.rim_spheres``: 8).
+        robot_self_contact: keep contact between the robot's own links (the world filters only
+            links one joint apart).
+        sampled_output_ports: the plant's ``use_sampled_output_ports`` (False: outputs from the
+            current state, no sampled copy kept per step).
+    """
+
+    top_spheres: bool = False
+    rim_spheres: int = 4
+    robot_self_contact: bool = False
+    sampled_output_ports: bool = False
+
+
+@dataclass(frozen=True)
 class StoConfig:
     """The stochastic trajectory optimiser (``hlp_drake.systems.optimiser``).
 
     Attributes:
         samples: noisy rollouts per iteration (K).
         max_iterations: iteration budget (an iteration = K rollouts + an update).
-        time_budget_s: wall-clock budget of one optimisation; no iteration starts that is expected
-            to end past it.
+        max_rollouts: rollout budget of one optimisation, the initial and the alternatives'
+            rollouts included: no iteration starts that would pass it. With ``max_iterations`` it
+            decides when the optimiser gives up, so the same seed gives the same result on any
+            machine, busy or idle, on 1 or N workers.
+        time_budget_s: an optional wall-clock safety cap of one optimisation, s (0: none); no
+            iteration starts that is expected to end past it. A result then depends on the machine.
         step_duration: duration of one control step, s (the sequence's knots are this far apart).
         noise: base-velocity noise per step.
         update: "greedy" (keep the best noisy rollout) or "mppi" (cost-weighted mean of the noise).
         mppi_temperature: h in w_k = exp(-h (c_k - c_min) / (c_max - c_min)).
         workers: rollout processes (1: roll out in this process).
         seed: seed of the noise.
-        rollout_time_step: plant time step of the rollouts, s (coarser than the execution's; the
-            executed result is checked on the full model).
-        reduced_model: roll out on reduced models in which objects nothing has come near yet are
-            welded at their scene poses (fewer bodies and contacts; every cost term still covers every
-            object, a welded one simply stays put); off: every rollout simulates every object.
-        weld_clearance: in the reduced model, an object is freed ``weld_lookahead`` before the robot's
-            collision geometry, following the commanded motion, first comes within this of it, m.
+        rollout_time_step: plant time step of the rollouts, s (coarser than the execution's; an
+            accepted rollout is verified on the execution model, see ``verify``).
+        rollout_trims: how else the rollout model is cheaper than the world.
+        reduced_model: let the objects sleep (their joints locked) while nothing comes near them,
+            and again once they have come to rest with nothing near (fewer degrees of freedom and
+            contacts; every cost term still covers every object); off: every object is awake in
+            every rollout (the full model).
+        weld_clearance: an object is woken ``weld_lookahead`` before the robot's collision geometry,
+            following the commanded motion, first comes within this of it, and goes back to sleep
+            only with neither the robot nor a moving object this close, m.
         weld_lookahead: see ``weld_clearance``, s.
-        weld_margin: in the reduced model, when at a sample the robot or an object that has moved
-            comes within this (plus the largest motion of a body since the previous sample) of a
-            welded object, the rollout goes back to the previous sample and on with it freed, m.
+        weld_margin: when at a sample the robot or an awake object that has moved comes within this
+            (plus the largest motion of a body since the previous sample) of a sleeping object, the
+            rollout goes back to the previous sample and on with it awake, m.
+        sleep_speed: an awake object slower than this at two samples in a row has come to rest, m/s.
         settle_s: simulated time after the last control step before the final state is read, s.
         sample_period: how often a rollout's state is read for the cost, s.
         max_object_speed: an object faster than this (m/s) means the simulation blew up.
         max_sink: an object's centre more than this below the table top while over it means it
             tunnelled into the table, m.
         cost: the cost weights.
+        verify: before declaring success, simulate a passing rollout's sequence again on the
+            execution model (the world at the plant's time step, every object free, settling as the
+            execution does); only if it passes there too does the optimisation succeed, else that
+            outcome (and cost) replaces the rollout's and the optimisation goes on.
+        max_verifications: verifications per optimisation at most (they do not count in
+            ``max_rollouts``: each costs several rollouts' time, reported apart).
         alternatives: when the initial sequence's rollout fails, roll out the planner's next this
             many distinct candidate plans once (the HLP's, by expected arm collision; the straight
             line has none) and go on from the best of them all (0: never).
@@ -103,21 +138,46 @@ class StoConfig:
 
     samples: int = 8
     max_iterations: int = 20
-    time_budget_s: float = 120.0
+    max_rollouts: int = 100
+    time_budget_s: float = 0.0
     step_duration: float = 0.5
     noise: BaseNoise = field(default_factory=BaseNoise)
     update: Literal["greedy", "mppi"] = "greedy"
     mppi_temperature: float = 10.0
     workers: int = 2
     seed: int = 0
-    rollout_time_step: float = 0.005
+    rollout_time_step: float = 0.01
+    rollout_trims: RolloutTrims = field(default_factory=RolloutTrims)
     reduced_model: bool = True
     weld_clearance: float = 0.15
     weld_lookahead: float = 0.5
     weld_margin: float = 0.01
+    sleep_speed: float = 0.005
     settle_s: float = 0.5
     sample_period: float = 0.1
     max_object_speed: float = 5.0
     max_sink: float = 0.03
     cost: StoCost = field(default_factory=StoCost)
+    verify: bool = True
+    max_verifications: int = 4
     alternatives: int = 3
+
+
+@dataclass(frozen=True)
+class ClosedLoopConfig:
+    """The receding-horizon controller of closed-loop execution (``receding_horizon``).
+
+    Attributes:
+        enabled: execute closed loop (``--execution closed``); False plays the optimised sequence.
+        replan_period: simulated time between two re-optimisations, s.
+        iterations, rollouts: the budget of each re-optimisation (its iterations and rollouts).
+        replan_distance: an object this far from where the current plan's rollout put it has
+            "moved far": the controller asks for a new initial sequence (the planner's, on the
+            observed scene) and optimises from it, the remainder of the current one its alternative, m.
+    """
+
+    enabled: bool = False
+    replan_period: float = 0.5
+    iterations: int = 1
+    rollouts: int = 9
+    replan_distance: float = 0.05

@@ -18,22 +18,17 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem
 from pydrake.trajectories import PiecewisePolynomial
 
 from hlp_drake.systems.control_sequence import ControlSequence
-from hlp_drake.systems.optimiser import StoResult, optimise
+from hlp_drake.systems.optimiser import EMPTY_RESULT, StoResult, optimise
 from hlp_drake.systems.rollout_pool import RolloutPool
 from hlp_drake.systems.scene_source import declare_scene_input_port, scene_input, with_scene
 
 if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
-
-_EMPTY_RESULT = StoResult(
-    ControlSequence(np.array([0.0, 1.0]), np.zeros((2, 11))), None, False, "not optimised"
-)
 
 
 class StochasticTrajectoryOptimiser(LeafSystem):
@@ -62,7 +57,7 @@ class StochasticTrajectoryOptimiser(LeafSystem):
         }
         self._result = self.DeclareAbstractOutputPort(
             name="result",
-            alloc=lambda: AbstractValue.Make(_EMPTY_RESULT),
+            alloc=lambda: AbstractValue.Make(EMPTY_RESULT),
             calc=self._calc_result,
             prerequisites_of_calc=ticket,
         )
@@ -93,7 +88,7 @@ class StochasticTrajectoryOptimiser(LeafSystem):
     def _calc_result(self, context, output) -> None:
         trajectory = self._input.Eval(context) if self._input.HasValue(context) else PiecewisePolynomial()
         if trajectory.get_number_of_segments() == 0:
-            output.set_value(StoResult(_EMPTY_RESULT.sequence, None, False, "no initial trajectory"))
+            output.set_value(StoResult(EMPTY_RESULT.sequence, None, False, "no initial trajectory"))
             return
         scenario = with_scene(self._scenario, scene_input(self._scene, context))
         step = scenario.optimiser.step_duration

@@ -30,10 +30,8 @@ class RolloutSamples:
         max_force: (T,) largest contact force magnitude on any object, N.
         table_contact: (T,) whether the robot touched the table.
         blew_up: why the simulation is not to be trusted (None if it is sane).
-        touched: welded objects something came near where no world with them freed was at hand (the
-            samples stop there; see ``sample_rollout``).
-        welded: the objects that stayed welded throughout (reduced worlds only).
-        switches: how often the rollout moved on to a world with fewer objects welded.
+        asleep: the objects asleep at the end (``rollout_sampler``).
+        switches: how often the set of sleeping objects changed.
     """
 
     times: np.ndarray
@@ -42,9 +40,28 @@ class RolloutSamples:
     max_force: np.ndarray
     table_contact: np.ndarray
     blew_up: str | None = None
-    touched: tuple[str, ...] = ()
-    welded: tuple[str, ...] = ()
+    asleep: tuple[str, ...] = ()
     switches: int = 0
+
+
+@dataclass(frozen=True)
+class Prediction:
+    """Where a rollout had the objects and the tcp at its samples (for comparing with the world later).
+
+    Attributes:
+        times: (T,) sample times from the rollout's start, s.
+        positions: (T, m, 3) object centres (the target first).
+        tcp: (T, 3) tcp positions.
+    """
+
+    times: np.ndarray
+    positions: np.ndarray
+    tcp: np.ndarray
+
+    def at(self, t: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """(object centres, tcp) at the last sample at or before ``t`` (None before the first)."""
+        k = int(np.searchsorted(self.times, t + 1e-9, side="right")) - 1
+        return None if k < 0 else (self.positions[k], self.tcp[k])
 
 
 @dataclass(frozen=True)
@@ -59,8 +76,11 @@ class RolloutOutcome:
         target_distance: final horizontal tcp-to-target distance, m.
         fallen: names of the objects off the table at the end.
         simulated_s, wall_s: simulated and wall-clock time of the rollout.
-        welded: the objects that stayed welded throughout (empty: the full model).
-        switches: how often the rollout moved on to a world with fewer objects welded.
+        asleep: the objects asleep at the end (empty: the full model).
+        switches: how often the set of sleeping objects changed.
+        prediction: the samples' object centres and tcp positions.
+        verification: the same sequence's outcome on the execution model, when it was verified there
+            and passed (its prediction is then the execution's own).
     """
 
     cost: float
@@ -71,8 +91,10 @@ class RolloutOutcome:
     fallen: tuple[str, ...] = ()
     simulated_s: float = 0.0
     wall_s: float = 0.0
-    welded: tuple[str, ...] = ()
+    asleep: tuple[str, ...] = ()
     switches: int = 0
+    prediction: Prediction | None = None
+    verification: RolloutOutcome | None = None
 
 
 def _half_extent(size: tuple[float, float, float]) -> float:

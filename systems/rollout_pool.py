@@ -1,7 +1,7 @@
 """``RolloutPool``: STO rollouts on one or several worker processes, owned and closed by the caller.
 
 The pool keeps pre-built ``SceneRollouts`` (one per scenario, keyed by ``Scenario.key``, the latest
-few, each with its full and reduced ``RolloutWorld``s): with one worker in the pool itself, with
+few, each with its rollout world and, once verifying, its execution world): with one worker in the pool itself, with
 several in each worker process, which receives the scenario as YAML text once per task and builds
 its worlds on first use. A rollout then only swaps a trajectory and resets a context. The results
 are the same either way: a rollout is a pure function of the scenario and the sequence.
@@ -20,6 +20,7 @@ from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.rollout_cost import RolloutOutcome
 
 if TYPE_CHECKING:
+    from hlp_drake.systems.rollout_world import RolloutStart
     from hlp_drake.systems.scenario import Scenario
     from hlp_drake.systems.scene_rollouts import SceneRollouts
 
@@ -50,11 +51,14 @@ class _Worlds:
 _worker_worlds = _Worlds()  # in a worker process: its worlds, for the pool that spawned it
 
 
-def _rollout_task(key: str, scenario_yaml: str, times, knots) -> RolloutOutcome:
+def _rollout_task(
+    key: str, scenario_yaml: str, times, knots, start: RolloutStart | None, verify: bool
+) -> RolloutOutcome:
     from hlp_drake.systems.scenario import load_scenario
 
     world = _worker_worlds.get(key, lambda: load_scenario(data=scenario_yaml))
-    return world.rollout(ControlSequence(times, knots))
+    sequence = ControlSequence(times, knots)
+    return world.verify(sequence, start) if verify else world.rollout(sequence, start)
 
 
 def _warm_up(delay: float) -> int:
@@ -71,7 +75,8 @@ class RolloutPool:
 
     Args:
         workers: rollout processes (1: roll out here).
-        on_rollout: called with every rollout's outcome as it arrives (e.g. to show progress).
+        on_rollout: called with every rollout's outcome as it arrives (e.g. to show progress; not
+            with the verifications').
 
     Attributes:
         startup_s: how long starting the worker processes took, s.
@@ -100,17 +105,29 @@ class RolloutPool:
         """This pool's pre-built ``SceneRollouts`` for ``scenario`` (for start checks and in-process rollouts)."""
         return self._worlds.get(scenario.key, lambda: scenario)
 
-    def rollouts(self, scenario: Scenario, sequences: list[ControlSequence]) -> list[RolloutOutcome]:
-        """The ``RolloutOutcome`` of every sequence, in order."""
+    def rollouts(
+        self,
+        scenario: Scenario,
+        sequences: list[ControlSequence],
+        *,
+        start: RolloutStart | None = None,
+        verify: bool = False,
+    ) -> list[RolloutOutcome]:
+        """The ``RolloutOutcome`` of every sequence, in order, from ``start`` (default: the scene's
+        start); with ``verify`` on the execution model (``SceneRollouts.verify``)."""
         if self._executor is None:
             world = self.world(scenario)
-            return [self._arrived(world.rollout(sequence)) for sequence in sequences]
+            simulate = world.verify if verify else world.rollout
+            return [self._arrived(simulate(sequence, start), verify) for sequence in sequences]
         key, text = scenario.key, scenario.yaml
-        futures = [self._executor.submit(_rollout_task, key, text, s.times, s.knots) for s in sequences]
-        return [self._arrived(future.result()) for future in futures]
+        futures = [
+            self._executor.submit(_rollout_task, key, text, s.times, s.knots, start, verify)
+            for s in sequences
+        ]
+        return [self._arrived(future.result(), verify) for future in futures]
 
-    def _arrived(self, outcome: RolloutOutcome) -> RolloutOutcome:
-        if self._on_rollout is not None:
+    def _arrived(self, outcome: RolloutOutcome, verify: bool) -> RolloutOutcome:
+        if self._on_rollout is not None and not verify:
             self._on_rollout(outcome)
         return outcome
 

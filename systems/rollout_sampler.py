@@ -1,15 +1,28 @@
-"""``sample_rollout``: a rollout read every sample period, moving on to worlds with fewer objects welded.
+"""``sample_rollout``: a rollout read every sample period, its objects put to sleep and woken as it goes.
 
-At every sample the rollout also checks that neither the robot nor an object that has moved came
-within ``optimiser.weld_margin`` (plus the largest motion of a body since the previous sample) of a
-welded object; if one did, it goes back to the previous sample and on with it freed. Each welded
-set is a world of its own, built once; moving on carries the robot's and the free objects' states over.
+An object asleep has its floating joint locked (``RolloutWorld.set_asleep``): it stays put and adds
+no degrees of freedom to the contact problem, which is where most of a rollout's time goes
+(resting objects' table contacts). At every sample the rollout
+
+* wakes, from the previous sample on, every sleeping object that the robot or an awake object that
+  has moved came within ``optimiser.weld_margin`` (plus the largest motion of a body since the
+  previous sample) of: until then nothing can have touched it, so it would have stayed at rest
+  anyway;
+* wakes the objects the commanded motion comes within ``optimiser.weld_clearance`` of in the next
+  ``optimiser.weld_lookahead`` s (``SleepSchedule``);
+* puts back to sleep the awake objects that have come to rest (slower than ``optimiser.sleep_speed``
+  at this sample and the previous one), with neither the robot nor a moving object within
+  ``optimiser.weld_clearance`` (SceneGraph's distances), nor an object that stays awake within
+  twice the margin (resting objects in contact sleep together), and the commanded motion not
+  about to come near: e.g. an obstacle pushed aside and left there once the robot has gone.
+
+A rollout's outcome is a pure function of the scene, the configuration, the start and the sequence.
 """
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -18,49 +31,107 @@ from hlp_drake.systems.optimiser_config import StoConfig
 from hlp_drake.systems.rollout_cost import RolloutSamples
 
 if TYPE_CHECKING:
-    from hlp_drake.systems.rollout_world import RolloutWorld
+    from hlp_drake.systems.rollout_world import BodyPoses, RolloutStart, RolloutWorld
+    from hlp_drake.systems.sleep_schedule import SleepSchedule
+
+MOVED = 1.0e-3
+"""An awake object whose geometry has moved more than this from its start (m) is watched near sleeping ones."""
+ANGULAR_REST = 0.05
+"""An object turning slower than this (rad/s) may count as at rest."""
 
 
-class WorldSet(Protocol):
-    """Worlds of one scene by the objects welded in them."""
+def _near_asleep(
+    world: RolloutWorld, poses: BodyPoses, previous: BodyPoses, start: BodyPoses, asleep: frozenset[str]
+) -> frozenset[str]:
+    """The sleeping objects within the margin (see the module's docstring) of the robot or of an
+    awake object that has moved since ``start`` (the poses now)."""
+    names = [body.name() for body in world.objects]
+    moved = world.motion_bounds(poses, start) > MOVED
+    moved[: world.num_robot_bodies] = True  # the robot always counts
+    for i, name in enumerate(names):
+        if name in asleep:
+            moved[world.num_robot_bodies + i] = False
+    step = float(np.max(world.motion_bounds(poses, previous)[moved], initial=0.0))
+    watchers = {name for name, m in zip(names, moved[world.num_robot_bodies :]) if m}
+    near = set()
+    for a, b, _ in world.close_pairs(world.scenario.optimiser.weld_margin + step):
+        for sleeper, other in ((a, b), (b, a)):
+            name, other_name = world.object_name(sleeper), world.object_name(other)
+            if name in asleep and (other in world.robot_bodies or other_name in watchers):
+                near.add(name)
+    return frozenset(near)
 
-    def world_with(self, welded: frozenset[str]) -> RolloutWorld | None: ...
 
-
-class Schedule(Protocol):
-    """The objects to keep welded from a time on."""
-
-    def welded_at(self, t: float) -> frozenset[str]: ...
+def _sleepers(
+    world: RolloutWorld,
+    poses: BodyPoses,
+    previous: BodyPoses,
+    asleep: frozenset[str],
+    keep_awake: frozenset[str],
+    sto: StoConfig,
+) -> frozenset[str]:
+    """The awake objects that may go to sleep now (see the module's docstring): at rest, with
+    neither the robot nor a moving object within ``weld_clearance`` and no object staying awake
+    within twice ``weld_margin`` (resting objects touching each other go to sleep together)."""
+    names = [body.name() for body in world.objects]
+    speed, turn = world.object_speeds()
+    step = world.motion_bounds(poses, previous)[world.num_robot_bodies :]
+    resting = (speed < sto.sleep_speed) & (turn < ANGULAR_REST) & (step < sto.sleep_speed * sto.sample_period)
+    index = {name: i for i, name in enumerate(names)}
+    chosen = {n for i, n in enumerate(names) if resting[i] and n not in asleep and n not in keep_awake}
+    if not chosen:
+        return frozenset()
+    touching: dict[str, set[str]] = {n: set() for n in chosen}
+    for a, b, distance in world.close_pairs(sto.weld_clearance):
+        for body, other in ((a, b), (b, a)):
+            name, other_name = world.object_name(body), world.object_name(other)
+            if name not in touching:
+                continue
+            if other in world.robot_bodies or (
+                other_name is not None and other_name not in asleep and not resting[index[other_name]]
+            ):
+                chosen.discard(name)  # the robot or a moving object is near
+            elif other_name is not None and other_name not in asleep and distance < 2.0 * sto.weld_margin:
+                touching[name].add(other_name)
+    changed = True
+    while changed:  # an object touching one that stays awake stays awake too
+        awake_touched = {n for n in chosen if touching[n] - chosen}
+        chosen -= awake_touched
+        changed = bool(awake_touched)
+    return frozenset(chosen)
 
 
 def sample_rollout(
-    sequence: ControlSequence, sto: StoConfig, worlds: WorldSet, schedule: Schedule
+    sequence: ControlSequence,
+    sto: StoConfig,
+    world: RolloutWorld,
+    schedule: SleepSchedule,
+    *,
+    start: RolloutStart | None = None,
 ) -> RolloutSamples:
-    """Roll ``sequence`` out and read the state every ``sto.sample_period``, on worlds of one scene
-    with fewer and fewer objects welded.
+    """Roll ``sequence`` out on ``world`` and read the state every ``sto.sample_period``, its objects
+    asleep and awake as ``schedule`` and the checks of the module's docstring say.
 
     Args:
-        worlds: ``worlds.world_with(welded)`` is the ``RolloutWorld`` with the objects ``welded``
-            welded, or None if there is none (the samples then stop where it would be needed).
-        schedule: ``schedule.welded_at(t)`` are the objects to keep welded from sample time ``t`` on
-            (at most those welded before: an object once free stays free).
-
-    At every sample the rollout moves on to a world with fewer objects welded (carrying over the
-    robot's and the free objects' states) when ``welded_at`` frees some, and goes back to the
-    previous sample and on with them freed when the robot or an object that has moved came near a
-    welded object (``RolloutWorld.near_welded``): until then nothing can have touched it, so in the
-    full model it would have stayed at rest, as it does welded.
+        start: the state to start from (default: the scene's, the robot at its start configuration);
+            objects moving in it start awake.
     """
     end = sequence.duration + sto.settle_s
     count = max(1, math.ceil(end / sto.sample_period - 1e-9))
     times = np.minimum(sto.sample_period * np.arange(count + 1), end)
-    welded = frozenset(schedule.welded_at(0.0))
-    world = worlds.world_with(welded)
-    world.begin(sequence)
-    start = previous = world.watched_poses()
+    initial = None if start is None else start.states
+    world.begin(sequence, states=initial)
+    speed, turn = world.object_speeds()
+    moving = {
+        b.name() for b, v, w in zip(world.objects, speed, turn) if v >= sto.sleep_speed or w >= ANGULAR_REST
+    }
+    asleep = schedule.initially_asleep() - moving
+    world.set_asleep(frozenset(), asleep)
+    first = previous = world.watched_poses()
+    saved = (0.0, world.states())  # the time and the states at the last sample read
+    woken: set[str] = set()
     readings: list[list] = []
-    problem, touched, switches = None, (), 0
-    saved: tuple[float, dict] | None = None  # the time and the states at the last sample read
+    problem, switches = None, 0
     k = 0
     while k < len(times):
         t = times[k]
@@ -68,29 +139,30 @@ def sample_rollout(
             problem = world.advance_to(t)
             if problem is not None:
                 break
-        poses = world.watched_poses() if welded else previous  # nothing to watch for once all are free
-        near = world.near_welded(poses, previous, start)
-        if near:  # back to the previous sample (or the start) with those objects freed
-            freed, at = frozenset(near), saved
-        else:
-            reading = world.read()
-            readings.append(reading)
-            if reading.problem is not None:
-                problem = f"{reading.problem} at t = {t:.2f} s"
-                break
-            previous, saved = poses, (float(t), world.states()) if welded else None
-            freed, at = welded - frozenset(schedule.welded_at(t)), saved
-            k += 1
-        if freed:
-            successor = worlds.world_with(welded - freed)
-            if successor is None:
-                touched = tuple(sorted(freed))
-                break
-            world, welded, switches = successor, welded - freed, switches + 1
-            if at is None:
-                world.begin(sequence)
-            else:
-                world.begin(sequence, time=at[0], states=at[1])
+        poses = world.watched_poses()
+        near = _near_asleep(world, poses, previous, first, asleep) if asleep else frozenset()
+        if near:  # back to the previous sample (or the start) with those objects awake
+            asleep, switches = asleep - near, switches + 1
+            world.begin(sequence, time=saved[0], states=saved[1], asleep=asleep)
+            continue
+        reading = world.read()
+        readings.append(reading)
+        if reading.problem is not None:
+            problem = f"{reading.problem} at t = {t:.2f} s"
+            break
+        due = schedule.due(t) - woken
+        woken |= due
+        sleepers = (
+            _sleepers(world, poses, previous, asleep, schedule.approaching(t), sto)
+            if schedule.sleeping
+            else frozenset()
+        )
+        after = (asleep - due) | sleepers
+        if after != asleep:
+            world.set_asleep(asleep, after)
+            asleep, switches = after, switches + 1
+        previous, saved = poses, (float(t), world.states())
+        k += 1
     positions, tcps, forces, contacts, _ = zip(*readings) if readings else ([], [], [], [], [])
     return RolloutSamples(
         times[: len(readings)],
@@ -99,7 +171,6 @@ def sample_rollout(
         np.array(forces),
         np.array(contacts, dtype=bool),
         problem,
-        touched,
-        welded=tuple(sorted(welded)),
+        asleep=tuple(sorted(asleep)),
         switches=switches,
     )

@@ -1,9 +1,12 @@
 """``RolloutWorld``: a world built once per scene, in which a control sequence is rolled out with contact.
 
-The world is ``make_world_diagram`` at the rollout time step (``optimiser.rollout_time_step``) with a
-C++ ``TrajectorySource`` driving the robot; the initial context is kept. A rollout swaps the source's
-trajectory, resets the context and simulates, Python only reading the state (``Reading``) every
-``optimiser.sample_period``. A reduced world has some objects welded (see ``scene_rollouts``).
+The world is ``make_world_diagram`` of the rollout model (``rollout_scenario``: the optimiser's
+``rollout_time_step`` and ``rollout_trims``) or of the execution model itself (``execution=True``,
+for verifying), with a C++ ``TrajectorySource`` driving the robot; the initial context is kept. A
+rollout swaps the source's trajectory, resets the context (or sets a given start state) and
+simulates, Python only reading the state (``Reading``) every ``optimiser.sample_period``. Objects
+may be put to sleep (their floating joints locked in the context: they neither move nor cost the
+contact solver a degree of freedom) and woken again, at any pose (see ``rollout_sampler``).
 """
 
 from __future__ import annotations
@@ -16,25 +19,23 @@ from functools import cached_property
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
-from pydrake.geometry import Role
+from pydrake.geometry import CollisionFilterDeclaration, GeometrySet, Role
 from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.robot import TCP_FRAME
-from hlp_drake.systems.rollout_cost import RolloutOutcome, RolloutSamples, rollout_cost
+from hlp_drake.systems.rollout_cost import Prediction, RolloutOutcome, RolloutSamples, rollout_cost
 from hlp_drake.systems.rollout_sampler import sample_rollout
 from hlp_drake.systems.scene_models import TABLE_NAME, object_body, over_table_mask
+from hlp_drake.systems.sleep_schedule import AWAKE
 from hlp_drake.systems.start_pose import tcp_keypoint_height
-from hlp_drake.systems.weld_schedule import FixedWelds
 from hlp_drake.systems.world import add_position_trajectory, make_world_diagram, world_plant
+from hlp_drake.systems.world_settings import EXECUTION_SETTLE_S
 
 if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
-
-MOVED = 1.0e-3
-"""A free object whose geometry has moved more than this from its start (m) is watched near welded ones."""
 
 
 def simulation_failure(error: BaseException) -> str:
@@ -47,10 +48,35 @@ def simulation_failure(error: BaseException) -> str:
 
 
 def rollout_scenario(scenario: Scenario) -> Scenario:
-    """``scenario`` with the plant stepping at the optimiser's rollout time step."""
+    """``scenario`` as the optimiser's rollout model: the plant stepping at ``optimiser.rollout_time_step``
+    and the contact geometry and plant outputs trimmed as ``optimiser.rollout_trims`` says."""
+    sto = scenario.optimiser
+    trims = sto.rollout_trims
     plant = copy.copy(scenario.plant)
-    plant.time_step = scenario.optimiser.rollout_time_step
-    return replace(scenario, plant=plant)
+    plant.time_step = sto.rollout_time_step
+    plant.use_sampled_output_ports = trims.sampled_output_ports
+    contact = replace(
+        scenario.contact,
+        top_spheres=trims.top_spheres,
+        rim_spheres=trims.rim_spheres,
+        robot_self_contact=trims.robot_self_contact,
+    )
+    return replace(scenario, plant=plant, contact=contact)
+
+
+def verification_scenario(scenario: Scenario) -> Scenario:
+    """``scenario`` as the execution simulates it (its own plant and contact), settling as long as the
+    execution does before the reach is checked."""
+    return replace(scenario, optimiser=replace(scenario.optimiser, settle_s=EXECUTION_SETTLE_S))
+
+
+@dataclass(frozen=True)
+class RolloutStart:
+    """A rollout's start other than the scene's: the given model instances' positions and velocities
+    (by name: the robot's and objects'; any other starts as in the scene) at time 0, in
+    ``RolloutWorld.states()``' form (positions then velocities)."""
+
+    states: dict[str, np.ndarray]
 
 
 def _rotation_angles(R_a: np.ndarray, R_b: np.ndarray) -> np.ndarray:
@@ -90,18 +116,20 @@ class Reading(NamedTuple):
 class RolloutWorld:
     """A pre-built world for rolling out control sequences on ``scenario``'s scene (one per worker process).
 
-    With ``welded_objects`` it is a reduced world: those objects are welded at their scene poses, and
-    ``near_welded`` tells which of them the robot or a moving object came near.
+    Every object is a free body; ``begin(..., asleep=...)`` and ``set_asleep`` lock and unlock their
+    joints (``rollout_sampler``). With ``execution`` it is the execution model
+    (``verification_scenario``) rather than the rollout model.
     """
 
-    def __init__(self, scenario: Scenario, *, welded_objects: Iterable[str] = ()) -> None:
+    def __init__(self, scenario: Scenario, *, execution: bool = False) -> None:
+        if execution:
+            scenario = verification_scenario(scenario)
         scene = scenario.scene
         self.scene = scene
         self.scenario = scenario
-        self.welded_objects = frozenset(welded_objects)
         builder = DiagramBuilder()
         world = builder.AddSystem(
-            make_world_diagram(rollout_scenario(scenario), welded_objects=self.welded_objects, cameras=False)
+            make_world_diagram(scenario if execution else rollout_scenario(scenario), cameras=False)
         )
         plant, robot = world_plant(world)
         start = plant.GetPositions(plant.CreateDefaultContext(), robot)
@@ -119,6 +147,11 @@ class RolloutWorld:
         self._initial = self._context.Clone()
         self.objects = [object_body(plant, obj.name) for obj in scene.objects]
         self.object_bodies = {int(body.index()) for body in self.objects}
+        self._object_names = {int(body.index()): body.name() for body in self.objects}
+        self._joints = {
+            b.name(): [plant.get_joint(j) for j in plant.GetJointIndices(b.model_instance())]
+            for b in self.objects
+        }
         self._table_bodies = {int(i) for i in plant.GetBodyIndices(plant.GetModelInstanceByName(TABLE_NAME))}
         self.robot_bodies = {int(i) for i in plant.GetBodyIndices(robot)}
         self._tcp = plant.GetFrameByName(TCP_FRAME, robot)
@@ -128,12 +161,14 @@ class RolloutWorld:
             g: int(plant.GetBodyFromFrameId(inspector.GetFrameId(g)).index())
             for g in inspector.GetAllGeometryIds(Role.kProximity)
         }
-        self._welded_bodies = {
-            int(b.index()): b.name() for b in self.objects if b.name() in self.welded_objects
-        }
-        self._moving = [robot] + [
-            b.model_instance() for b in self.objects if b.name() not in self.welded_objects
-        ]
+        self._instances = [robot] + [b.model_instance() for b in self.objects]
+        self._scene_graph = world.GetSubsystemByName("scene_graph")
+        self._scene_graph_context = self._scene_graph.GetMyMutableContextFromRoot(self._context)
+        self._geometries = {b.name(): plant.GetCollisionGeometriesForBody(b) for b in self.objects}
+        self._table_geometry = GeometrySet(
+            [g for g, body in self.geometry_body.items() if body in self._table_bodies]
+        )
+        self._filter = None
         robot_bodies = [plant.get_body(i) for i in plant.GetBodyIndices(robot)]
         self._num_robot_watched = len(robot_bodies)
         self._watched = robot_bodies + self.objects
@@ -162,10 +197,16 @@ class RolloutWorld:
         return tuple(sorted(hits))
 
     def begin(
-        self, sequence: ControlSequence, *, time: float = 0.0, states: dict[str, np.ndarray] | None = None
+        self,
+        sequence: ControlSequence,
+        *,
+        time: float = 0.0,
+        states: dict[str, np.ndarray] | None = None,
+        asleep: Iterable[str] = (),
     ) -> None:
         """Load ``sequence`` and reset to the initial state, or to time ``time`` with the given model
-        instances' states (``states()`` of another world of this scene; the rest start at rest)."""
+        instances' states (``states()``'s or a ``RolloutStart``'s form; the rest start as in the
+        scene), with the objects ``asleep`` asleep."""
         self._source.UpdateTrajectory(sequence.to_trajectory())
         self._context.SetTimeStateAndParametersFrom(self._initial)
         if states is not None:
@@ -173,14 +214,40 @@ class RolloutWorld:
             for name, x in states.items():
                 instance = self.plant.GetModelInstanceByName(name)
                 self.plant.SetPositionsAndVelocities(self._plant_context, instance, x)
+        self._filter = None  # the reset dropped the sleeping objects' collision filter
+        self.set_asleep(frozenset(), frozenset(asleep))
         self._simulator.Initialize()
 
+    def set_asleep(self, before: frozenset[str], after: frozenset[str]) -> None:
+        """Put the objects of ``after`` but not ``before`` to sleep (their joints locked, velocities
+        zeroed) and wake those of ``before`` but not ``after``. Sleeping objects' contacts with the
+        table and with each other are filtered out (neither moves)."""
+        for name in after - before:
+            for joint in self._joints[name]:
+                joint.Lock(self._plant_context)
+        for name in before - after:
+            for joint in self._joints[name]:
+                joint.Unlock(self._plant_context)
+        if after == before and self._filter is not None:
+            return
+        manager = self._scene_graph.collision_filter_manager(self._scene_graph_context)
+        if self._filter is not None:
+            manager.RemoveDeclaration(self._filter)
+            self._filter = None
+        if after:
+            sleeping = GeometrySet([g for name in after for g in self._geometries[name]])
+            self._filter = manager.ApplyTransient(
+                CollisionFilterDeclaration()
+                .ExcludeWithin(sleeping)
+                .ExcludeBetween(sleeping, self._table_geometry)
+            )
+
     def states(self) -> dict[str, np.ndarray]:
-        """Positions and velocities of the robot and of every free object, by model instance name."""
+        """Positions and velocities of the robot and of every object, by model instance name."""
         plant = self.plant
         return {
             plant.GetModelInstanceName(i): plant.GetPositionsAndVelocities(self._plant_context, i)
-            for i in self._moving
+            for i in self._instances
         }
 
     def advance_to(self, t: float) -> str | None:
@@ -195,28 +262,36 @@ class RolloutWorld:
         return self._context.get_time()
 
     def watched_poses(self) -> BodyPoses:
-        """Poses of the robot's bodies and of every object (for ``near_welded``)."""
+        """Poses of the robot's bodies and of every object (for ``rollout_sampler``'s checks)."""
         X = np.array([body.EvalPoseInWorld(self._plant_context).GetAsMatrix34() for body in self._watched])
         return BodyPoses(X[:, :, 3], X[:, :, :3])
 
-    def near_welded(self, poses: BodyPoses, previous: BodyPoses, start: BodyPoses) -> tuple[str, ...]:
-        """The welded objects within ``sto.weld_margin`` plus the largest motion of a watched body since
-        ``previous`` of the robot or of an object that has moved since ``start`` (the poses now)."""
-        if not self._welded_bodies:
-            return ()
-        radii = self._watched_radii
-        moved = poses.motion(start, radii) > MOVED
-        moved[: self._num_robot_watched] = True  # the robot always counts
-        step = float(np.max(poses.motion(previous, radii)[moved], initial=0.0))
-        margin = self.scenario.optimiser.weld_margin + step
-        watched = {int(b.index()) for b, m in zip(self._watched, moved) if m}
-        near = set()
-        for pair in self._query.Eval(self._world_context).ComputeSignedDistancePairwiseClosestPoints(margin):
-            a, b = self.geometry_body[pair.id_A], self.geometry_body[pair.id_B]
-            for welded, other in ((a, b), (b, a)):
-                if welded in self._welded_bodies and other in watched:
-                    near.add(self._welded_bodies[welded])
-        return tuple(obj.name for obj in self.scene.objects if obj.name in near)
+    def motion_bounds(self, poses: BodyPoses, other: BodyPoses) -> np.ndarray:
+        """(robot bodies + objects,) how far a point of each watched body moved from ``other`` to ``poses``."""
+        return poses.motion(other, self._watched_radii)
+
+    @property
+    def num_robot_bodies(self) -> int:
+        """The watched bodies are the robot's (this many, first) and then the objects (in scene order)."""
+        return self._num_robot_watched
+
+    def close_pairs(self, threshold: float) -> list[tuple[int, int, float]]:
+        """(body, body, distance) of the geometry pairs within ``threshold`` of each other (m; the
+        pairs SceneGraph filters, e.g. two sleeping objects, left out)."""
+        pairs = self._query.Eval(self._world_context).ComputeSignedDistancePairwiseClosestPoints(threshold)
+        return [(self.geometry_body[p.id_A], self.geometry_body[p.id_B], p.distance) for p in pairs]
+
+    def object_name(self, body: int) -> str | None:
+        """The scene object of body index ``body`` (None: the robot or the table)."""
+        return self._object_names.get(body)
+
+    def object_speeds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per object (scene order), its translational (m/s) and angular (rad/s) speed."""
+        velocities = [body.EvalSpatialVelocityInWorld(self._plant_context) for body in self.objects]
+        return (
+            np.array([np.linalg.norm(v.translational()) for v in velocities]),
+            np.array([np.linalg.norm(v.rotational()) for v in velocities]),
+        )
 
     def read(self) -> Reading:
         """The rollout's state now."""
@@ -256,23 +331,13 @@ class RolloutWorld:
             problem = f"{self.scene.objects[int(np.argmax(sunk))].name} sank into the table"
         return Reading(positions, tcp, max_force, table_contact, problem)
 
-    def world_with(self, welded: frozenset[str]) -> RolloutWorld | None:
-        """This world if ``welded`` are its welded objects, else None (a ``WorldSet`` of one world)."""
-        return self if welded == self.welded_objects else None
-
-    def simulate(self, sequence: ControlSequence) -> RolloutSamples:
-        """Roll ``sequence`` out from the initial state and read the state every sample period (on a
-        reduced world, up to the first sample at which something came near a welded object)."""
-        return sample_rollout(sequence, self.scenario.optimiser, self, FixedWelds(self.welded_objects))
+    def simulate(self, sequence: ControlSequence, start: RolloutStart | None = None) -> RolloutSamples:
+        """Roll ``sequence`` out from the initial state (or ``start``) with every object awake,
+        reading the state every sample period (the full model)."""
+        return sample_rollout(sequence, self.scenario.optimiser, self, AWAKE, start=start)
 
     def cost(self, samples: RolloutSamples, sequence: ControlSequence) -> RolloutOutcome:
-        """The cost of ``sequence``'s rollout from its ``samples``.
-
-        Raises:
-            ValueError: the samples stopped because something came near a welded object.
-        """
-        if samples.touched:
-            raise ValueError(f"the rollout came near the welded {', '.join(samples.touched)}")
+        """The cost of ``sequence``'s rollout from its ``samples``."""
         return rollout_cost(
             samples,
             self.scene,
@@ -282,14 +347,22 @@ class RolloutWorld:
             step_duration=float(np.mean(sequence.steps)),
         )
 
-    def rollout(self, sequence: ControlSequence) -> RolloutOutcome:
-        """Simulate ``sequence`` and cost it (see ``cost``)."""
-        return timed_rollout(sequence, self.simulate, self)
+    def rollout(self, sequence: ControlSequence, start: RolloutStart | None = None) -> RolloutOutcome:
+        """Simulate ``sequence`` (from ``start``) and cost it (see ``cost``)."""
+        return timed_rollout(sequence, self.simulate, self, start)
 
 
-def timed_rollout(sequence: ControlSequence, simulate, costing: RolloutWorld) -> RolloutOutcome:
-    """``simulate(sequence)`` costed by ``costing``, with the welding record and the wall time."""
+def timed_rollout(
+    sequence: ControlSequence, simulate, costing: RolloutWorld, start: RolloutStart | None = None
+) -> RolloutOutcome:
+    """``simulate(sequence, start)`` costed by ``costing``, with the sleeping record and the wall time."""
     started = time.perf_counter()
-    samples = simulate(sequence)
-    outcome = replace(costing.cost(samples, sequence), welded=samples.welded, switches=samples.switches)
+    samples = simulate(sequence, start)
+    prediction = Prediction(samples.times, samples.positions, samples.tcp)
+    outcome = replace(
+        costing.cost(samples, sequence),
+        asleep=samples.asleep,
+        switches=samples.switches,
+        prediction=prediction,
+    )
     return replace(outcome, wall_s=time.perf_counter() - started)

@@ -21,7 +21,7 @@ whole)::
 from __future__ import annotations
 
 import hashlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
 from typing import Literal
@@ -33,7 +33,8 @@ from hlp_drake.planner.config import PlannerConfig
 from hlp_drake.scene.io import default_scene
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.validation import scene_problems
-from hlp_drake.systems.optimiser_config import StoConfig
+from hlp_drake.systems.model_error import UncertaintyConfig
+from hlp_drake.systems.optimiser_config import ClosedLoopConfig, StoConfig
 from hlp_drake.systems.perception_config import PerceptionConfig
 from hlp_drake.systems.scenario_checks import scenario_problems
 from hlp_drake.systems.transfer_geometry import TransferConfig
@@ -88,6 +89,8 @@ class Scenario:
         grasp: the grasp and lift after the reach.
         perception: where the planning blocks' scene comes from (the plant, or the cameras through
             ``ScenePerception``), the world's cameras and the perception block's settings.
+        closed_loop: the receding-horizon controller of ``--execution closed``.
+        uncertainty: the seeded model error of ``--uncertainty`` (``model_error``).
     """
 
     scene: Scene = field(default_factory=default_scene)
@@ -102,6 +105,8 @@ class Scenario:
     optimiser: StoConfig = field(default_factory=StoConfig)
     grasp: GraspConfig = field(default_factory=GraspConfig)
     perception: PerceptionConfig = field(default_factory=PerceptionConfig)
+    closed_loop: ClosedLoopConfig = field(default_factory=ClosedLoopConfig)
+    uncertainty: UncertaintyConfig = field(default_factory=UncertaintyConfig)
 
     @cached_property
     def yaml(self) -> str:
@@ -155,4 +160,19 @@ def load_scenario(
     return scenario
 
 
-__all__ = ["PLANNERS", "PlannerSettings", "Scenario", "load_scenario"]
+def with_conditions(
+    scenario: Scenario, *, execution: str | None = None, uncertainty: int | None = None
+) -> Scenario:
+    """``scenario`` executed ``execution`` ("open" or "closed"; None: as it says), with seeded
+    model error of seed ``uncertainty`` (None: as it says), the ``--execution`` and
+    ``--uncertainty`` options of ``run_scene`` and the experiments."""
+    if execution is not None:
+        scenario = replace(scenario, closed_loop=replace(scenario.closed_loop, enabled=execution == "closed"))
+    if uncertainty is not None:
+        scenario = replace(
+            scenario, uncertainty=replace(scenario.uncertainty, enabled=True, seed=int(uncertainty))
+        )
+    return scenario
+
+
+__all__ = ["PLANNERS", "PlannerSettings", "Scenario", "load_scenario", "with_conditions"]

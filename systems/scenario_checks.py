@@ -79,13 +79,17 @@ def scenario_problems(scenario: Scenario) -> list[str]:
     positive("motion.joint_speed_fraction", scenario.motion.joint_speed_fraction)
     positive("motion.min_segment_duration", scenario.motion.min_segment_duration)
     sto, grasp = scenario.optimiser, scenario.grasp
-    for name in ("samples", "max_iterations", "workers"):
+    for name in ("samples", "max_iterations", "max_rollouts", "workers"):
         if int(getattr(sto, name)) < 1:
             problems.append(f"optimiser.{name} must be >= 1, got {getattr(sto, name)}")
-    if int(sto.alternatives) < 0:
-        problems.append(f"optimiser.alternatives must be >= 0, got {sto.alternatives}")
+    for name in ("alternatives", "max_verifications"):
+        if int(getattr(sto, name)) < 0:
+            problems.append(f"optimiser.{name} must be >= 0, got {getattr(sto, name)}")
+    rim = sto.rollout_trims.rim_spheres
+    if rim < 0 or rim in (1, 2):
+        problems.append(f"optimiser.rollout_trims.rim_spheres must be 0 or >= 3, got {rim}")
+    positive("optimiser.time_budget_s", sto.time_budget_s, zero_ok=True)
     for name in (
-        "time_budget_s",
         "step_duration",
         "mppi_temperature",
         "rollout_time_step",
@@ -98,6 +102,7 @@ def scenario_problems(scenario: Scenario) -> list[str]:
     positive("optimiser.weld_clearance", sto.weld_clearance)
     positive("optimiser.weld_lookahead", sto.weld_lookahead, zero_ok=True)
     positive("optimiser.weld_margin", sto.weld_margin, zero_ok=True)
+    positive("optimiser.sleep_speed", sto.sleep_speed, zero_ok=True)
     if sto.weld_margin > sto.weld_clearance:
         problems.append(
             f"optimiser.weld_margin ({sto.weld_margin}) must not exceed optimiser.weld_clearance ({sto.weld_clearance})"

@@ -91,14 +91,15 @@ def _support_points(obj: SceneObject, contact: ContactConfig) -> list[np.ndarray
         return []
     sx, sy, height = obj.size
     z = height / 2.0 - r
+    levels = (-1, 1) if contact.top_spheres else (-1,)
     if obj.shape == "box":
         x, y = sx / 2.0 - r, sy / 2.0 - r
-        return [np.array([i * x, j * y, k * z]) for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)]
+        return [np.array([i * x, j * y, k * z]) for i in (-1, 1) for j in (-1, 1) for k in levels]
     if contact.rim_spheres <= 0:
         return []
     rho = sx / 2.0 - r
     angles = 2.0 * math.pi * np.arange(contact.rim_spheres) / contact.rim_spheres
-    return [np.array([rho * math.cos(a), rho * math.sin(a), k * z]) for k in (-1, 1) for a in angles]
+    return [np.array([rho * math.cos(a), rho * math.sin(a), k * z]) for k in levels for a in angles]
 
 
 def _add_object(
@@ -109,12 +110,13 @@ def _add_object(
     *,
     color: np.ndarray,
     support_spheres: bool = True,
+    scales: tuple[float, float] = (1.0, 1.0),
 ) -> tuple[ModelInstanceIndex, RigidBody]:
     sx, sy, height = obj.size
     if obj.shape not in ("box", "cylinder"):
         raise ValueError(f"object {obj.name!r} has unknown shape {obj.shape!r}")
     instance = plant.AddModelInstance(obj.name)
-    mass = object_mass(obj, bodies)
+    mass = object_mass(obj, bodies) * scales[0]
     if obj.shape == "box":
         shape = Box(sx, sy, height)
         unit_inertia = UnitInertia.SolidBox(sx, sy, height)
@@ -122,7 +124,7 @@ def _add_object(
         shape = Cylinder(sx / 2.0, height)
         unit_inertia = UnitInertia.SolidCylinder(sx / 2.0, height, [0.0, 0.0, 1.0])
     body = plant.AddRigidBody(obj.name, instance, SpatialInertia(mass, np.zeros(3), unit_inertia))
-    properties = _contact_properties(contact, contact.object_friction)
+    properties = _contact_properties(contact, contact.object_friction * scales[1])
     plant.RegisterCollisionGeometry(body, RigidTransform(), shape, f"{obj.name}_collision", properties)
     plant.RegisterVisualGeometry(body, RigidTransform(), shape, f"{obj.name}_visual", color)
     sphere = Sphere(contact.corner_sphere_radius) if contact.corner_sphere_radius > 0 else None
@@ -142,6 +144,7 @@ def add_scene(
     weld_objects: bool = False,
     welded_objects: Iterable[str] = (),
     with_objects: bool = True,
+    scales: dict[str, tuple[float, float]] | None = None,
 ) -> SceneModels:
     """Add ``scene``'s table and objects to ``plant`` (not yet finalized).
 
@@ -155,6 +158,8 @@ def add_scene(
             (objects a motion cannot reach, to shrink a simulation's contact problem); they get no
             support spheres (they rest on nothing, and their shape holds the spheres anyway).
         with_objects: False adds the table only (``SceneModels.objects`` is then empty).
+        scales: per object name, factors on its mass and its friction coefficient (a world with
+            model error, ``model_error``; default 1).
 
     Returns:
         The model instances; the objects' free-body default poses are their scene poses.
@@ -199,7 +204,13 @@ def add_scene(
     for obj in scene.objects if with_objects else ():
         color = TARGET_COLOR if obj is scene.target else OBSTACLE_COLOR
         instance, body = _add_object(
-            plant, obj, contact, bodies, color=color, support_spheres=weld_objects or obj.name not in welded
+            plant,
+            obj,
+            contact,
+            bodies,
+            color=color,
+            support_spheres=weld_objects or obj.name not in welded,
+            scales=(scales or {}).get(obj.name, (1.0, 1.0)),
         )
         objects[obj.name] = instance
         X_WO = object_pose(obj, table.height)

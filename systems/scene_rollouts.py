@@ -1,68 +1,70 @@
-"""``SceneRollouts``: the rollouts of one scenario, on its full world or on reduced ones.
+"""``SceneRollouts``: the rollouts of one scenario on its rollout model, and their verification.
 
 The reduced model (``optimiser.reduced_model``): most of a rollout's time goes to the contact problem,
 which every resting object joins with its contact points on the table. An object nothing has come
-near stays at rest, so until then it can as well be welded (``weld_schedule``, ``rollout_sampler``).
-Every cost term still covers every object: a welded one simply stays put.
+near stays at rest, so until then it can as well sleep (its joint locked; ``sleep_schedule``,
+``rollout_sampler``); one that has come to rest again goes back to sleep. Every cost term still
+covers every object. ``verify`` rolls a sequence out on the execution model instead
+(``RolloutWorld(..., execution=True)``).
 """
 
 from __future__ import annotations
 
-from collections import OrderedDict
 from typing import TYPE_CHECKING
 
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.rollout_cost import RolloutOutcome, RolloutSamples
 from hlp_drake.systems.rollout_sampler import sample_rollout
-from hlp_drake.systems.rollout_world import RolloutWorld, timed_rollout
-from hlp_drake.systems.weld_schedule import FixedWelds, Sweep, WeldSchedule
+from hlp_drake.systems.rollout_world import RolloutStart, RolloutWorld, timed_rollout
+from hlp_drake.systems.sleep_schedule import AWAKE, SleepSchedule, Sweep
 
 if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
 
 
 class SceneRollouts:
-    """Rollouts on one scene: on the full world, or with ``sto.reduced_model`` on reduced worlds
-    (see the module's docstring), built on first use and the latest ``worlds_kept`` kept.
+    """Rollouts on one scene: on the rollout model's world, with ``sto.reduced_model`` its objects
+    asleep while nothing comes near them (see the module's docstring); verification on the
+    execution model's (built on first use).
 
-    A rollout's outcome is a pure function of the scene, the configuration and the sequence: which
-    objects are welded when follows from the sequence alone, whichever worlds happen to be built.
+    A rollout's outcome is a pure function of the scene, the configuration, the start and the sequence.
     """
 
-    def __init__(self, scenario: Scenario, *, worlds_kept: int = 32) -> None:
+    def __init__(self, scenario: Scenario) -> None:
         self.full = RolloutWorld(scenario)
         self.scenario = scenario
-        self._worlds_kept = worlds_kept
-        self._reduced: OrderedDict[frozenset[str], RolloutWorld] = OrderedDict()
         self._sweep = Sweep(self.full) if scenario.optimiser.reduced_model else None
+        self._execution: RolloutWorld | None = None
 
     @property
     def start_collisions(self) -> tuple[str, ...]:
         return self.full.start_collisions
 
-    def world_with(self, welded: frozenset[str]) -> RolloutWorld:
-        """The world with the objects ``welded`` welded (the full one when empty)."""
-        if not welded:
-            return self.full
-        if welded not in self._reduced:
-            self._reduced[welded] = RolloutWorld(self.scenario, welded_objects=welded)
-            while len(self._reduced) > self._worlds_kept:
-                self._reduced.popitem(last=False)
-        self._reduced.move_to_end(welded)
-        return self._reduced[welded]
-
-    def weld_schedule(self, sequence: ControlSequence) -> WeldSchedule | FixedWelds:
-        """The objects the robot's commanded motion does not come within ``optimiser.weld_clearance``
-        of before ``t + optimiser.weld_lookahead`` (none with the reduced model off)."""
+    def sleep_schedule(self, sequence: ControlSequence, start: RolloutStart | None = None) -> SleepSchedule:
+        """When ``sequence``'s commanded motion first comes within ``optimiser.weld_clearance`` of each
+        object (from ``start``'s object poses, if given), the objects sleeping until
+        ``optimiser.weld_lookahead`` before (never with the reduced model off: ``AWAKE``)."""
         sto = self.scenario.optimiser
         if self._sweep is None:
-            return FixedWelds(frozenset())
-        return WeldSchedule(self._sweep.approach_times(sequence, sto.weld_clearance), sto.weld_lookahead)
+            return AWAKE
+        states = None if start is None else start.states
+        return SleepSchedule(
+            self._sweep.approach_times(sequence, sto.weld_clearance, states), sto.weld_lookahead
+        )
 
-    def simulate(self, sequence: ControlSequence) -> RolloutSamples:
-        """Roll ``sequence`` out on the reduced worlds (or the full one), reading the state every sample period."""
-        return sample_rollout(sequence, self.scenario.optimiser, self, self.weld_schedule(sequence))
+    def simulate(self, sequence: ControlSequence, start: RolloutStart | None = None) -> RolloutSamples:
+        """Roll ``sequence`` out (from ``start``), reading the state every sample period."""
+        return sample_rollout(
+            sequence, self.scenario.optimiser, self.full, self.sleep_schedule(sequence, start), start=start
+        )
 
-    def rollout(self, sequence: ControlSequence) -> RolloutOutcome:
-        """Simulate ``sequence`` and cost it."""
-        return timed_rollout(sequence, self.simulate, self.full)
+    def rollout(self, sequence: ControlSequence, start: RolloutStart | None = None) -> RolloutOutcome:
+        """Simulate ``sequence`` (from ``start``) and cost it."""
+        return timed_rollout(sequence, self.simulate, self.full, start)
+
+    def verify(self, sequence: ControlSequence, start: RolloutStart | None = None) -> RolloutOutcome:
+        """Simulate ``sequence`` (from ``start``) on the execution model (built on first use), every
+        object awake, and cost it."""
+        if self._execution is None:
+            self._execution = RolloutWorld(self.scenario, execution=True)
+        return self._execution.rollout(sequence, start)

@@ -10,6 +10,7 @@ Drake's ``ConstantValueSource``.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
@@ -86,18 +87,24 @@ class SceneFromPlant(LeafSystem):
 
     def _calc_scene(self, context: Context, output: AbstractValue) -> None:
         poses = self._poses.Eval(context)
+        output.set_value(scene_at(self._template, {name: poses[i] for name, i in self._bodies.items()}))
 
-        def placed(obj: SceneObject) -> SceneObject:
-            pose = poses[self._bodies[obj.name]]
-            x, y, _ = pose.translation()
-            rotation = pose.rotation().matrix()
-            yaw = math.atan2(rotation[1, 0], rotation[0, 0])
-            turn = math.remainder(yaw - obj.yaw, math.tau)
-            if max(abs(x - obj.x), abs(y - obj.y), abs(turn)) <= SAME_POSE:
-                return obj
-            return obj.moved(float(x), float(y), float(yaw))
 
-        template = self._template
-        target, obstacles = placed(template.target), tuple(placed(o) for o in template.obstacles)
-        same = target is template.target and all(a is b for a, b in zip(obstacles, template.obstacles))
-        output.set_value(template if same else replace(template, target=target, obstacles=obstacles))
+def scene_at(template: Scene, poses: Mapping[str, RigidTransform]) -> Scene:
+    """``template`` with every object at the planar part of its pose in ``poses`` (by name; world
+    poses); objects within ``SAME_POSE`` of their template poses keep the template's numbers (and
+    ``template`` itself comes back when all do)."""
+
+    def placed(obj: SceneObject) -> SceneObject:
+        pose = poses[obj.name]
+        x, y, _ = pose.translation()
+        rotation = pose.rotation().matrix()
+        yaw = math.atan2(rotation[1, 0], rotation[0, 0])
+        turn = math.remainder(yaw - obj.yaw, math.tau)
+        if max(abs(x - obj.x), abs(y - obj.y), abs(turn)) <= SAME_POSE:
+            return obj
+        return obj.moved(float(x), float(y), float(yaw))
+
+    target, obstacles = placed(template.target), tuple(placed(o) for o in template.obstacles)
+    same = target is template.target and all(a is b for a, b in zip(obstacles, template.obstacles))
+    return template if same else replace(template, target=target, obstacles=obstacles)

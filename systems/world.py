@@ -29,6 +29,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from pydrake.geometry import (
+    CollisionFilterDeclaration,
+    GeometrySet,
     Meshcat,
     MeshcatVisualizer,
     MeshcatVisualizerParams,
@@ -41,7 +43,7 @@ from pydrake.multibody.meshcat import ContactVisualizer, ContactVisualizerParams
 from pydrake.multibody.plant import AddMultibodyPlant, CoulombFriction, MultibodyPlant
 from pydrake.multibody.tree import JointActuatorIndex, ModelInstanceIndex, PdControllerGains
 from pydrake.systems.controllers import InverseDynamics
-from pydrake.systems.framework import Diagram, DiagramBuilder
+from pydrake.systems.framework import Diagram, DiagramBuilder, OutputPort
 from pydrake.systems.primitives import MatrixGain, TrajectorySource
 from pydrake.trajectories import Trajectory
 
@@ -52,6 +54,7 @@ from hlp_drake.systems.start_pose import robot_position_names, start_configurati
 from hlp_drake.systems.world_settings import ContactConfig, ControlConfig
 
 if TYPE_CHECKING:
+    from hlp_drake.systems.model_error import ModelError
     from hlp_drake.systems.scenario import Scenario
 
 GRIPPER_BODIES = ("gripper_base_link", "left_finger_link", "right_finger_link")
@@ -85,6 +88,20 @@ def _set_robot_contact(
                 else:
                     properties.AddProperty("material", name, value)
             scene_graph.AssignRole(plant.get_source_id(), geometry, properties, RoleAssign.kReplace)
+
+
+def _filter_robot_self_contact(
+    plant: MultibodyPlant, scene_graph: SceneGraph, instance: ModelInstanceIndex
+) -> None:
+    """Exclude every contact pair between two of the robot's links (the rollout model's trim)."""
+    geometries = [
+        g
+        for i in plant.GetBodyIndices(instance)
+        for g in plant.GetCollisionGeometriesForBody(plant.get_body(i))
+    ]
+    scene_graph.collision_filter_manager().Apply(
+        CollisionFilterDeclaration().ExcludeWithin(GeometrySet(geometries))
+    )
 
 
 def _set_pd_gains(plant: MultibodyPlant, instance: ModelInstanceIndex, control: ControlConfig) -> None:
@@ -173,6 +190,7 @@ def make_world_diagram(
     contact_forces: bool = False,
     welded_objects: Iterable[str] = (),
     cameras: bool | None = None,
+    model_error: ModelError | None = None,
 ) -> Diagram:
     """Build the world of ``scenario`` (its scene, plant, contact, bodies, controller and start pose):
     see the module's docstring for the ports.
@@ -188,17 +206,27 @@ def make_world_diagram(
             default): when the scenario perceives the scene through them (``perception.source:
             camera``). Even unrendered, a camera costs ~10 % of the simulation's time (the render
             engine follows every pose).
+        model_error: the world differs from the scenario so (``sample_model_error``): its objects
+            stand where ``model_error.true_scene`` has them, with its mass and friction factors.
     """
-    scene = scenario.scene
+    scene = scenario.scene if model_error is None else model_error.true_scene(scenario.scene)
+    scales = None if model_error is None else model_error.scales()
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlant(scenario.plant, builder)
     instance = add_robot(plant)
     _set_robot_contact(plant, scene_graph, instance, scenario.contact)
     _set_pd_gains(plant, instance, scenario.controller)
     models = add_scene(
-        plant, scene, contact=scenario.contact, bodies=scenario.bodies, welded_objects=welded_objects
+        plant,
+        scene,
+        contact=scenario.contact,
+        bodies=scenario.bodies,
+        welded_objects=welded_objects,
+        scales=scales,
     )
     plant.Finalize()
+    if not scenario.contact.robot_self_contact:
+        _filter_robot_self_contact(plant, scene_graph, instance)
     if cameras or (cameras is None and scenario.perception.source == "camera"):
         label_classes(plant, scene_graph, instance, models, scene)
         add_cameras(builder, scene_graph, scenario)
@@ -231,22 +259,29 @@ def world_plant(diagram: Diagram) -> tuple[MultibodyPlant, ModelInstanceIndex]:
     return plant, plant.GetModelInstanceByName(ROBOT_MODEL_NAME)
 
 
+def connect_robot_command(builder: DiagramBuilder, world: Diagram, port: OutputPort, *, name: str) -> None:
+    """Drive ``world``'s ``robot.desired_state`` from ``port``: the robot's 11 positions then their
+    velocities (22, e.g. a ``TrajectorySource``'s with its derivative), through a selection gain
+    named ``{name}_to_desired_state``. ``world`` must already be in ``builder``."""
+    plant, instance = world_plant(world)
+    select = builder.AddNamedSystem(
+        f"{name}_to_desired_state", MatrixGain(actuated_state_selector(plant, instance))
+    )
+    builder.Connect(port, select.get_input_port())
+    builder.Connect(select.get_output_port(), world.GetInputPort(DESIRED_STATE_PORT))
+
+
 def add_position_trajectory(
     builder: DiagramBuilder, world: Diagram, trajectory: Trajectory, *, name: str = "robot_trajectory"
 ) -> TrajectorySource:
     """Drive ``world``'s ``robot.desired_state`` from a trajectory of the robot's 11 positions.
 
     ``world`` must already be in ``builder``. Adds a C++ ``TrajectorySource`` (positions and their
-    derivative) and a selection gain; swap trajectories per rollout with ``UpdateTrajectory``.
+    derivative; ``connect_robot_command``); swap trajectories per rollout with ``UpdateTrajectory``.
     Returns the source.
     """
-    plant, instance = world_plant(world)
     source = builder.AddNamedSystem(name, TrajectorySource(trajectory, output_derivative_order=1))
-    select = builder.AddNamedSystem(
-        f"{name}_to_desired_state", MatrixGain(actuated_state_selector(plant, instance))
-    )
-    builder.Connect(source.get_output_port(), select.get_input_port())
-    builder.Connect(select.get_output_port(), world.GetInputPort(DESIRED_STATE_PORT))
+    connect_robot_command(builder, world, source.get_output_port(), name=name)
     return source
 
 
@@ -254,6 +289,7 @@ __all__ = [
     "DESIRED_STATE_PORT",
     "actuated_state_selector",
     "add_position_trajectory",
+    "connect_robot_command",
     "desired_state_from_robot_state",
     "make_world_diagram",
     "robot_position_names",

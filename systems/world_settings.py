@@ -23,6 +23,9 @@ from dataclasses import dataclass, field
 
 from pydrake.multibody.plant import MultibodyPlantConfig
 
+EXECUTION_SETTLE_S = 1.0
+"""Simulated time the execution lets pass after the reach's trajectory ends before checking it, s."""
+
 
 def default_plant_config() -> MultibodyPlantConfig:
     """The plant settings of the world: 2 ms steps, point contact, the SAP solver and approximation."""
@@ -54,6 +57,9 @@ class ContactConfig:
         corner_sphere_radius: radius of the contact spheres put in the corners of every box and
             around the rims of every cylinder (flush with the faces), m; 0 turns them off.
         rim_spheres: number of spheres on each rim of a cylinder.
+        top_spheres: put spheres on the top corners and rim too (False: the bottom ones only).
+        robot_self_contact: contact between the robot's own links (links one joint apart never
+            touch: the plant filters them); False filters every robot-robot pair.
         table_friction, object_friction, gripper_friction: Coulomb friction coefficients (static and
             dynamic); Drake combines two surfaces' coefficients as 2 a b / (a + b).
     """
@@ -63,6 +69,8 @@ class ContactConfig:
     relaxation_time: float = 0.01
     corner_sphere_radius: float = 0.001
     rim_spheres: int = 8
+    top_spheres: bool = True
+    robot_self_contact: bool = True
     table_friction: float = 0.3
     object_friction: float = 0.4
     gripper_friction: float = 0.8

@@ -154,6 +154,26 @@ def test_run_scene_end_to_end_json_and_html(tmp_path):
         assert stage in result.stdout, stage
 
 
+@pytest.mark.slow  # ~20 s of CPU: the 2 ms execution with a re-optimisation every second
+def test_run_scene_closed_loop_with_uncertainty_end_to_end(tmp_path):
+    out, config = tmp_path / "run.json", tmp_path / "cheap.yaml"
+    config.write_text(
+        "optimiser: {samples: 2, max_rollouts: 5, verify: false}\n"
+        "closed_loop: {replan_period: 1.0, iterations: 1, rollouts: 3}\n"
+    )
+    args = ["--kind", "gen1", "--seed", "7", "--workers", "1", "--config", str(config), "--json", str(out)]
+    result = run_module("hlp_drake.run_scene", *args, "--execution", "closed", "--uncertainty", "5")
+    assert result.returncode in (0, 1) and "Traceback" not in result.stderr, result.stderr
+    report = json.loads(out.read_text())
+    assert report["execution"] == "closed" and report["success"] == (result.returncode == 0)
+    loop = report["closed_loop"]
+    assert loop["replans"] >= 1 and loop["replans"] <= loop["rollouts"] <= 3 * loop["replans"]
+    assert "closed loop:" in result.stdout
+    assert report["rollout_passed_execution_failed"] == (
+        report["optimisation"]["success"] and not report["success"]
+    )
+
+
 def test_run_scene_bad_scene_file_is_one_line(tmp_path):
     bad = tmp_path / "bad.yaml"
     bad.write_text("table: [1, 2\n")
@@ -176,6 +196,17 @@ def test_run_scene_bad_scene_file_is_one_line(tmp_path):
     overlapping.write_text(yaml.safe_dump(data))
     result = run_module("hlp_drake.run_scene", "--scene", str(overlapping), "--json", str(out))
     assert result.returncode == 2 and "overlap" in result.stderr and not out.exists()
+
+
+def test_run_scene_rejects_a_bad_execution_or_uncertainty_seed(tmp_path):
+    out = tmp_path / "run.json"
+    for args, problem in (
+        (["--execution", "half"], "invalid choice: 'half'"),
+        (["--uncertainty", "x"], "invalid int value: 'x'"),
+    ):
+        result = run_module("hlp_drake.run_scene", *args, "--json", str(out))
+        assert result.returncode == 2 and problem in result.stderr and "Traceback" not in result.stderr
+    assert not out.exists()
 
 
 def test_run_scene_rejects_a_bad_worker_count(tmp_path):

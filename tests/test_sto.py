@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import math
 import re
 
 import numpy as np
@@ -21,11 +20,11 @@ from hlp_drake.systems.optimiser_system import StochasticTrajectoryOptimiser
 from hlp_drake.systems.planning_diagram import make_planning_diagram
 from hlp_drake.systems.rollout_cost import BLOWN_UP_COST, RolloutSamples, rollout_cost
 from hlp_drake.systems.rollout_pool import RolloutPool
-from hlp_drake.systems.rollout_world import RolloutWorld
+from hlp_drake.systems.rollout_world import RolloutStart, RolloutWorld
 from hlp_drake.systems.scenario import Scenario
 from hlp_drake.systems.scene_rollouts import SceneRollouts
+from hlp_drake.systems.sleep_schedule import Sweep
 from hlp_drake.systems.start_pose import tcp_keypoint_height
-from hlp_drake.systems.weld_schedule import Sweep
 
 
 def on(scene, data: str | None = None) -> Scenario:
@@ -268,7 +267,7 @@ def test_two_workers_give_the_same_outcomes_as_one(scene, trajectories):
         assert pool.startup_s > 0
         remote = pool.rollouts(config, sequences)
     assert [o.cost for o in remote] == [o.cost for o in local]
-    assert [o.welded for o in remote] == [o.welded for o in local] and all(o.welded for o in local)
+    assert [o.asleep for o in remote] == [o.asleep for o in local] and all(o.asleep for o in local)
 
 
 # --- The reduced rollout model ---------------------------------------------------------------------
@@ -277,7 +276,7 @@ PUSHING_HORIZON = 3.0
 """The straight line's first 3 s on the default scene push two obstacles (Long, then Med-1 with it)."""
 
 
-def test_the_reduced_model_welds_only_objects_nothing_comes_near(scene, trajectories, world):
+def test_the_reduced_model_lets_only_objects_nothing_comes_near_sleep(scene, trajectories, world):
     config = on(scene)
     reduced = SceneRollouts(config)
     sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), PUSHING_HORIZON)
@@ -286,50 +285,70 @@ def test_the_reduced_model_welds_only_objects_nothing_comes_near(scene, trajecto
     pushed = {
         n for n, d in zip(names, np.linalg.norm(full.positions[-1] - full.positions[0], axis=1)) if d > 0.01
     }
-    assert len(pushed) == 2 and samples.welded and samples.switches > 0
-    assert not pushed & set(samples.welded)  # a pushed object is never welded
+    assert len(pushed) == 2 and samples.asleep and samples.switches > 0
     approach = Sweep(world).approach_times(sequence, config.optimiser.weld_clearance)
-    assert all(approach[name] == math.inf for name in samples.welded)  # nor one the robot's sweep comes near
-    np.testing.assert_allclose(samples.positions, full.positions, atol=1e-3)  # welded ones simply stay put
+    initially = reduced.sleep_schedule(sequence).initially_asleep()
+    assert initially and all(approach[name] > config.optimiser.weld_lookahead for name in initially)
+    assert "FailOnTouchObstacleLong" not in initially  # the one the robot pushes at once starts awake
+    np.testing.assert_allclose(samples.positions, full.positions, atol=1e-3)  # sleeping ones simply stay put
     a, b = reduced.rollout(sequence), world.rollout(sequence)
     assert a.success == b.success and a.fallen == b.fallen
     assert a.cost == pytest.approx(b.cost, rel=1e-3)
     assert a.terms["disturbance"] == pytest.approx(b.terms["disturbance"], rel=1e-2)
-    assert a.welded == samples.welded and b.welded == () and b.switches == 0
+    assert a.asleep == samples.asleep and b.asleep == () and b.switches == 0
     off = config.updated("optimiser: {reduced_model: false}")
     assert SceneRollouts(off).rollout(sequence).terms == b.terms  # off: the full model
 
 
-def test_an_object_pushed_towards_a_welded_one_frees_it_from_the_sample_before(scene, trajectories, world):
+def test_an_object_pushed_towards_a_sleeping_one_wakes_it_from_the_sample_before(scene, trajectories, world):
     sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), PUSHING_HORIZON)
     chained = "FailOnTouchObstacleMed-1"  # pushed by Long before the robot itself comes near it
-    alone = RolloutWorld(on(scene), welded_objects=[chained]).simulate(sequence)
-    assert alone.touched == (chained,) and alone.times[-1] < 2.5  # no world to go on with: it stops there
-    config = on(scene, "optimiser: {weld_clearance: 0.01, weld_lookahead: 0.0}")  # the schedule frees late...
-    assert (
-        Sweep(world).approach_times(sequence, config.optimiser.weld_clearance)[chained]
-        > alone.times[-1] + 0.1
-    )
-    samples = SceneRollouts(config).simulate(sequence)  # ...so the check during the rollout must
-    assert chained not in samples.welded and samples.switches >= 2 and samples.touched == ()
+    config = on(scene, "optimiser: {weld_clearance: 0.01, weld_lookahead: 0.0}")  # the schedule wakes late...
+    reduced = SceneRollouts(config)
+    assert chained in reduced.sleep_schedule(sequence).initially_asleep()
+    samples = reduced.simulate(sequence)  # ...so the check during the rollout must
+    assert chained not in samples.asleep and samples.switches >= 2
     np.testing.assert_allclose(samples.positions, world.simulate(sequence).positions, atol=1e-3)
-    with pytest.raises(ValueError, match=chained):
-        world.cost(alone, sequence)
 
 
-def test_a_rollout_carried_over_to_another_world_goes_on_exactly(scene, trajectories, world):
+def test_an_object_come_to_rest_after_a_push_goes_back_to_sleep(scene, trajectories, world):
+    pushing = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 2.0)  # pushes Long aside
+    times = np.append(pushing.times, pushing.times[-1] + np.array([1.0, 2.0]))
+    sequence = ControlSequence(
+        times, np.vstack([pushing.knots, pushing.knots[-2], pushing.knots[0]])
+    )  # ...back
+    samples = SceneRollouts(on(scene)).simulate(sequence)
+    pushed = scene.objects.index(next(o for o in scene.objects if o.name == "FailOnTouchObstacleLong"))
+    assert np.linalg.norm(samples.positions[-1, pushed] - samples.positions[0, pushed]) > 0.05
+    assert set(samples.asleep) == {obj.name for obj in scene.objects}  # it too, once the robot is away
+    np.testing.assert_allclose(samples.positions, world.simulate(sequence).positions, atol=1e-3)
+
+
+def test_a_rollout_restarted_from_its_states_goes_on_exactly(scene, trajectories, world):
     sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 2.0)
-    other = RolloutWorld(on(scene))
     world.begin(sequence)
     world.advance_to(2.0)
     end = world.states()
     world.begin(sequence)
     world.advance_to(1.0)
+    other = RolloutWorld(on(scene))
     other.begin(sequence, time=1.0, states=world.states())
     other.advance_to(2.0)
     assert other.states().keys() == end.keys()
     for name, x in other.states().items():
         np.testing.assert_array_equal(x, end[name])
+
+
+def test_a_rollout_from_a_given_state_starts_there(scene, trajectories, world):
+    sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)
+    world.begin(sequence)
+    states = world.states()
+    obstacle = scene.obstacles[0].name
+    states[obstacle] = states[obstacle].copy()
+    states[obstacle][4:6] += [0.0, 0.02]  # the obstacle 2 cm to the left (x, y, z follow the quaternion)
+    samples = SceneRollouts(on(scene)).simulate(sequence, RolloutStart(states))
+    assert samples.positions[0, 1, 1] == pytest.approx(scene.obstacles[0].y + 0.02, abs=1e-6)
+    assert samples.positions[-1, 1, 1] == pytest.approx(scene.obstacles[0].y + 0.02, abs=1e-3)
 
 
 # --- The optimiser ---------------------------------------------------------------------------------
@@ -357,6 +376,20 @@ def test_optimiser_respects_its_time_budget(scene, trajectories):
     assert "time budget" in result.failure_reason
 
 
+def test_optimiser_stops_at_its_rollout_budget_with_the_same_result_on_two_workers(scene, trajectories):
+    assert Scenario().optimiser.time_budget_s == 0.0  # by default no wall-clock budget at all
+    config = on(scene, "optimiser: {samples: 2, max_iterations: 20, max_rollouts: 5}")
+    initial = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)  # too short to reach
+    with RolloutPool(1) as pool:
+        one = optimise(config, initial, pool)
+    with RolloutPool(2) as pool:
+        two = optimise(config, initial, pool)
+    assert not one.success and one.rollouts == 5 and one.iterations == 2
+    assert "rollout budget of 5 spent" in one.failure_reason
+    assert (two.costs, two.rollouts, two.failure_reason) == (one.costs, one.rollouts, one.failure_reason)
+    np.testing.assert_array_equal(two.sequence.knots, one.sequence.knots)
+
+
 def test_a_failed_initial_rollout_goes_on_from_the_planners_first_passing_alternative(scene, trajectories):
     config = on(scene, "optimiser: {max_iterations: 1, samples: 1}")
     stuck = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)  # fails: too short
@@ -370,6 +403,10 @@ def test_a_failed_initial_rollout_goes_on_from_the_planners_first_passing_altern
     with RolloutPool(1) as pool:
         passed = optimise(config, reaching, pool, alternatives=alternatives)
         assert passed.success and passed.start == 0 and passed.rollouts == 1 and not calls  # not needed
+        assert passed.verifications == 1 and passed.rejected == 0  # verified on the execution model
+        assert passed.outcome.verification.success and passed.outcome.verification.wall_s > 0
+        unverified = optimise(config.updated("optimiser: {max_verifications: 0}"), reaching, pool)
+        assert not unverified.success and "verifications ran out" in unverified.failure_reason
         result = optimise(config, stuck, pool, alternatives=alternatives)
         assert calls == [1]
         assert result.success and result.iterations == 0 and result.start == 2  # the first that passes

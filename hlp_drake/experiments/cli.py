@@ -2,7 +2,8 @@
 
     python -m hlp_drake.experiments {gen1,gen2} [--scenes 100] [--objects 5 7 9] [--seed S]
         [--workers N] [--executor local|dask] [--scheduler ADDRESS] [--config SCENARIO.yaml]
-        [--perception truth|camera] [--fresh] [--quiet] --out DIR
+        [--perception truth|camera] [--execution open|closed] [--uncertainty [SEED]] [--fresh] [--quiet]
+        --out DIR
 
 Every scene is planned and executed with both planners (HLP and STO's straight line); scene i has
 seed S + i (gen2: for each object count). Writes DIR/results.csv (resumable: run the same command
@@ -21,7 +22,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from hlp_drake.cli import add_perception, add_quiet, make_parser
+from hlp_drake.cli import add_conditions, add_perception, add_quiet, make_parser
 from hlp_drake.errors import HlpError
 from hlp_drake.experiments.executors import EXECUTORS
 from hlp_drake.experiments.experiment import DERIVED, RESULTS, ExperimentSettings, run_experiment
@@ -64,6 +65,7 @@ def _parser() -> argparse.ArgumentParser:
         help="scenario settings (see hlp_drake.systems.Scenario); each job has its own scene",
     )
     add_perception(parser)
+    add_conditions(parser)
     parser.add_argument("--fresh", action="store_true", help="discard DIR's earlier results and start over")
     add_quiet(parser)
     parser.add_argument(
@@ -83,6 +85,11 @@ def main(argv: Sequence[str] | None = None, *, job: JobFunction = run_job) -> in
             raise HlpError(f"{args.config}: scenario file not found") from None
         except (OSError, UnicodeDecodeError) as error:
             raise HlpError(f"{args.config}: cannot read the scenario: {error}") from None
+    if args.execution is not None or args.uncertainty is not None:
+        from hlp_drake.systems.scenario import load_scenario, with_conditions
+
+        scenario = load_scenario(data=config_yaml, where=args.config or "--config")
+        config_yaml = with_conditions(scenario, execution=args.execution, uncertainty=args.uncertainty).yaml
     settings = ExperimentSettings(
         kind=args.kind,
         scenes=args.scenes,

@@ -1,7 +1,11 @@
 """``results.csv``: one row per (scene, planner), read back for resuming, rewritten atomically.
 
 Columns (in this order): the paper's ``scene, objects, planner, success, failure_reason, init_s,
-optimise_s, total_s, rollouts, objects_moved, objects_dropped``, then ``seed, iterations, execute_s``.
+optimise_s, total_s, rollouts, objects_moved, objects_dropped``, then ``seed, iterations,
+verifications, rejected, passed_then_failed, replans, replan_rollouts, execute_s`` (``rollouts``
+counts the optimiser's rollouts, ``verifications`` its checks on the execution model, of which
+``rejected`` failed there; ``passed_then_failed``: the optimiser accepted a sequence and the
+execution failed; ``replans`` and ``replan_rollouts``: the closed-loop controller's).
 Times are seconds; ``init_s`` = plan + IK, ``total_s`` = init + optimise (planning time: the simulated
 execution, ``execute_s``, is excluded); ``objects_moved`` and ``objects_dropped`` are counts.
 Booleans are ``true``/``false``; a missing failure reason is an empty field.
@@ -34,10 +38,16 @@ COLUMNS = (
     "objects_dropped",
     "seed",
     "iterations",
+    "verifications",
+    "rejected",
+    "passed_then_failed",
+    "replans",
+    "replan_rollouts",
     "execute_s",
 )
-INT_COLUMNS = frozenset({"objects", "rollouts", "objects_moved", "objects_dropped", "seed", "iterations"})
+BOOL_COLUMNS = frozenset({"success", "passed_then_failed"})
 FLOAT_COLUMNS = frozenset({"init_s", "optimise_s", "total_s", "execute_s"})
+INT_COLUMNS = frozenset(COLUMNS) - BOOL_COLUMNS - FLOAT_COLUMNS - {"scene", "planner", "failure_reason"}
 BOOLEANS = {"true": True, "false": False}
 
 
@@ -52,7 +62,7 @@ def sort_key(row: Row) -> tuple[int, int, str]:
 
 
 def _format(column: str, value: Any) -> str:
-    if column == "success":
+    if column in BOOL_COLUMNS:
         return "true" if value else "false"
     if column in FLOAT_COLUMNS:
         return f"{float(value):.6f}"
@@ -60,7 +70,7 @@ def _format(column: str, value: Any) -> str:
 
 
 def _parse(column: str, text: str) -> Any:
-    if column == "success":
+    if column in BOOL_COLUMNS:
         return BOOLEANS[text]  # KeyError: not a boolean
     if column in INT_COLUMNS:
         return int(text)

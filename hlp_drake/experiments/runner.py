@@ -87,6 +87,11 @@ def make_row(
     iterations: int,
     objects_moved: int,
     objects_dropped: int,
+    verifications: int = 0,
+    rejected: int = 0,
+    passed_then_failed: bool = False,
+    replans: int = 0,
+    replan_rollouts: int = 0,
 ) -> Row:
     """The row of ``job``'s outcome: init = plan + IK, total = init + optimise (execution excluded)."""
     init_s = plan_s + ik_s
@@ -104,6 +109,11 @@ def make_row(
         "objects_dropped": int(objects_dropped),
         "seed": job.seed,
         "iterations": int(iterations),
+        "verifications": int(verifications),
+        "rejected": int(rejected),
+        "passed_then_failed": bool(passed_then_failed),
+        "replans": int(replans),
+        "replan_rollouts": int(replan_rollouts),
         "execute_s": execute_s,
     }
 
@@ -162,4 +172,9 @@ def run_job(job: Job) -> Row:
         iterations=result.iterations,
         objects_moved=len(result.objects_moved),
         objects_dropped=len(result.objects_dropped),
+        verifications=result.optimisation.get("verifications", 0),
+        rejected=result.optimisation.get("rejected", 0),
+        passed_then_failed=result.rollout_passed_execution_failed,
+        replans=result.closed_loop.get("replans", 0),
+        replan_rollouts=result.closed_loop.get("rollouts", 0),
     )

@@ -121,6 +121,8 @@ def planner_stats(rows: list[Row], paper: PaperFigures) -> dict[str, Any]:
         "crashed": sum((row["failure_reason"] or "").startswith("crashed:") for row in rows),
     }
     stats.update({column: _mean(row[column] for row in rows) for column in (*TIMES, "execute_s")})
+    stats["rollouts_mean"] = _mean(row.get("rollouts", 0) for row in rows)
+    stats["passed_then_failed"] = sum(bool(row.get("passed_then_failed")) for row in rows)
     stats["paper"] = asdict(paper)
     return stats
 
@@ -204,6 +206,17 @@ def summary_markdown(summary: dict[str, Any]) -> str:
             f"| {condition['condition']} | {_number(condition['hlp_to_sto_total'], 3)} | "
             f"{_number(condition['paper_hlp_to_sto_total'], 3)} |"
         )
+    lines += [
+        "",
+        "| condition | planner | rollouts (mean) | rollout passed, execution failed |",
+        "|---|---|---:|---:|",
+    ]
+    for condition in summary["conditions"]:
+        for planner, stats in condition["planners"].items():
+            lines.append(
+                f"| {condition['condition']} | {PLANNER_LABELS[planner]} | {_number(stats['rollouts_mean'], 1)} | "
+                f"{stats['passed_then_failed']} of {stats['n']} |"
+            )
     lines += ["", "Notes:", ""] + [f"- {note}" for note in summary["notes"]]
     return "\n".join(lines) + "\n"
 

@@ -1,8 +1,10 @@
-"""Which objects a reduced rollout keeps welded when: ``WeldSchedule`` (the commanded sweep) or ``FixedWelds``.
+"""When a rollout's objects sleep: ``SleepSchedule`` (from the commanded sweep) or ``AWAKE`` (never).
 
-A reduced rollout starts with the objects welded that the robot's collision geometry, following the
-commanded motion (``Sweep.approach_times``), does not come within ``optimiser.weld_clearance`` of in
-the next ``optimiser.weld_lookahead`` seconds, and frees them as that changes.
+A rollout starts with the objects asleep (their joints locked) that the robot's collision geometry,
+following the commanded motion (``Sweep.approach_times``), does not come within
+``optimiser.weld_clearance`` of in the next ``optimiser.weld_lookahead`` seconds, and wakes each
+that long before the motion comes near it. Between, ``rollout_sampler`` wakes an object anything
+comes near and puts objects that have come to rest back to sleep.
 """
 
 from __future__ import annotations
@@ -21,25 +23,28 @@ if TYPE_CHECKING:
 
 
 @dataclass(frozen=True)
-class FixedWelds:
-    """The same objects welded throughout."""
-
-    welded: frozenset[str]
-
-    def welded_at(self, t: float) -> frozenset[str]:
-        return self.welded
-
-
-@dataclass(frozen=True)
-class WeldSchedule:
-    """The objects welded from time ``t`` on: those the commanded motion does not come near before
-    ``t + lookahead`` (``approach``: the first time it comes near each, inf if never)."""
+class SleepSchedule:
+    """The objects' first approach by the commanded motion (``approach``: s, inf if never) and how
+    long before it an object is woken (``lookahead``); ``sleeping``: whether objects sleep at all."""
 
     approach: dict[str, float]
     lookahead: float
+    sleeping: bool = True
 
-    def welded_at(self, t: float) -> frozenset[str]:
-        return frozenset(name for name, first in self.approach.items() if first > t + self.lookahead)
+    def initially_asleep(self) -> frozenset[str]:
+        return frozenset(n for n, first in self.approach.items() if self.sleeping and first > self.lookahead)
+
+    def due(self, t: float) -> frozenset[str]:
+        """The objects to be awake by ``t`` (their approach is at most ``lookahead`` away)."""
+        return frozenset(n for n, first in self.approach.items() if first <= t + self.lookahead)
+
+    def approaching(self, t: float) -> frozenset[str]:
+        """The objects not to put to sleep at ``t``: the motion comes near them within ``lookahead``."""
+        return frozenset(n for n, first in self.approach.items() if t <= first <= t + self.lookahead)
+
+
+AWAKE = SleepSchedule({}, 0.0, sleeping=False)
+"""Every object awake throughout (the full model)."""
 
 
 class Sweep:
@@ -70,12 +75,24 @@ class Sweep:
         )
         self._context = context
 
-    def approach_times(self, sequence: ControlSequence, clearance: float) -> dict[str, float]:
+    def approach_times(
+        self, sequence: ControlSequence, clearance: float, states: dict[str, np.ndarray] | None = None
+    ) -> dict[str, float]:
         """Per object, the first time the robot's collision geometry comes within ``clearance`` of it
-        when following ``sequence``'s commanded motion exactly, the objects at their scene poses
-        (checked every sample period and at every knot; inf if never)."""
+        when following ``sequence``'s commanded motion exactly, the objects at their scene poses or
+        as ``states`` has them (a ``RolloutStart``'s; checked every sample period and at every knot;
+        inf if never)."""
         world = self._world
         plant_context = world.plant.GetMyMutableContextFromRoot(self._context)
+        for body in world.objects:
+            x = None if states is None else states.get(body.name())
+            instance = body.model_instance()
+            q = (
+                world.plant.GetDefaultPositions(instance)
+                if x is None
+                else x[: world.plant.num_positions(instance)]
+            )
+            world.plant.SetPositions(plant_context, instance, q)
         world_context = world.world.GetMyContextFromRoot(self._context)
         query = world.world.GetOutputPort("query_object")
         trajectory = sequence.to_trajectory()

@@ -1,0 +1,238 @@
+"""``RecedingHorizonController``: closed-loop execution, the STO re-run on the measured state.
+
+Input ports:
+    ``state``: the plant's whole state (the world's ``state`` output: the robot and the free objects).
+    ``initial`` (abstract ``StoResult``, e.g. the planning diagram's ``optimisation``): the open-loop
+        optimisation, read once when the simulation is initialised.
+
+Output port:
+    ``desired_trajectory_state`` (22): the robot's 11 commanded positions then their velocities now (zero
+        velocities once the sequence has ended); ``connect_robot_command`` feeds it to the world.
+
+Every ``closed_loop.replan_period`` s of simulated time while its sequence lasts (a periodic
+unrestricted update: the simulation waits for it), the controller reads the measured state, cuts its
+commanded sequence there (the warm start: its remainder, starting where the robot is commanded now)
+and runs ``optimise`` from the measured state (``RolloutStart``) with the budget of
+``closed_loop.iterations`` and ``closed_loop.rollouts``; the result's sequence is commanded from then
+on (the optimiser's acceptance is monotone: the remainder unless a candidate is cheaper or passes;
+re-optimisations do not verify on the execution model: the execution itself goes on from there).
+When an object is farther than ``closed_loop.replan_distance`` from where the current sequence's
+rollout put it, and an ``initialiser`` is given, its sequence for the measured states (e.g. the
+planner's on the observed scene) is optimised instead, the remainder its alternative. The commanded
+sequence and the counts live in the context's abstract state (``ControllerRecord``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.systems.framework import Context, LeafSystem, State
+
+from hlp_drake.systems.control_sequence import ControlSequence
+from hlp_drake.systems.optimiser import EMPTY_RESULT, Budget, StoResult, optimise
+from hlp_drake.systems.robot import ROBOT_MODEL_NAME
+from hlp_drake.systems.rollout_cost import Prediction
+from hlp_drake.systems.rollout_world import RolloutStart
+
+if TYPE_CHECKING:
+    from pydrake.multibody.plant import MultibodyPlant
+
+    from hlp_drake.systems.rollout_pool import RolloutPool
+    from hlp_drake.systems.scenario import Scenario
+
+MIN_REMAINDER = 1.0e-3
+"""A sequence with less than this left (s) is not re-optimised."""
+
+
+@dataclass(frozen=True)
+class ControllerRecord:
+    """The controller's state: the commanded ``sequence`` (started at simulated time ``t0``), the
+    prediction of its last rollout and what the re-optimisations did."""
+
+    sequence: ControlSequence | None = None
+    t0: float = 0.0
+    prediction: Prediction | None = None
+    replans: int = 0
+    rollouts: int = 0
+    initialised: int = 0
+    changed: int = 0
+    reason: str | None = None
+
+    def to_dict(self) -> dict:
+        return {
+            "replans": self.replans,
+            "rollouts": self.rollouts,
+            "initialised": self.initialised,
+            "changed": self.changed,
+            "reason": self.reason,
+        }
+
+
+def remainder(sequence: ControlSequence, t: float) -> ControlSequence | None:
+    """``sequence`` from ``t`` on, starting at time 0 at its value at ``t`` (None: less than
+    ``MIN_REMAINDER`` left)."""
+    if sequence.duration - t < MIN_REMAINDER:
+        return None
+    later = sequence.times > t + MIN_REMAINDER
+    now = sequence.to_trajectory().value(t).ravel()
+    return ControlSequence(
+        np.concatenate([[0.0], sequence.times[later] - t]), np.vstack([now, sequence.knots[later]])
+    )
+
+
+class RecedingHorizonController(LeafSystem):
+    """The receding-horizon controller (see the module's docstring for the ports and the behaviour).
+
+    Args:
+        scenario: the optimiser's settings and the believed scene.
+        plant: the world's plant (to split its state by model instance; not simulated here).
+        pool: the rollout workers (the caller's).
+        initialiser: a fresh initial sequence from the measured model-instance states (None: none).
+    """
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        plant: MultibodyPlant,
+        pool: RolloutPool,
+        *,
+        initialiser: Callable[[dict[str, np.ndarray]], ControlSequence | None] | None = None,
+    ) -> None:
+        super().__init__()
+        self._scenario, self._pool, self._initialiser = scenario, pool, initialiser
+        self._plant = plant
+        names = [ROBOT_MODEL_NAME] + [
+            o.name for o in scenario.scene.objects if plant.HasModelInstanceNamed(o.name)
+        ]
+        self._instances = {n: plant.GetModelInstanceByName(n) for n in names}
+        self._state = self.DeclareVectorInputPort("state", plant.num_multibody_states())
+        self._initial = self.DeclareAbstractInputPort("initial", AbstractValue.Make(EMPTY_RESULT))
+        self._record = self.DeclareAbstractState(AbstractValue.Make(ControllerRecord()))
+        nq = plant.num_positions(self._instances[ROBOT_MODEL_NAME])
+        self.DeclareVectorOutputPort(
+            "desired_trajectory_state",
+            2 * nq,
+            self._calc_desired,
+            {self.time_ticket(), self.abstract_state_ticket(self._record), self._state.ticket()},
+        )
+        self.DeclareInitializationUnrestrictedUpdateEvent(self._initialise)
+        self.DeclarePeriodicUnrestrictedUpdateEvent(
+            scenario.closed_loop.replan_period, scenario.closed_loop.replan_period, self._replan
+        )
+
+    def record(self, root_context: Context) -> ControllerRecord:
+        """The controller's state in the diagram's ``root_context``."""
+        return self.GetMyContextFromRoot(root_context).get_abstract_state(int(self._record)).get_value()
+
+    def command(self, root_context: Context, sequence: ControlSequence, t0: float) -> None:
+        """Command ``sequence`` from simulated time ``t0`` on, and stop re-optimising (e.g. the grasp)."""
+        mine = self.GetMyMutableContextFromRoot(root_context)
+        record = self.record(root_context)
+        mine.get_mutable_abstract_state(int(self._record)).set_value(
+            replace(record, sequence=sequence, t0=t0, prediction=None, reason="commanded")
+        )
+
+    def _states(self, context: Context) -> dict[str, np.ndarray]:
+        x = self._state.Eval(context)
+        plant = self._plant
+        q, v = x[: plant.num_positions()], x[plant.num_positions() :]
+        return {
+            name: np.concatenate([plant.GetPositionsFromArray(i, q), plant.GetVelocitiesFromArray(i, v)])
+            for name, i in self._instances.items()
+        }
+
+    def _initialise(self, context: Context, state: State) -> None:
+        result: StoResult = self._initial.Eval(context)
+        prediction = None if result.outcome is None else result.outcome.prediction
+        state.get_mutable_abstract_state(int(self._record)).set_value(
+            ControllerRecord(result.sequence, float(context.get_time()), prediction)
+        )
+
+    def _replan(self, context: Context, state: State) -> None:
+        record: ControllerRecord = context.get_abstract_state(int(self._record)).get_value()
+        if record.sequence is None or record.reason == "commanded":
+            return
+        t = float(context.get_time())
+        rest = remainder(record.sequence, t - record.t0)
+        if rest is None:
+            return
+        states = self._states(context)
+        closed = self._scenario.closed_loop
+        sto = self._scenario.optimiser
+        initial, alternatives, initialised = rest, None, False
+        if self._initialiser is not None and self._moved_far(record, t, states):
+            fresh = self._initialiser(states)
+            if fresh is not None:
+                initial, alternatives, initialised = fresh, (lambda: [rest]), True
+        budget = Budget(
+            sto.samples,
+            closed.iterations,
+            closed.rollouts,
+            alternatives=1 if initialised else 0,
+            seed=sto.seed + 1 + record.replans,
+        )
+        result = optimise(
+            self._scenario,
+            initial,
+            self._pool,
+            budget=budget,
+            start=RolloutStart(states),
+            alternatives=alternatives,
+        )
+        prediction = None if result.outcome is None else result.outcome.prediction
+        state.get_mutable_abstract_state(int(self._record)).set_value(
+            ControllerRecord(
+                result.sequence,
+                t,
+                prediction,
+                record.replans + 1,
+                record.rollouts + result.rollouts,
+                record.initialised + int(initialised),
+                record.changed + int(result.sequence is not rest),
+                result.failure_reason,
+            )
+        )
+
+    def _moved_far(self, record: ControllerRecord, t: float, states: dict[str, np.ndarray]) -> bool:
+        """Whether an object is farther than ``closed_loop.replan_distance`` from where the
+        commanded sequence's rollout put it at ``t``."""
+        if record.prediction is None:
+            return False
+        expected = record.prediction.at(t - record.t0)
+        if expected is None:
+            return False
+        positions, _ = expected
+        for k, obj in enumerate(self._scenario.scene.objects):
+            x = states.get(obj.name)
+            if (
+                x is not None
+                and np.linalg.norm(x[4:6] - positions[k, :2]) > self._scenario.closed_loop.replan_distance
+            ):
+                return True
+        return False
+
+    def _calc_desired(self, context: Context, output) -> None:
+        record: ControllerRecord = context.get_abstract_state(int(self._record)).get_value()
+        if record.sequence is None:
+            x = self._state.Eval(context)
+            robot = self._instances[ROBOT_MODEL_NAME]
+            q = self._plant.GetPositionsFromArray(robot, x[: self._plant.num_positions()])
+            output.SetFromVector(np.concatenate([q, np.zeros_like(q)]))
+            return
+        trajectory = record.sequence.to_trajectory()
+        s = float(context.get_time()) - record.t0
+        if s >= record.sequence.duration:
+            q = record.sequence.knots[-1]
+            output.SetFromVector(np.concatenate([q, np.zeros_like(q)]))
+            return
+        s = max(s, 0.0)
+        output.SetFromVector(
+            np.concatenate([trajectory.value(s).ravel(), trajectory.EvalDerivative(s, 1).ravel()])
+        )
+
+
+__all__ = ["ControllerRecord", "RecedingHorizonController", "remainder"]

@@ -1,0 +1,154 @@
+"""Closed-loop execution: the receding-horizon controller on its own, and its model error."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+
+from hlp_drake.run_scene import DEFAULT_SCENE
+from hlp_drake.scene.io import load_scene
+from hlp_drake.systems.control_sequence import ControlSequence
+from hlp_drake.systems.model_error import UncertaintyConfig, sample_model_error
+from hlp_drake.systems.observed_planning import ObservedScenePlanner, measured_scene
+from hlp_drake.systems.optimiser import StoResult
+from hlp_drake.systems.receding_horizon import RecedingHorizonController, remainder
+from hlp_drake.systems.robot import ROBOT_MODEL_NAME
+from hlp_drake.systems.rollout_cost import Prediction, RolloutOutcome
+from hlp_drake.systems.rollout_pool import RolloutPool
+from hlp_drake.systems.rollout_world import RolloutWorld
+from hlp_drake.systems.scenario import Scenario
+from hlp_drake.systems.world import connect_robot_command, make_world_diagram, world_plant
+
+SETTINGS = (
+    "optimiser: {samples: 2, workers: 1, verify: false}\n"
+    "closed_loop: {replan_period: 0.4, iterations: 1, rollouts: 3}\n"
+)
+
+
+@pytest.fixture(scope="module")
+def scenario():
+    return Scenario(scene=load_scene(DEFAULT_SCENE)).updated(SETTINGS)
+
+
+def forward(start: np.ndarray, distance: float, duration: float) -> ControlSequence:
+    """The robot's base moving ``distance`` along x from ``start`` in ``duration`` s (4 steps)."""
+    times = np.linspace(0.0, duration, 5)
+    knots = np.tile(start, (5, 1))
+    knots[:, 0] += np.linspace(0.0, distance, 5)
+    return ControlSequence(times, knots)
+
+
+def test_the_remainder_starts_where_the_sequence_is_and_keeps_its_later_knots():
+    sequence = forward(np.zeros(11), 0.2, 2.0)
+    rest = remainder(sequence, 0.7)
+    assert rest.duration == pytest.approx(1.3) and rest.knots[0, 0] == pytest.approx(0.07)
+    np.testing.assert_array_equal(rest.knots[1:], sequence.knots[2:])
+    assert remainder(sequence, 2.0) is None
+
+
+def run_controller(
+    scenario: Scenario, sequence: ControlSequence, until: float, *, outcome=None, initialiser=None
+):
+    """Simulate the world driven by the controller (its initial optimisation ``sequence``, whose
+    rollout had ``outcome``) to ``until``."""
+    builder = DiagramBuilder()
+    world = builder.AddSystem(make_world_diagram(scenario))
+    plant, _ = world_plant(world)
+    with RolloutPool(1) as pool:
+        controller = builder.AddNamedSystem(
+            "controller", RecedingHorizonController(scenario, plant, pool, initialiser=initialiser)
+        )
+        builder.Connect(world.GetOutputPort("state"), controller.GetInputPort("state"))
+        connect_robot_command(builder, world, controller.GetOutputPort("desired_trajectory_state"), name="c")
+        simulator = Simulator(builder.Build())
+        context = simulator.get_mutable_context()
+        controller.GetInputPort("initial").FixValue(
+            controller.GetMyMutableContextFromRoot(context), StoResult(sequence, outcome, True, None)
+        )
+        simulator.AdvanceTo(until)
+        record = controller.record(context)
+        desired = controller.GetOutputPort("desired_trajectory_state").Eval(
+            controller.GetMyContextFromRoot(context)
+        )
+        q = plant.GetPositions(plant.GetMyContextFromRoot(context), world_plant(world)[1])
+    return record, desired, q
+
+
+def test_the_controller_re_optimises_every_period_within_its_budget_and_the_robot_follows(scenario):
+    start = RolloutWorld(scenario).start_positions
+    sequence = forward(start, 0.05, 1.6)
+    record, desired, q = run_controller(scenario, sequence, 1.0)
+    assert record.replans == 2 and record.t0 == pytest.approx(0.8)  # at 0.4 s and 0.8 s
+    assert 2 <= record.rollouts <= 2 * scenario.closed_loop.rollouts
+    assert record.t0 + record.sequence.duration == pytest.approx(sequence.duration)  # the same end
+    trajectory = record.sequence.to_trajectory()
+    np.testing.assert_allclose(desired[:11], trajectory.value(1.0 - record.t0).ravel())
+    assert abs(q[0] - desired[0]) < 0.01  # the base follows the command
+    again, _, _ = run_controller(scenario, sequence, 1.0)  # the same seed, the same commands
+    np.testing.assert_array_equal(again.sequence.knots, record.sequence.knots)
+
+
+def test_model_error_is_seeded_per_scene_and_changes_the_world(scenario):
+    scene = scenario.scene
+    config = UncertaintyConfig(enabled=True, seed=3)
+    error = sample_model_error(config, scene)
+    assert error == sample_model_error(config, scene)
+    assert error != sample_model_error(UncertaintyConfig(enabled=True, seed=4), scene)
+    offsets = np.array([[e.dx, e.dy] for e in error.objects.values()])
+    assert 0 < np.max(np.abs(offsets)) < 5 * config.position_sigma
+    assert all(0.5 <= e.mass_scale <= 2.0 and 0.7 <= e.friction_scale <= 1.3 for e in error.objects.values())
+    true = error.true_scene(scene)
+    world = make_world_diagram(scenario, model_error=error)
+    plant, _ = world_plant(world)
+    context = plant.CreateDefaultContext()
+    target = plant.GetBodyByName(scene.target.name)
+    p = target.EvalPoseInWorld(context).translation()
+    assert p[:2] == pytest.approx([true.target.x, true.target.y], abs=1e-9)
+    assert target.default_mass() == pytest.approx(
+        make_world_diagram(scenario)
+        .GetSubsystemByName("plant")
+        .GetBodyByName(scene.target.name)
+        .default_mass()
+        * error.objects[scene.target.name].mass_scale
+    )
+
+
+def test_the_observed_scene_planner_plans_on_the_measured_scene_from_where_the_robot_is(scenario):
+    world = RolloutWorld(scenario)
+    world.begin(forward(world.start_positions, 0.0, 1.0))
+    states = world.states()
+    template = scenario.scene
+    pushed = template.obstacles[0].name
+    states[pushed][4] += 0.03  # measured 3 cm further along x
+    states[ROBOT_MODEL_NAME][0] += 0.02  # the base 2 cm on
+    scene = measured_scene(template, states)
+    assert scene.obstacles[0].x == pytest.approx(template.obstacles[0].x + 0.03, abs=1e-9)
+    assert scene.obstacles[1] is template.obstacles[1] and scene.target is template.target
+    sequence = ObservedScenePlanner(scenario)(states)
+    np.testing.assert_allclose(sequence.knots[0], states[ROBOT_MODEL_NAME][:11])
+    assert sequence.duration > 1.0
+
+
+def test_an_object_far_from_where_the_plan_expected_it_asks_for_a_new_initial_sequence(scenario):
+    start = RolloutWorld(scenario).start_positions
+    sequence, fresh = forward(start, 0.05, 1.6), forward(start, 0.0, 1.0)
+    positions = np.array([[o.x, o.y, 0.8] for o in scenario.scene.objects])
+    calls = []
+
+    def initialiser(states):
+        calls.append(states)
+        return fresh
+
+    def outcome(offset: float) -> RolloutOutcome:
+        shifted = positions + [offset, 0.0, 0.0]
+        prediction = Prediction(np.array([0.0, 2.0]), np.stack([shifted, shifted]), np.zeros((2, 3)))
+        return RolloutOutcome(1.0, {}, True, None, 0.0, prediction=prediction)
+
+    record, _, _ = run_controller(scenario, sequence, 0.5, outcome=outcome(0.0), initialiser=initialiser)
+    assert record.replans == 1 and record.initialised == 0 and not calls  # as expected: no new plan
+    far = 2 * scenario.closed_loop.replan_distance
+    record, _, _ = run_controller(scenario, sequence, 0.5, outcome=outcome(far), initialiser=initialiser)
+    assert record.replans == 1 and record.initialised == 1 and len(calls) == 1
+    assert set(calls[0]) >= {ROBOT_MODEL_NAME, scenario.scene.target.name}

@@ -52,17 +52,17 @@ def brief(value: Any) -> str:
         return "a very long integer"
 
 
-def read_document(
+def read_bytes(
     path: str | os.PathLike[str],
     error: type[HlpError] = HlpError,
     *,
     missing: str = "no such file",
     limit: int = MAX_DOCUMENT_BYTES,
-) -> str:
-    """The UTF-8 text of the file ``path``, read at most ``limit`` bytes.
+) -> bytes:
+    """The bytes of the file ``path``, read at most ``limit`` of them.
 
     Raises:
-        error: the file is missing, unreadable, larger than ``limit`` or not UTF-8 (one line).
+        error: the file is missing, unreadable or larger than ``limit`` (one line).
     """
     try:
         with open(path, "rb") as file:
@@ -74,7 +74,23 @@ def read_document(
     except OSError as problem:
         raise error(f"{path}: cannot read: {problem.strerror or problem}") from None
     if len(data) > limit:
-        raise error(f"{path}: larger than the {limit / 2**20:g} MiB a document may have") from None
+        raise error(f"{path}: larger than the {limit / 2**20:g} MiB such a file may have") from None
+    return data
+
+
+def read_document(
+    path: str | os.PathLike[str],
+    error: type[HlpError] = HlpError,
+    *,
+    missing: str = "no such file",
+    limit: int = MAX_DOCUMENT_BYTES,
+) -> str:
+    """The UTF-8 text of the file ``path`` (``read_bytes``).
+
+    Raises:
+        error: as ``read_bytes``, or the file is not UTF-8 (one line).
+    """
+    data = read_bytes(path, error, missing=missing, limit=limit)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as problem:

@@ -60,11 +60,15 @@ class PlannerSettings:
             optimiser and its settings are the same for both.
         models: a directory of trained decision models (``python -m hlp_drake.train --out DIR``);
             "" for the bundled ones.
+        models_sha256: the SHA-256 of the trusted ``models.json`` in ``models``
+            (``sha256sum models.json``); "" trusts whatever is there (the bundled models are
+            always pinned).
         hlp: the human-like planner's settings.
     """
 
     kind: Literal["hlp", "sto"] = "hlp"
     models: str = ""
+    models_sha256: str = ""
     hlp: PlannerConfig = field(default_factory=PlannerConfig)
 
 

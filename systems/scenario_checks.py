@@ -6,6 +6,7 @@ import math
 from typing import TYPE_CHECKING
 
 from hlp_drake.planner.config import planner_config_problems
+from hlp_drake.scene.generators import MAX_SEED
 from hlp_drake.systems.optimiser_config import StoCost
 from hlp_drake.systems.transfer_geometry import TransferConfig
 
@@ -18,8 +19,6 @@ MAX_TIME_STEP = 0.1
 """s: the largest plant and rollout time step."""
 MAX_WORKERS = 64
 """Most rollout processes."""
-MAX_SEED = 2**32 - 1
-"""Seeds lie in [0, MAX_SEED] (numpy's seeds are non-negative)."""
 SAP_APPROXIMATIONS = ("sap", "lagged", "similar")
 """Discrete contact approximations solved by SAP (TAMSI, "tamsi", cannot simulate the mimic finger)."""
 CONTACT_MODELS = ("point", "hydroelastic", "hydroelastic_with_fallback")

@@ -112,15 +112,16 @@ def test_unreadable_and_non_numeric_files_are_reported(folder, tmp_path):
     assert [r.key for r in ds.records] == ["sub_01/T005"]
 
 
-def test_nan_samples_are_kept_as_nan(folder, tmp_path):
+def test_a_nan_sample_leaves_its_trial_out_with_the_file_and_line(folder, tmp_path):
     path = folder / "sub_01" / "T010" / "movement" / "HandTracker_movement_T010.csv"
     lines = path.read_text().splitlines()
     fields = lines[3].split(",")
     fields[1] = "NaN"
     lines[3] = ",".join(fields)
     path.write_text("\n".join(lines) + "\n")
-    hand = load(folder, tmp_path).trial("sub_01/T010").trackers["hand"]
-    assert np.isnan(hand.position[2, 1]) and not np.isnan(hand.position[1, 1])
+    ds = load(folder, tmp_path)
+    assert "sub_01/T010" not in ds and "sub_01/T005" in ds
+    assert ds.problems == [{"path": str(path), "reason": "line 4: non-finite value"}]
 
 
 def test_overlapping_objects_in_a_layout_reject_the_trial(folder, tmp_path):

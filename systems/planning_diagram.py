@@ -10,10 +10,13 @@ from functools import cache
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import Diagram, DiagramBuilder
+from pydrake.systems.primitives import ConstantValueSource
 
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.learners.models import DecisionModels
+from hlp_drake.planner.plan import HighLevelPlan
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.hlp_planner_system import HlpPlannerSystem
 from hlp_drake.systems.keypoint_ik import KeypointIk
@@ -42,7 +45,11 @@ def scenario_models(scenario: Scenario) -> DecisionModels:
 
 
 def make_planning_diagram(
-    scenario: Scenario, *, pool: RolloutPool | None = None, models: DecisionModels | None = None
+    scenario: Scenario,
+    *,
+    pool: RolloutPool | None = None,
+    models: DecisionModels | None = None,
+    plan: HighLevelPlan | None = None,
 ) -> Diagram:
     """``scene`` input -> planner block -> push transfer -> KeypointIk -> StochasticTrajectoryOptimiser.
 
@@ -58,28 +65,36 @@ def make_planning_diagram(
     Args:
         pool: the optimiser's rollout workers (the caller's); without one, no optimiser.
         models: the decision models (default: ``scenario_models(scenario)``).
+        plan: a person's plan to use instead of the planner block's (written out, or planned
+            elsewhere): a constant source feeds it to the transfer, whatever the scene.
     """
-    kind = scenario.planner.kind
+    kind = "given" if plan is not None else scenario.planner.kind
     builder = DiagramBuilder()
-    if kind == "hlp":
-        block = HlpPlannerSystem(models=models or scenario_models(scenario), config=scenario.planner.hlp)
-    else:
-        block = StraightLinePlanSystem()
-    builder.AddNamedSystem(f"{kind}_planner", block)
     transfer = builder.AddNamedSystem("robot_plan_transfer", RobotPlanTransfer(scenario))
+    if plan is not None:
+        source = ConstantValueSource(AbstractValue.Make(plan))
+        plan_port = builder.AddNamedSystem("given_plan", source).get_output_port()
+        builder.ExportInput(transfer.get_scene_input_port(), SCENE_PORT)
+    else:
+        if kind == "hlp":
+            block = HlpPlannerSystem(models=models or scenario_models(scenario), config=scenario.planner.hlp)
+        else:
+            block = StraightLinePlanSystem()
+        builder.AddNamedSystem(f"{kind}_planner", block)
+        plan_port = block.get_plan_output_port()
+        builder.ExportInput(block.get_scene_input_port(), SCENE_PORT)
+        builder.ConnectToSame(block.get_scene_input_port(), transfer.get_scene_input_port())
     ik = builder.AddNamedSystem("keypoint_ik", KeypointIk(scenario))
-    builder.Connect(block.get_plan_output_port(), transfer.get_plan_input_port())
+    builder.Connect(plan_port, transfer.get_plan_input_port())
     builder.Connect(transfer.get_robot_plan_output_port(), ik.get_plan_input_port())
     builder.Connect(transfer.get_robot_alternatives_output_port(), ik.get_alternatives_input_port())
-    builder.ExportInput(block.get_scene_input_port(), SCENE_PORT)
-    builder.ConnectToSame(block.get_scene_input_port(), transfer.get_scene_input_port())
-    builder.ExportOutput(block.get_plan_output_port(), "plan")
+    builder.ExportOutput(plan_port, "plan")
     builder.ExportOutput(transfer.get_robot_plan_output_port(), "robot_plan")
     builder.ExportOutput(ik.get_keyframes_output_port(), "keyframes")
     builder.ExportOutput(ik.get_trajectory_output_port(), "trajectory")
     if pool is not None:
         optimiser = builder.AddNamedSystem("optimiser", StochasticTrajectoryOptimiser(scenario, pool))
-        builder.ConnectToSame(block.get_scene_input_port(), optimiser.get_scene_input_port())
+        builder.ConnectToSame(transfer.get_scene_input_port(), optimiser.get_scene_input_port())
         builder.Connect(ik.get_trajectory_output_port(), optimiser.get_initial_trajectory_input_port())
         builder.Connect(
             ik.get_alternative_trajectories_output_port(), optimiser.get_alternatives_input_port()

@@ -60,42 +60,15 @@ GEN2_9_39_NEXT = [
 GEN1_15 = [("move", "FailOnTouchObstacleLong", "BL"), ("move", "FailOnTouchObstacleMed-1", "RR")]
 
 
-def plan_chain(scenario, human: HighLevelPlan, pool=None):
-    """The planning diagram's chain after the planner, fed a fixed person's plan: a constant plan
-    source -> RobotPlanTransfer -> KeypointIk (-> the optimiser, with a ``pool``); the scene is the
-    scenario's, fixed. Outputs as ``make_planning_diagram``'s (but ``plan``)."""
-    from pydrake.common.value import AbstractValue
-    from pydrake.systems.framework import DiagramBuilder
-    from pydrake.systems.primitives import ConstantValueSource
-
-    from hlp_drake.systems import KeypointIk, RobotPlanTransfer, StochasticTrajectoryOptimiser
-
-    builder = DiagramBuilder()
-    source = builder.AddSystem(ConstantValueSource(AbstractValue.Make(human)))
-    scene = builder.AddSystem(ConstantValueSource(AbstractValue.Make(scenario.scene)))
-    transfer = builder.AddNamedSystem("robot_plan_transfer", RobotPlanTransfer(scenario))
-    ik = builder.AddNamedSystem("keypoint_ik", KeypointIk(scenario))
-    builder.Connect(source.get_output_port(), transfer.get_plan_input_port())
-    builder.Connect(scene.get_output_port(), transfer.get_scene_input_port())
-    builder.Connect(transfer.get_robot_plan_output_port(), ik.get_plan_input_port())
-    builder.Connect(transfer.get_robot_alternatives_output_port(), ik.get_alternatives_input_port())
-    builder.ExportOutput(transfer.get_robot_plan_output_port(), "robot_plan")
-    builder.ExportOutput(ik.get_trajectory_output_port(), "trajectory")
-    if pool is not None:
-        optimiser = builder.AddNamedSystem("optimiser", StochasticTrajectoryOptimiser(scenario, pool))
-        builder.Connect(scene.get_output_port(), optimiser.get_scene_input_port())
-        builder.Connect(ik.get_trajectory_output_port(), optimiser.get_initial_trajectory_input_port())
-        builder.Connect(ik.get_alternative_trajectories_output_port(), optimiser.get_alternatives_input_port())
-        builder.ExportOutput(optimiser.get_result_output_port(), "optimisation")
-    return builder.Build()
-
-
 def chain_first_rollout(scenario, human: HighLevelPlan):
     """The optimiser's first rollout of the initial trajectory of ``human``'s robot plan."""
+    from hlp_drake.systems import make_planning_diagram
     from hlp_drake.systems.control_sequence import ControlSequence
     from hlp_drake.systems.scene_rollouts import SceneRollouts
 
-    diagram = plan_chain(scenario, human)
-    trajectory = diagram.GetOutputPort("trajectory").Eval(diagram.CreateDefaultContext())
+    diagram = make_planning_diagram(scenario, plan=human)
+    context = diagram.CreateDefaultContext()
+    diagram.GetInputPort("scene").FixValue(context, scenario.scene)
+    trajectory = diagram.GetOutputPort("trajectory").Eval(context)
     sequence = ControlSequence.from_trajectory(trajectory, scenario.optimiser.step_duration)
     return SceneRollouts(scenario).rollout(sequence)

@@ -8,7 +8,7 @@ import re
 
 import numpy as np
 import pytest
-from human_plans import GEN1_15, GEN2_9_39, GEN2_9_39_NEXT, chain_first_rollout, human_plan, plan_chain
+from human_plans import GEN1_15, GEN2_9_39, GEN2_9_39_NEXT, chain_first_rollout, human_plan
 from pydrake.trajectories import PiecewisePolynomial
 
 from hlp_drake.run_scene import DEFAULT_SCENE
@@ -199,8 +199,9 @@ def test_where_the_hlps_plan_fails_at_its_first_rollout_its_next_candidates_are_
     config = on(scene, "optimiser: {max_iterations: 1, samples: 2}")
     person = human_plan(scene, GEN2_9_39, GEN2_9_39_NEXT)
     with RolloutPool(1) as pool:
-        diagram = plan_chain(config, person, pool)
+        diagram = make_planning_diagram(config, pool=pool, plan=person)
         context = diagram.CreateDefaultContext()
+        diagram.GetInputPort("scene").FixValue(context, scene)
         transfer = diagram.GetSubsystemByName("robot_plan_transfer")
         count = len(transfer.GetOutputPort("robot_alternatives").Eval(transfer.GetMyContextFromRoot(context)))
         hlp = diagram.GetOutputPort("optimisation").Eval(context)

@@ -79,6 +79,21 @@ def test_damaged_cache_is_rebuilt(folder, tmp_path):
     assert len(rebuilt.trial("sub_01/T010").trackers["hand"]) == 6
 
 
+def test_a_cache_with_a_trial_removed_is_rebuilt_even_with_its_digest_updated(folder, tmp_path):
+    import hashlib
+    import json
+
+    ds = load(folder, tmp_path)
+    index_path = ds.cache_path / "index.json"
+    index = json.loads(index_path.read_text())
+    index["trials"] = [t for t in index["trials"] if t["trial"] != 10]
+    text = json.dumps(index)
+    index_path.write_text(text)
+    (ds.cache_path / "index.sha256").write_text(hashlib.sha256(text.encode()).hexdigest())
+    rebuilt = load(folder, tmp_path)
+    assert rebuilt.cache_status == "built" and "sub_01/T010" in rebuilt
+
+
 def test_truncated_movement_file_is_reported_by_path_and_only_its_trial_dropped(folder, tmp_path):
     path = folder / "sub_01" / "T010" / "movement" / "ElbowTracker_movement_T010.csv"
     path.write_text(path.read_text()[:-12])  # cut the last line in the middle
@@ -151,8 +166,14 @@ def test_bad_paths_raise_one_clear_error(tmp_path, monkeypatch):
 
 
 def test_summary_cli_missing_dataset_is_one_line(tmp_path):
-    result = run_module("hlp_drake.dataset", "summary", "--dataset", str(tmp_path / "nope"), "--json",
-                        str(tmp_path / "out.json"))
+    result = run_module(
+        "hlp_drake.dataset",
+        "summary",
+        "--dataset",
+        str(tmp_path / "nope"),
+        "--json",
+        str(tmp_path / "out.json"),
+    )
     assert result.returncode == 2
     assert result.stderr.count("\n") == 1 and result.stderr.startswith("error: ")
     assert "Traceback" not in result.stderr
@@ -162,8 +183,15 @@ def test_summary_cli_missing_dataset_is_one_line(tmp_path):
 def test_summary_cli_reports_problems_and_counts(folder, tmp_path):
     (folder / "sub_01" / "T011" / "movement" / "Target_movement_T011.csv").unlink()
     out = tmp_path / "summary.json"
-    result = run_module("hlp_drake.dataset", "summary", "--dataset", str(folder), "--json", str(out),
-                        env={"HLP_CACHE": str(tmp_path / "cache")})
+    result = run_module(
+        "hlp_drake.dataset",
+        "summary",
+        "--dataset",
+        str(folder),
+        "--json",
+        str(out),
+        env={"HLP_CACHE": str(tmp_path / "cache")},
+    )
     assert result.returncode == 0, result.stderr
     assert "warning:" in result.stderr and "Target_movement_T011.csv" in result.stderr
     import json

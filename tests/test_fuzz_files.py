@@ -272,16 +272,17 @@ def _check_cache_damage(case) -> None:
             np.save(first.cache_path / "tracks.npy", tracks)
         text = json.dumps(index)
         index_path.write_text(text)
-        if data.draw(st.booleans()):  # a consistent tamper: the digest updated too
+        consistent = data.draw(st.booleans())
+        if consistent:  # a tamper with the digest updated too
             (first.cache_path / "index.sha256").write_text(hashlib.sha256(text.encode()).hexdigest())
         try:
             dataset = _load(root, cache)
         except DatasetError as error:  # a damaged track found in use: dropped, rebuilt on the next load
             check_error(error)
             dataset = _load(root, cache)
-        assert dataset is not None and sorted(r.key for r in dataset.records) == sorted(
-            r.key for r in first.records
-        )
+        assert dataset is not None
+        if not (consistent and how == "field"):  # a well-formed edit of one field cannot be told apart
+            assert sorted(r.key for r in dataset.records) == sorted(r.key for r in first.records)
         STATS["caches rebuilt"] += dataset.cache_status == "built"
 
 

@@ -34,7 +34,7 @@ from hlp_drake.dataset.records import TRACKERS, category_of, trial_key
 from hlp_drake.dataset.source import PARTICIPANTS_FILE, Source
 from hlp_drake.errors import HlpError, short
 
-CACHE_VERSION = 3
+CACHE_VERSION = 4  # 4: the track array holds the kept trials' tracks only, in index order
 COVERAGE_TOLERANCE = 0.1  # s: a track may start or end this much inside its trial (the data: <= 12 ms)
 INDEX_DIGEST = "index.sha256"  # beside index.json: a cache whose index was edited or damaged is rebuilt
 CACHE_ENV_VAR = "HLP_CACHE"
@@ -239,6 +239,21 @@ def _trial_entry(
     }
 
 
+def _kept_tracks(blocks: list[np.ndarray], trials: list[dict[str, Any]]) -> np.ndarray:
+    """The kept ``trials``' track blocks end to end in index order, their spans renumbered to match
+    (so the spans tile the array exactly: ``check_index`` refuses an index with a trial removed)."""
+    by_start, start = {}, 0
+    for block in blocks:
+        by_start[start], start = block, start + len(block)
+    kept, rows = [], 0
+    for entry in trials:
+        for name, (first, count) in entry["tracks"].items():
+            kept.append(by_start[first])
+            entry["tracks"][name] = [rows, count]
+            rows += count
+    return np.concatenate(kept) if kept else np.empty((0, 7))
+
+
 def build_cache(source: Source, directory: Path, *, progress: bool = True) -> None:
     """Parse the whole source once and write the cache into ``directory`` (atomically)."""
     collector = _Collector(source)
@@ -253,7 +268,7 @@ def build_cache(source: Source, directory: Path, *, progress: bool = True) -> No
         for relative, where, content in source.files(bar):
             collector.add(relative, where, content)
     trials = _assemble(collector)
-    tracks = np.concatenate(collector.blocks) if collector.blocks else np.empty((0, 7))
+    tracks = _kept_tracks(collector.blocks, trials)
     index = {
         "version": CACHE_VERSION,
         "source": source.describe_parts(),

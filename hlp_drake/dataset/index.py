@@ -2,18 +2,24 @@
 
 The cache is the project's own file, but it lives on disk between runs: one damaged or edited
 (whose digest was updated too) must be rebuilt, never trusted. ``check_index`` raises
-``ValueError`` naming the first field that does not fit; the loader then rebuilds the cache.
+``ValueError`` naming the first field that does not fit; the loader then rebuilds the cache. The
+kept trials' track spans tile the track array in index order, so an index with a trial removed,
+added or repeated is refused too. An edit that keeps every field well-formed and the spans
+tiling (e.g. another outcome text) cannot be told from a real cache without a secret: the cache
+guards against damage, and a user who suspects an edit deletes it (``HLP_CACHE``).
 """
 
 from __future__ import annotations
 
 import math
+import re
 from typing import Any
 
 from hlp_drake.dataset.parse import MIN_SAMPLES
 from hlp_drake.dataset.records import CATEGORIES
 
 _TEXT_FIELDS = ("subject", "category", "outcome", "handedness", "trial_name")
+_SUBJECT = re.compile(r"sub_\d+")
 
 
 def _number(value: Any) -> bool:
@@ -44,13 +50,15 @@ def _interactions(rows: Any) -> bool:
     )
 
 
-def _entry_problem(entry: Any, rows: int) -> str | None:
-    """What is wrong with one trial entry (None if nothing)."""
+def _entry_problem(entry: Any, first_row: int) -> str | None:
+    """What is wrong with one trial entry whose tracks start at ``first_row`` (None if nothing)."""
     if not isinstance(entry, dict):
         return "not a mapping"
     for name in _TEXT_FIELDS:
         if not isinstance(entry.get(name), str):
             return f"{name} is not text"
+    if not _SUBJECT.fullmatch(entry["subject"]):
+        return "subject is not a subject folder"
     if entry["category"] not in CATEGORIES:
         return "unknown category"
     if (
@@ -75,9 +83,14 @@ def _entry_problem(entry: Any, rows: int) -> str | None:
         if not (isinstance(span, list) and len(span) == 2 and all(isinstance(v, int) for v in span)):
             return "a track span is not 2 integers"
         start, count = span
-        if start < 0 or count < MIN_SAMPLES or start + count > rows:
-            return "a track span points outside the track array"
+        if start != first_row or count < MIN_SAMPLES:
+            return "the track spans do not follow each other through the track array"
+        first_row += count
     return None
+
+
+def _track_rows(entry: dict[str, Any]) -> int:
+    return sum(count for _, count in entry["tracks"].values())
 
 
 def _records(value: Any) -> bool:
@@ -96,10 +109,17 @@ def check_index(index: dict[str, Any]) -> None:
     trials = index.get("trials")
     if not isinstance(trials, list):
         raise ValueError("index: trials is not a list")  # noqa: TRY004 (the loader rebuilds on ValueError)
+    first_row, keys = 0, set()
     for k, entry in enumerate(trials):
-        problem = _entry_problem(entry, rows)
+        problem = _entry_problem(entry, first_row)
+        if problem is None and (entry["subject"], entry["trial"]) in keys:
+            problem = "a trial listed twice"
         if problem is not None:
             raise ValueError(f"index: trials[{k}]: {problem}")
+        keys.add((entry["subject"], entry["trial"]))
+        first_row += _track_rows(entry)
+    if first_row != rows:
+        raise ValueError(f"index: the trials' tracks cover {first_row} of the track array's {rows} rows")
     for name in ("problems", "notes"):
         if not _records(index.get(name)):
             raise ValueError(f"index: {name} are not path/reason records")

@@ -9,8 +9,11 @@ the checks saw; ``conftest.py`` prints it at the end of a run.
 from __future__ import annotations
 
 import collections
+import contextlib
 import math
-from collections.abc import Callable
+import tempfile
+from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -48,6 +51,16 @@ def check_error(error: HlpError) -> None:
     """A user error is a few short lines (the README's promise)."""
     assert 1 <= len(error.problems) <= MAX_PROBLEMS + 1
     assert all(len(line) <= MAX_LINE and "\n" not in line for line in error.problems), error.problems
+
+
+@contextlib.contextmanager
+def scene_file(case: tuple[str, str]) -> Iterator[Path]:
+    """A temporary file ``scene<suffix>`` holding ``text`` (a ``scene_texts`` case), even invalid UTF-8."""
+    suffix, text = case
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / f"scene{suffix}"
+        path.write_text(text, encoding="utf-8", errors="surrogatepass")
+        yield path
 
 
 HUGE_INT = 10**400

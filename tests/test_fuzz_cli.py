@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 import yaml
 from conftest import run_module
-from fuzz_support import PROFILES, STATS, check_error, mutate, run
+from fuzz_support import PROFILES, STATS, check_error, mutate, run, scene_file
 from hypothesis import strategies as st
 from test_fuzz_scenes import scene_texts
 
@@ -76,11 +76,8 @@ def test_scene_generate_arguments_succeed_or_are_one_line_errors(profile):
 
 
 def _check_validate(case: tuple[str, str]) -> None:
-    suffix, text = case
     STATS["command lines"] += 1
-    with tempfile.TemporaryDirectory() as folder:
-        path = Path(folder) / f"scene{suffix}"
-        path.write_text(text, encoding="utf-8", errors="surrogatepass")
+    with scene_file(case) as path:
         _check_lines(*_run_scene_cli(["validate", str(path)]))
 
 

@@ -78,7 +78,8 @@ def damaged_models(draw) -> tuple[bytes, bytes]:
         if values.ndim:
             values.flat[draw(st.integers(0, values.size - 1))] = draw(_VALUES)
         else:
-            values = np.asarray(draw(_VALUES)).astype(values.dtype)
+            with np.errstate(invalid="ignore"):  # nan or inf into an integer: whatever the cast gives
+                values = np.asarray(draw(_VALUES)).astype(values.dtype)
         arrays[name] = values
     elif how == "dtype":
         arrays[name] = arrays[name].astype(
@@ -167,6 +168,21 @@ def test_a_pinned_model_refuses_other_files_with_a_valid_checksum(tmp_path):
     DecisionModels.load(folder)  # consistent files: the checksum alone cannot tell
     with pytest.raises(ModelError, match="is not the pinned"):
         DecisionModels.load(folder, sha256=pin)
+
+
+def test_a_scenario_pins_its_models_by_the_sha256_of_models_json(tmp_path):
+    from hlp_drake.systems import load_scenario
+    from hlp_drake.systems.planning_diagram import scenario_models
+
+    folder = tmp_path / "m"
+    shutil.copytree(BUNDLED_DIRECTORY, folder)
+    digest = hashlib.sha256((folder / "models.json").read_bytes()).hexdigest()  # what sha256sum prints
+    assert model_digest(folder) == digest
+    trusted = load_scenario(data=f"planner: {{models: '{folder}', models_sha256: {digest}}}")
+    assert scenario_models(trusted).planner == "rows"
+    other = load_scenario(data=f"planner: {{models: '{folder}', models_sha256: '{'0' * 64}'}}")
+    with pytest.raises(ModelError, match="is not the pinned"):
+        scenario_models(other)
 
 
 # --- The dataset ---------------------------------------------------------------------------------------

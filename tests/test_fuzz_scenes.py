@@ -10,13 +10,11 @@ from __future__ import annotations
 
 import functools
 import json
-import tempfile
 from dataclasses import replace
-from pathlib import Path
 
 import pytest
 import yaml
-from fuzz_support import PROFILES, STATS, check_error, junk, mutate, numbers, run
+from fuzz_support import PROFILES, STATS, check_error, junk, mutate, numbers, run, scene_file
 from hypothesis import strategies as st
 
 from hlp_drake.errors import SceneError
@@ -77,11 +75,8 @@ def _check_plan(scene: object) -> None:
 
 
 def _check_scene_file(case: tuple[str, str]) -> None:
-    suffix, text = case
     STATS["scene files"] += 1
-    with tempfile.TemporaryDirectory() as folder:
-        path = Path(folder) / f"scene{suffix}"
-        path.write_text(text, encoding="utf-8", errors="surrogatepass")
+    with scene_file(case) as path:
         try:
             scene = load_scene(path)
         except SceneError as error:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import reprlib
 from typing import Any
 
@@ -34,6 +35,8 @@ _SCALAR_TAGS = {_CORE + name for name in ("str", "int", "float", "bool", "null")
 _COLLECTION_TAGS = {None, "!", _CORE + "seq", _CORE + "map"}
 _RESOLVER = Resolver()
 _CONSTRUCTOR = SafeConstructor()
+_FLOAT_NO_DOT = re.compile(r"[-+]?[0-9]+[eE][-+]?[0-9]+")
+"""``1e-3``: a number in YAML 1.2 (and to Drake), text to YAML 1.1's resolver without a dot."""
 _REPR = reprlib.Repr()
 _REPR.maxstring, _REPR.maxother, _REPR.maxlong = 60, 60, 30
 _REPR.maxlist = _REPR.maxtuple = _REPR.maxdict = 4
@@ -106,6 +109,8 @@ def _scalar(event: events.ScalarEvent) -> Any:
     tag = event.tag
     if tag is None or tag == "!":
         tag = _RESOLVER.resolve(ScalarNode, event.value, event.implicit)
+        if event.implicit[0] and tag == _CORE + "str" and _FLOAT_NO_DOT.fullmatch(event.value):
+            return float(event.value)
     elif tag not in _SCALAR_TAGS:
         raise _Refused(f"tag {short(tag, 40)!r} is not allowed{_line(event)}")
     node = ScalarNode(tag, event.value, event.start_mark, event.end_mark, event.style)

@@ -211,7 +211,7 @@ def scene_problems(scene: Scene) -> list[str]:
 
 def _overlaps(sound: list[tuple[SceneObject, str]], shapes: np.ndarray, tree: shapely.STRtree) -> list[str]:
     """A message per pair of footprints sharing more than ``AREA_TOLERANCE``, in index order; after
-    ``MAX_PROBLEMS`` pairs one line says more overlap (so a pile of n equal objects costs O(n))."""
+    ``MAX_PROBLEMS - 1`` pairs one line says more overlap (so a pile of n equal objects costs O(n))."""
     problems: list[str] = []
     first, chunk = 0, 1
     while first < len(shapes):  # chunks of 1, 2, 4, ... 256 objects: a pile is found in the first
@@ -225,8 +225,8 @@ def _overlaps(sound: list[tuple[SceneObject, str]], shapes: np.ndarray, tree: sh
             i, j = a[start : start + _PAIRS_PER_BATCH], b[start : start + _PAIRS_PER_BATCH]
             areas = shapely.area(shapely.intersection(shapes[i], shapes[j]))
             for k in np.flatnonzero(areas > AREA_TOLERANCE).tolist():
-                if len(problems) == MAX_PROBLEMS:
-                    return [*problems, f"more objects overlap (the first {MAX_PROBLEMS} pairs are listed)"]
+                if len(problems) == MAX_PROBLEMS - 1:  # with the line below: what an error shows
+                    return [*problems, f"more objects overlap (the first {len(problems)} pairs are listed)"]
                 (obj_a, role_a), (obj_b, role_b) = sound[i[k]], sound[j[k]]
                 problems.append(
                     f"{_label(obj_a, role_a)} and {_label(obj_b, role_b)} overlap ({areas[k] * 1e4:.2f} cm^2)"

@@ -79,19 +79,29 @@ def test_damaged_cache_is_rebuilt(folder, tmp_path):
     assert len(rebuilt.trial("sub_01/T010").trackers["hand"]) == 6
 
 
-def test_a_cache_with_a_trial_removed_is_rebuilt_even_with_its_digest_updated(folder, tmp_path):
+@pytest.mark.parametrize(
+    "edit",
+    [
+        lambda trials: [t for t in trials if t["trial"] != 10],  # a trial removed
+        lambda trials: [*trials, trials[0]],  # a trial repeated
+        lambda trials: [{}],
+        lambda trials: 5,
+    ],
+    ids=["removed", "repeated", "[{}]", "5"],
+)
+def test_an_edited_cache_index_is_rebuilt_even_with_its_digest_updated(folder, tmp_path, edit):
     import hashlib
     import json
 
     ds = load(folder, tmp_path)
     index_path = ds.cache_path / "index.json"
     index = json.loads(index_path.read_text())
-    index["trials"] = [t for t in index["trials"] if t["trial"] != 10]
+    index["trials"] = edit(index["trials"])
     text = json.dumps(index)
     index_path.write_text(text)
     (ds.cache_path / "index.sha256").write_text(hashlib.sha256(text.encode()).hexdigest())
     rebuilt = load(folder, tmp_path)
-    assert rebuilt.cache_status == "built" and "sub_01/T010" in rebuilt
+    assert rebuilt.cache_status == "built" and [r.key for r in rebuilt.records] == [r.key for r in ds.records]
 
 
 def test_truncated_movement_file_is_reported_by_path_and_only_its_trial_dropped(folder, tmp_path):

@@ -125,6 +125,7 @@ _PROCESS_CASES = [
     ("scene", "validate", "{deep}"),
     ("scene", "validate", "{laughs}"),
     ("run_scene", "--config", "{number}"),
+    ("run_scene", "--config", "{samples}"),
     ("run_scene", "--seed", "-1"),
     ("scene", "generate", "--kind", "gen2", "--seed", "1", "--out", "{afile}/x.yaml"),
 ]
@@ -136,6 +137,7 @@ def test_hostile_input_never_shows_a_traceback_to_the_user(tmp_path, case):
         "deep": "start: " + "[" * 100_000 + "]" * 100_000,
         "laughs": "a: &a [x, x, x, x, x, x, x, x, x]\nb: &b [*a, *a, *a, *a, *a, *a, *a, *a, *a]\nstart: [*b, *b]\n",
         "number": "plant: {time_step: " + "9" * 400 + "}\n",
+        "samples": "optimiser: {samples: " + "1" * 401 + "}\n",
         "afile": "a file, not a folder",
     }
     paths = {}

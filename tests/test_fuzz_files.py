@@ -155,6 +155,45 @@ def test_damaged_model_files_load_or_are_one_model_error(profile):
     run(profile, (80, 400), damaged_models(), _check_models)
 
 
+def _edited_models(folder: Path, how: str) -> None:
+    """The bundled models in ``folder`` with one of the issue's edits, the checksum updated to match."""
+    arrays, meta = dict(_bundled_arrays()), json.loads((BUNDLED_DIRECTORY / "models.json").read_text())
+    if how == "subjects: 5":
+        meta["subjects"] = 5
+    elif how == "row.learner.feature as float":
+        arrays["row.learner.feature"] = arrays["row.learner.feature"].astype(float)
+    elif how == "row.novelty.points of 3 features":
+        arrays["row.novelty.points"] = arrays["row.novelty.points"][:, :3]
+    elif how == "row.learner.left past the nodes":
+        arrays["row.learner.left"] = arrays["row.learner.left"] + 10**6
+    payload = _huge_header(arrays, "arm.train") if how == "10^12 elements" else _npz(arrays)
+    meta["sha256"] = hashlib.sha256(payload).hexdigest()
+    folder.mkdir()
+    (folder / "models.npz").write_bytes(payload)
+    (folder / "models.json").write_text(json.dumps(meta))
+
+
+@pytest.mark.parametrize(
+    ("how", "problem"),
+    [
+        ("subjects: 5", "models.json: subjects: expected a list"),
+        ("10^12 elements", "array 'arm.train' has shape (1000000, 1000000)"),
+        (
+            "row.learner.feature as float",
+            "array 'row.learner.feature' has dtype float64, the format has int32",
+        ),
+        ("row.novelty.points of 3 features", "array 'row.novelty.points' has shape"),
+        ("row.learner.left past the nodes", "array 'row.learner.left' has values outside"),
+    ],
+)
+def test_an_edited_model_file_is_one_model_error_naming_the_field(tmp_path, how, problem):
+    _edited_models(tmp_path / "m", how)
+    with pytest.raises(ModelError) as error:
+        DecisionModels.load(tmp_path / "m")
+    check_error(error.value)
+    assert problem in str(error.value), str(error.value)
+
+
 def test_a_pinned_model_refuses_other_files_with_a_valid_checksum(tmp_path):
     folder = tmp_path / "m"
     shutil.copytree(BUNDLED_DIRECTORY, folder)

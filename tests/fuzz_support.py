@@ -44,7 +44,11 @@ def run(
             HealthCheck.large_base_example,
         ],
     )
-    given(strategy)(options(check))()
+
+    def example(value: Any) -> None:  # a new function per run: settings apply to one function once
+        check(value)
+
+    given(strategy)(options(example))()
 
 
 def check_error(error: HlpError) -> None:

@@ -15,6 +15,7 @@ import io
 import json
 import shutil
 import tempfile
+import warnings
 import zipfile
 from pathlib import Path
 
@@ -44,19 +45,23 @@ def _npz(arrays: dict[str, np.ndarray]) -> bytes:
     return buffer.getvalue()
 
 
-def _huge_header(arrays: dict[str, np.ndarray], name: str) -> bytes:
-    """An npz whose member ``name`` declares 10^12 elements."""
+def _huge_header(arrays: dict[str, np.ndarray], name: str, *, unclosed: bool = False) -> bytes:
+    """An npz whose member ``name`` declares 10^12 elements (or, with ``unclosed``, has a header
+    whose shape's parenthesis is never closed), every member's CRC right."""
     buffer = io.BytesIO()
     with zipfile.ZipFile(buffer, "w") as archive:
         for key, value in arrays.items():
             member = io.BytesIO()
-            if key == name:
+            if key == name and not unclosed:
                 header = {"descr": "<f8", "fortran_order": False, "shape": (10**6, 10**6)}
                 np.lib.format.write_array_header_1_0(member, header)
                 member.write(value.tobytes())
             else:
                 np.lib.format.write_array(member, value)
-            archive.writestr(f"{key}.npy", member.getvalue())
+            data = member.getvalue()
+            if key == name and unclosed:
+                data = data.replace(b"), }", b",  }", 1)
+            archive.writestr(f"{key}.npy", data)
     return buffer.getvalue()
 
 
@@ -75,10 +80,11 @@ def damaged_models(draw) -> tuple[bytes, bytes]:
     name = names[draw(st.integers(0, len(names) - 1))]
     if how == "value":
         values = arrays[name].copy()
-        if values.ndim:
-            values.flat[draw(st.integers(0, values.size - 1))] = draw(_VALUES)
-        else:
-            with np.errstate(invalid="ignore"):  # nan or inf into an integer: whatever the cast gives
+        with warnings.catch_warnings():  # nan or inf into an integer: whatever the cast gives
+            warnings.simplefilter("ignore", RuntimeWarning)
+            if values.ndim:
+                values.flat[draw(st.integers(0, values.size - 1))] = draw(_VALUES)
+            else:
                 values = np.asarray(draw(_VALUES)).astype(values.dtype)
         arrays[name] = values
     elif how == "dtype":
@@ -166,7 +172,10 @@ def _edited_models(folder: Path, how: str) -> None:
         arrays["row.novelty.points"] = arrays["row.novelty.points"][:, :3]
     elif how == "row.learner.left past the nodes":
         arrays["row.learner.left"] = arrays["row.learner.left"] + 10**6
-    payload = _huge_header(arrays, "arm.train") if how == "10^12 elements" else _npz(arrays)
+    if how in ("10^12 elements", "an unclosed header"):  # the second: numpy raised TokenError
+        payload = _huge_header(arrays, "arm.train", unclosed=how == "an unclosed header")
+    else:
+        payload = _npz(arrays)
     meta["sha256"] = hashlib.sha256(payload).hexdigest()
     folder.mkdir()
     (folder / "models.npz").write_bytes(payload)
@@ -184,6 +193,7 @@ def _edited_models(folder: Path, how: str) -> None:
         ),
         ("row.novelty.points of 3 features", "array 'row.novelty.points' has shape"),
         ("row.learner.left past the nodes", "array 'row.learner.left' has values outside"),
+        ("an unclosed header", "unreadable .npy header (TokenError)"),
     ],
 )
 def test_an_edited_model_file_is_one_model_error_naming_the_field(tmp_path, how, problem):

@@ -4,7 +4,7 @@ name, dtype and shape, checked before any array is used.
 Shapes are written with symbols: a number is a fixed size, a name a size every array that uses it
 must share (``F`` the row-choice features, ``P`` the kept novelty points, ...). The npz members'
 headers are read first (within ``MAX_HEADER``), so a header declaring a huge array is refused
-before anything is allocated; then the values are checked (indices in range, positive scales).
+before anything is allocated; then the values are checked (indices in range, scales positive, every number within ``MAX_VALUE``).
 Every damage is one ``ModelError``.
 
 Trust: ``allow_pickle=False`` and this check make a model file plain data: loading one never runs
@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import hashlib
 import io
+import tokenize
 import zipfile
 import zlib
 from math import comb
@@ -45,6 +46,9 @@ MAX_HEADER = 4096
 """Longest .npy header read, bytes."""
 MAX_DEPTH = 64
 """Deepest boosted tree."""
+MAX_VALUE = 1e9
+"""Largest magnitude of a stored number, and the inverse of the smallest scale (trained models
+stay within 1e5; beyond, z-scores and kernels overflow)."""
 
 Spec = tuple[str, tuple[int | str, ...]]
 
@@ -136,7 +140,11 @@ def _header(member: Any) -> tuple[tuple[int, ...], np.dtype]:
     )
     if read is None:
         raise ValueError(f"unknown .npy version {version}")
-    shape, fortran, dtype = read(member, max_header_size=MAX_HEADER)
+    try:
+        shape, fortran, dtype = read(member, max_header_size=MAX_HEADER)
+    except (SyntaxError, TypeError, RecursionError, tokenize.TokenError) as error:
+        # numpy's header parser: literal_eval, then its Python 2 header filter (tokenize)
+        raise ValueError(f"unreadable .npy header ({type(error).__name__})") from None
     if fortran:
         raise ValueError("Fortran-ordered array")
     return shape, dtype
@@ -203,6 +211,8 @@ def check_values(arrays: dict[str, np.ndarray]) -> None:
     for name, values in arrays.items():
         if values.dtype.kind == "f" and not np.all(np.isfinite(values)):
             raise ValueError(f"array {name!r} has non-finite values")
+        if values.dtype.kind == "f":
+            _range(name, values, -MAX_VALUE, MAX_VALUE)
     positive = [
         n
         for n in arrays
@@ -210,7 +220,7 @@ def check_values(arrays: dict[str, np.ndarray]) -> None:
         and not n.endswith("learner.threshold")
     ]
     for name in positive:
-        _range(name, arrays[name], 1e-300, np.inf)
+        _range(name, arrays[name], 1 / MAX_VALUE, MAX_VALUE)
     if "row.learner.feature" in arrays:
         nodes = arrays["row.learner.feature"].shape[1]
         _range("row.learner.feature", arrays["row.learner.feature"], 0, FIXED["F"] - 1)

@@ -107,7 +107,10 @@ def mutate(document: dict, draw: Callable, most: int = 3) -> dict:
             container[key] = draw(junk)
         elif operation == "nudge" and isinstance(value, int | float) and not isinstance(value, bool):
             factor = draw(st.floats(0.5, 1.5))
-            container[key] = value * factor if math.isfinite(value) and value else factor - 1.0
+            try:
+                container[key] = value * factor if math.isfinite(value) and value else factor - 1.0
+            except OverflowError:  # an integer beyond floats (a junk value put there before): kept
+                pass
         elif operation == "delete":
             container.pop(key)
         elif operation == "unknown" and isinstance(container, dict):

@@ -8,13 +8,22 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
+from hlp_drake.errors import HlpError
+
 
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
-    """Yield a temporary path beside ``path``; on success move it into place, on error delete it."""
+    """Yield a temporary path beside ``path``; on success move it into place, on error delete it.
+
+    Raises:
+        HlpError: ``path``'s folder cannot be made or written, or ``path`` cannot be replaced.
+    """
     target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    except OSError as error:
+        raise HlpError(f"{target}: cannot write: {_reason(error)}") from None
     os.close(fd)
     tmp = Path(tmp_name)
     try:
@@ -22,9 +31,19 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes files private; give them the usual mode
-        os.replace(tmp, target)
+        try:
+            os.replace(tmp, target)
+        except OSError as error:
+            raise HlpError(f"{target}: cannot write: {_reason(error)}") from None
     finally:
         tmp.unlink(missing_ok=True)
+
+
+def _reason(error: OSError) -> str:
+    """``error`` in a few words, naming the path it is about (e.g. a parent that is a file)."""
+    if isinstance(error, FileExistsError | NotADirectoryError):
+        return f"{error.filename} is not a directory"
+    return f"{error.strerror or error} ({error.filename})" if error.filename else str(error.strerror or error)
 
 
 def write_text_atomic(path: str | os.PathLike[str], text: str) -> None:

@@ -47,6 +47,28 @@ def make_parser(prog: str, doc: str | None, **kwargs) -> Parser:
     return parser
 
 
+MAX_SEED = 2**32 - 1
+"""Largest seed (numpy's seeds are non-negative)."""
+MAX_WORKERS = 64
+"""Most worker processes a command starts."""
+
+
+def integer(low: int, high: int) -> Callable[[str], int]:
+    """An argparse ``type``: an integer in [low, high] (else a one-line usage error)."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text[:40]!r}") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"must be between {low} and {high}, got {text[:40]}")
+        return value
+
+    parse.__name__ = "integer"
+    return parse
+
+
 def add_quiet(parser: argparse.ArgumentParser) -> None:
     """``--quiet``: no progress bars (they are shown by default, on stderr)."""
     parser.add_argument("--quiet", action="store_true", help="no progress bars")

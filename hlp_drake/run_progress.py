@@ -42,7 +42,8 @@ class ProgressListener:
         if not self._quiet:
             self._bar = tqdm(file=self._stream, dynamic_ncols=True, leave=False, **kwargs)
 
-    def _close(self) -> None:
+    def close(self) -> None:
+        """Take the open bar (if any) off the screen, e.g. when the run stops early."""
         if self._bar is not None:
             self._bar.close()
             self._bar = None
@@ -78,7 +79,7 @@ class ProgressListener:
             self._bar.update()
 
     def optimised(self, result) -> None:
-        self._close()
+        self.close()
         self._optimising = False
         verdict = "success" if result.success else f"no success ({result.failure_reason})"
         self._line(
@@ -103,8 +104,8 @@ class ProgressListener:
             self._bar.update(round(t - self._shown, 1))
             self._shown += round(t - self._shown, 1)
         if self._bar is not None and t >= self._bar.total - 1e-9:
-            self._close()
+            self.close()
 
     def finished(self, result) -> None:
-        self._close()
+        self.close()
         self._line(f"execute: {result.simulated_s:.1f} s simulated in {result.timings['execute_s']:.1f} s")

@@ -14,16 +14,27 @@ Exit status: 0 on success, 1 when the run failed (the reason is printed), 2 on b
 
 from __future__ import annotations
 
+import contextlib
 import json
+import os
 import sys
 import time
 from collections.abc import Sequence
 from dataclasses import replace
 
 from hlp_drake.atomic import write_text_atomic
-from hlp_drake.cli import add_conditions, add_perception, add_quiet, make_parser, run_cli
-from hlp_drake.errors import HlpError
-from hlp_drake.scene.generators import KINDS, generate_scene
+from hlp_drake.cli import (
+    MAX_SEED,
+    MAX_WORKERS,
+    add_conditions,
+    add_perception,
+    add_quiet,
+    integer,
+    make_parser,
+    run_cli,
+)
+from hlp_drake.errors import InstallError
+from hlp_drake.scene.generators import KINDS, MAX_GENERATED, generate_scene
 from hlp_drake.scene.io import DEFAULT_SCENE_FILE, load_scene
 
 DEFAULT_SCENE = DEFAULT_SCENE_FILE
@@ -68,8 +79,15 @@ def _parser():
         "--scene", metavar="FILE", help="a scene file (YAML or JSON); default: the bundled default scene"
     )
     source.add_argument("--kind", choices=KINDS, help="generate a scene of this kind (with --seed)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the generated scene (default 0)")
-    parser.add_argument("--objects", type=int, metavar="K", help="number of obstacles (gen2, unstructured)")
+    parser.add_argument(
+        "--seed", type=integer(0, MAX_SEED), default=0, help="seed of the generated scene (default 0)"
+    )
+    parser.add_argument(
+        "--objects",
+        type=integer(1, MAX_GENERATED),
+        metavar="K",
+        help="number of obstacles (gen2, unstructured)",
+    )
     parser.add_argument(
         "--planner",
         choices=("hlp", "sto"),
@@ -83,7 +101,10 @@ def _parser():
         help="scenario settings (see hlp_drake.systems.Scenario); --scene or --kind replace its scene",
     )
     parser.add_argument(
-        "--workers", type=int, metavar="N", help="rollout processes (default: the scenario's, 2)"
+        "--workers",
+        type=integer(1, MAX_WORKERS),
+        metavar="N",
+        help="rollout processes (default: the scenario's, 2)",
     )
     parser.add_argument(
         "--meshcat", action="store_true", help="show the run live in MeshCat (prints the URL)"
@@ -99,8 +120,6 @@ def _parser():
 def main(argv: Sequence[str] | None = None) -> int:
     started = time.perf_counter()
     args = _parser().parse_args(argv)
-    if args.workers is not None and args.workers < 1:
-        raise HlpError(f"--workers must be >= 1, got {args.workers}")
     scene = None
     if args.kind is not None:
         scene = generate_scene(args.kind, args.seed, args.objects)
@@ -147,24 +166,41 @@ def _print(line: str) -> None:
     print(line, flush=True)
 
 
+def _meshcat():
+    """A MeshCat server on localhost.
+
+    Raises:
+        InstallError: Drake's network policy (``DRAKE_ALLOW_NETWORK``) refuses MeshCat, or the
+            server cannot start.
+    """
+    from pydrake.geometry import Meshcat, MeshcatParams
+
+    try:
+        return Meshcat(MeshcatParams(host="localhost"))
+    except RuntimeError as error:
+        policy = os.environ.get("DRAKE_ALLOW_NETWORK")
+        if policy is not None and "meshcat" not in policy.split(":"):
+            raise InstallError(
+                f"--meshcat and --html need MeshCat, which DRAKE_ALLOW_NETWORK={policy} refuses; "
+                "allow it with DRAKE_ALLOW_NETWORK=meshcat (or unset the variable)"
+            ) from None
+        raise InstallError(f"cannot start MeshCat: {' '.join(str(error).split())}") from None
+
+
 def _run(scenario, args, started: float):
     """Plan and execute ``scenario`` on a rollout pool of its own, the stages printed as they come."""
     from hlp_drake.run_progress import ProgressListener
     from hlp_drake.systems.execution import plan_and_execute
     from hlp_drake.systems.rollout_pool import RolloutPool
 
-    meshcat = None
-    if args.meshcat or args.html:
-        from pydrake.geometry import Meshcat, MeshcatParams
-
-        meshcat = Meshcat(MeshcatParams(host="localhost"))
-        if args.meshcat:
-            _print(f"MeshCat: {meshcat.web_url()}")
+    meshcat = _meshcat() if args.meshcat or args.html else None
+    if args.meshcat:
+        _print(f"MeshCat: {meshcat.web_url()}")
     listener = ProgressListener(quiet=args.quiet, stream=sys.stderr)
     workers = scenario.optimiser.workers
     if workers > 1:
         _print(f"starting {workers} rollout workers ...")
-    with RolloutPool(workers, on_rollout=listener.rollout) as pool:
+    with contextlib.closing(listener), RolloutPool(workers, on_rollout=listener.rollout) as pool:
         if workers > 1:
             _print(f"rollout workers ready ({pool.startup_s:.1f} s)")
         result = plan_and_execute(

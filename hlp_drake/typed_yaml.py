@@ -8,9 +8,12 @@ for tuples, ``str`` for ``Literal``) and frozen again.
 
 Before that, the document is checked against the schema and every problem is reported at its
 place, one line each (``obstacles[0].size: expected a list of 3 numbers, got [1, 2]``), which
-Drake's loader cannot do. A schema with a field without a default (a scene, an object) is read
-whole: such a mapping must give every required field and does not merge into a default. A
-schema whose every field has a default merges into the defaults: a file gives only what it changes.
+Drake's loader cannot do: types, finite numbers (at most ``MAX_FLOAT``), 64-bit integers. A
+schema with a field without a default (a scene, an object) is read whole: such a mapping must give
+every required field and does not merge into a default. A schema whose every field has a default
+merges into the defaults: a file gives only what it changes. A whole schema without Drake structs
+(a scene) is then built directly from the checked document, the rest by Drake's loader. Documents
+come from ``hlp_drake.documents`` (``parse_yaml``: limits on size, depth, aliases, duplicate keys).
 
 Drake's YAML module is imported on the first load or dump only (it costs ~0.3 s), so the Drake-free
 half of the package stays quick to import.
@@ -26,15 +29,19 @@ from typing import Any, Literal, TypeVar
 
 import yaml
 
+from hlp_drake.documents import brief
 from hlp_drake.errors import HlpError
 
 T = TypeVar("T")
 NoneType = type(None)
+MAX_FLOAT = 1e300
+"""Largest magnitude of a number in a document (inf, nan and integers beyond it are refused)."""
 
 
 # --- Schema types -------------------------------------------------------------------------------
 
 
+@functools.cache
 def _hints(schema: type) -> dict[str, Any]:
     """A schema's field types, with string annotations resolved."""
     return typing.get_type_hints(schema)
@@ -48,6 +55,7 @@ def _is_drake_struct(kind: Any) -> bool:
     return isinstance(kind, type) and hasattr(kind, "__fields__") and not _is_schema(kind)
 
 
+@functools.cache
 def _optional(kind: Any) -> Any:
     """``X`` for ``X | None``, else None."""
     if typing.get_origin(kind) in (typing.Union, types.UnionType):
@@ -57,6 +65,7 @@ def _optional(kind: Any) -> Any:
     return None
 
 
+@functools.cache
 def _required(schema: type) -> list[str]:
     """The fields of ``schema`` that have no default."""
     return [
@@ -71,6 +80,7 @@ def _whole(schema: type) -> bool:
     return bool(_required(schema))
 
 
+@functools.cache
 def _tuple_items(kind: Any) -> tuple[Any, int | None] | None:
     """(item type, fixed length or None) of a tuple type, else None."""
     if typing.get_origin(kind) is not tuple:
@@ -144,11 +154,16 @@ def _freeze(schema: Any, value: Any) -> Any:
 # --- Located problems -------------------------------------------------------------------------------
 
 
+MAX_INT = 2**63 - 1
+"""Largest integer a document may give (Drake reads 64-bit integers)."""
+
+
 def _scalar_problem(kind: Any, value: Any) -> str | None:
     """Why ``value`` cannot be read as the scalar type ``kind`` (None if it can)."""
     if typing.get_origin(kind) is Literal:
         choices = typing.get_args(kind)
-        return None if value in choices else f"expected one of {', '.join(map(str, choices))}, got {value!r}"
+        ok = isinstance(value, str) and value in choices
+        return None if ok else f"expected one of {', '.join(map(str, choices))}, got {brief(value)}"
     expected = {float: "a number", int: "an integer", bool: "true or false", str: "text"}.get(kind)
     if expected is None:
         return None
@@ -158,7 +173,13 @@ def _scalar_problem(kind: Any, value: Any) -> str | None:
         bool: isinstance(value, bool),
         str: isinstance(value, str),
     }[kind]
-    return None if ok else f"expected {expected}, got {value!r}"
+    if not ok:
+        return f"expected {expected}, got {brief(value)}"
+    if kind is int and abs(value) > MAX_INT:
+        return f"expected an integer of at most 64 bits, got {brief(value)}"
+    if kind is float and not (abs(value) <= MAX_FLOAT):  # also refuses nan
+        return f"expected a finite number, got {brief(value)}"
+    return None
 
 
 def _join(where: str, name: str) -> str:
@@ -183,7 +204,7 @@ def document_problems(schema: Any, value: Any, where: str = "", *, top: str = "d
             count = "a list" if length is None else f"a list of {length} {noun}"
             if isinstance(value, list | dict) and length is None:
                 return [f"{label}: expected a list, got {type(value).__name__}"]
-            return [f"{label}: expected {count}, got {value!r}"]
+            return [f"{label}: expected {count}, got {brief(value)}"]
         return [p for i, v in enumerate(value) for p in document_problems(item, v, f"{label}[{i}]", top=top)]
     if _is_schema(schema) or _is_drake_struct(schema):
         if not isinstance(value, dict):
@@ -205,16 +226,33 @@ def document_problems(schema: Any, value: Any, where: str = "", *, top: str = "d
 # --- Loading and dumping -------------------------------------------------------------------------------
 
 
-def parse_yaml(text: str, where: str, error: type[HlpError] = HlpError) -> Any:
-    """The document in ``text``; a syntax error is one line naming ``where``, the line and the column."""
-    try:
-        return yaml.safe_load(text)
-    except yaml.YAMLError as problem:
-        mark = getattr(problem, "problem_mark", None)
-        at = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
-        raise error(
-            f"{where}: not valid YAML{at}: {getattr(problem, 'problem', None) or 'syntax error'}"
-        ) from None
+@functools.cache
+def _plain(kind: Any) -> bool:
+    """Whether values of ``kind`` hold no Drake struct (so they are built without Drake's loader)."""
+    inner = _optional(kind)
+    if inner is not None:
+        return _plain(inner)
+    items = _tuple_items(kind)
+    if items is not None:
+        return _plain(items[0])
+    if _is_schema(kind):
+        return all(_plain(hint) for hint in _hints(kind).values())
+    return not _is_drake_struct(kind)
+
+
+def _build(kind: Any, value: Any) -> Any:
+    """The checked document ``value`` as an instance of the plain type ``kind`` (fields it does not
+    give take their defaults, as Drake's loader fills them)."""
+    inner = _optional(kind)
+    if inner is not None:
+        return None if value is None else _build(inner, value)
+    items = _tuple_items(kind)
+    if items is not None:
+        return tuple(_build(items[0], v) for v in value)
+    if _is_schema(kind):
+        hints = _hints(kind)
+        return kind(**{name: _build(hints[name], v) for name, v in value.items()})
+    return float(value) if kind is float else value
 
 
 def _clear_whole(schema: type, base: Any, document: Any) -> None:
@@ -247,21 +285,32 @@ def load_typed(
     Raises:
         error: the document does not fit the schema.
     """
-    from pydrake.common.yaml import yaml_load_typed
-
     if document is None and defaults is not None:
         return defaults
     prefix = f"{where}: " if where else ""
     problems = document_problems(schema, document, top=top)
     if problems:
         raise error(*(prefix + p for p in problems))
+    if defaults is None and _plain(schema):
+        return _build(schema, document)
+    # Whole plain fields (a scenario's scene) are built directly: Drake's loader would take ~1 s
+    # per thousand objects to read what is already checked.
+    from pydrake.common.yaml import yaml_load_typed
+
+    hints = _hints(schema)
+    direct = {
+        name: _build(hints[name], sub)
+        for name, sub in (document or {}).items()
+        if _is_schema(hints[name]) and _whole(hints[name]) and _plain(hints[name])
+    }
+    document = {name: sub for name, sub in (document or {}).items() if name not in direct}
     base = _thaw(defaults) if defaults is not None else _thawed(schema)()
     _clear_whole(schema, base, document)
     try:
         loaded = yaml_load_typed(schema=_thawed(schema), data=yaml.safe_dump(document), defaults=base)
     except (RuntimeError, ValueError, TypeError, KeyError, AssertionError) as problem:
         raise error(prefix + " ".join(str(problem).split())) from None
-    return _freeze(schema, loaded)
+    return dataclasses.replace(_freeze(schema, loaded), **direct)
 
 
 def dump_typed(value: Any) -> str:

@@ -10,6 +10,7 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
 import hlp_drake.models
+from hlp_drake.errors import InstallError, short
 
 MODELS_PACKAGE = "hlp_drake_models"
 
@@ -19,11 +20,33 @@ def models_directory() -> Path:
     return Path(hlp_drake.models.__file__).resolve().parent
 
 
+REINSTALL = (
+    "reinstall hlp_drake (pip install --force-reinstall --no-deps hlp_drake; in a clone: git checkout models)"
+)
+"""The hint of a damaged or missing model package."""
+
+
+def drake_reason(error: Exception) -> str:
+    """The first line of a Drake error, short (its parse errors run over many lines)."""
+    lines = [line.strip() for line in str(error).splitlines() if line.strip()]
+    return short(lines[0] if lines else type(error).__name__, 160)
+
+
 def configure_parser(parser: Parser) -> Parser:
-    """Register the project's model package with ``parser``'s package map and return the parser."""
+    """Register the project's model package with ``parser``'s package map and return the parser.
+
+    Raises:
+        InstallError: the package's ``package.xml`` is missing or cannot be read.
+    """
     package_map = parser.package_map()
     if not package_map.Contains(MODELS_PACKAGE):
-        package_map.AddPackageXml(str(models_directory() / "package.xml"))
+        xml = models_directory() / "package.xml"
+        try:
+            package_map.AddPackageXml(str(xml))
+        except RuntimeError as error:
+            raise InstallError(
+                f"{xml}: the model package is missing or damaged ({drake_reason(error)}); {REINSTALL}"
+            ) from None
     return parser
 
 

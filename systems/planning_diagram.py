@@ -33,13 +33,15 @@ if TYPE_CHECKING:
 
 
 @cache
-def _models_in(directory: str) -> DecisionModels:
-    return DecisionModels.load(Path(directory))
+def _models_in(directory: str, sha256: str) -> DecisionModels:
+    return DecisionModels.load(Path(directory), sha256=sha256 or None)
 
 
 def scenario_models(scenario: Scenario) -> DecisionModels:
-    """The decision models ``scenario.planner.models`` names (the bundled ones for ""), loaded once."""
-    return _models_in(scenario.planner.models) if scenario.planner.models else default_models()
+    """The decision models ``scenario.planner.models`` names (the bundled ones for ""), loaded once,
+    pinned to ``scenario.planner.models_sha256`` where it is given."""
+    settings = scenario.planner
+    return _models_in(settings.models, settings.models_sha256) if settings.models else default_models()
 
 
 def make_planning_diagram(

@@ -29,7 +29,14 @@ from pydrake.multibody.plant import DiscreteContactSolver, MultibodyPlant
 from pydrake.multibody.tree import Joint, ModelInstanceIndex
 from pydrake.systems.framework import Context
 
-from hlp_drake.systems.model_package import MODELS_PACKAGE, configure_parser, new_parser
+from hlp_drake.errors import InstallError
+from hlp_drake.systems.model_package import (
+    MODELS_PACKAGE,
+    REINSTALL,
+    configure_parser,
+    drake_reason,
+    new_parser,
+)
 
 ROBOT_URL = f"package://{MODELS_PACKAGE}/robot/mobile_ur5.urdf"
 ROBOT_MODEL_NAME = "mobile_ur5"
@@ -102,6 +109,7 @@ def add_robot(
     Raises:
         ValueError: ``name`` is taken, ``parser`` belongs to another plant, or the plant is discrete
             without the SAP solver.
+        InstallError: the robot's model file or its package is missing or cannot be parsed.
     """
     if plant.time_step() > 0 and plant.get_discrete_contact_solver() != DiscreteContactSolver.kSap:
         raise ValueError(
@@ -120,6 +128,10 @@ def add_robot(
     parser.SetAutoRenaming(True)  # the file's name may be taken by another robot
     try:
         (instance,) = parser.AddModels(url=ROBOT_URL)
+    except RuntimeError as error:  # a damaged installation: one line and a hint, exit 2 on the command line
+        raise InstallError(
+            f"{ROBOT_URL}: the robot model cannot be parsed ({drake_reason(error)}); {REINSTALL}"
+        ) from None
     finally:
         parser.SetAutoRenaming(auto_renaming)
     if plant.GetModelInstanceName(instance) != name:

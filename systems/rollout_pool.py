@@ -16,6 +16,7 @@ from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 from typing import TYPE_CHECKING, Self
 
+from hlp_drake.processes import interrupts_held, terminate_workers, worker_pool
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.rollout_cost import RolloutOutcome
 
@@ -94,11 +95,16 @@ class RolloutPool:
         self._executor: ProcessPoolExecutor | None = None
         if self.workers > 1:
             started = time.perf_counter()
-            self._executor = ProcessPoolExecutor(
-                self.workers, mp_context=multiprocessing.get_context("spawn")
-            )
-            # Start every worker (and import Drake there) now, not inside the first optimisation.
-            list(self._executor.map(_warm_up, [0.2] * self.workers))
+            self._executor = worker_pool(self.workers)  # workers leave Ctrl-C to this process
+            try:
+                # Start every worker (and import Drake there) now, not inside the first optimisation.
+                with interrupts_held():
+                    warming = [self._executor.submit(_warm_up, 0.2) for _ in range(self.workers)]
+                for future in warming:
+                    future.result()
+            except BaseException:
+                self.close(terminate=True)
+                raise
             self.startup_s = time.perf_counter() - started
 
     def world(self, scenario: Scenario) -> SceneRollouts:
@@ -131,15 +137,18 @@ class RolloutPool:
             self._on_rollout(outcome)
         return outcome
 
-    def close(self) -> None:
-        """Stop the worker processes and drop the worlds."""
+    def close(self, *, terminate: bool = False) -> None:
+        """Stop the worker processes (at once with ``terminate``, else after their rollouts) and
+        drop the worlds."""
         self._worlds.clear()
         if self._executor is not None:
+            if terminate:
+                terminate_workers(self._executor)
             self._executor.shutdown(cancel_futures=True)
             self._executor = None
 
     def __enter__(self) -> Self:
         return self
 
-    def __exit__(self, *exc) -> None:
-        self.close()
+    def __exit__(self, kind, error, traceback) -> None:
+        self.close(terminate=kind is not None and issubclass(kind, KeyboardInterrupt))

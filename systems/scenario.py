@@ -28,6 +28,7 @@ from typing import Literal
 
 from pydrake.multibody.plant import MultibodyPlantConfig
 
+from hlp_drake.documents import parse_yaml, read_document
 from hlp_drake.errors import HlpError
 from hlp_drake.planner.config import PlannerConfig
 from hlp_drake.scene.io import default_scene
@@ -47,7 +48,7 @@ from hlp_drake.systems.world_settings import (
     MotionConfig,
     default_plant_config,
 )
-from hlp_drake.typed_yaml import dump_typed, load_typed, parse_yaml
+from hlp_drake.typed_yaml import dump_typed, load_typed
 
 PLANNERS = ("hlp", "sto")
 
@@ -61,11 +62,15 @@ class PlannerSettings:
             optimiser and its settings are the same for both.
         models: a directory of trained decision models (``python -m hlp_drake.train --out DIR``);
             "" for the bundled ones.
+        models_sha256: the SHA-256 of the trusted ``models.json`` in ``models``
+            (``sha256sum models.json``); "" trusts whatever is there (the bundled models are
+            always pinned).
         hlp: the human-like planner's settings.
     """
 
     kind: Literal["hlp", "sto"] = "hlp"
     models: str = ""
+    models_sha256: str = ""
     hlp: PlannerConfig = field(default_factory=PlannerConfig)
 
 
@@ -143,12 +148,7 @@ def load_scenario(
     scenario = Scenario() if defaults is None else defaults
     sources: list[tuple[str, str]] = []
     if filename is not None:
-        try:
-            sources.append((str(filename), Path(filename).read_text(encoding="utf-8")))
-        except FileNotFoundError:
-            raise HlpError(f"{filename}: scenario file not found") from None
-        except (OSError, UnicodeDecodeError) as error:
-            raise HlpError(f"{filename}: cannot read the scenario: {' '.join(str(error).split())}") from None
+        sources.append((str(filename), read_document(filename, missing="scenario file not found")))
     if data is not None:
         sources.append((where or "overrides", data))
     for name, text in sources:

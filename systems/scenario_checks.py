@@ -5,12 +5,20 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
+from hlp_drake.planner.config import planner_config_problems
+from hlp_drake.scene.generators import MAX_SEED
 from hlp_drake.systems.optimiser_config import StoCost
 from hlp_drake.systems.transfer_geometry import TransferConfig
 
 if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
 
+MAX_SETTING = 1e9
+"""Largest value of any number in the settings (a stiffness of 1e6 N/m is typical)."""
+MAX_TIME_STEP = 0.1
+"""s: the largest plant and rollout time step."""
+MAX_WORKERS = 64
+"""Most rollout processes."""
 SAP_APPROXIMATIONS = ("sap", "lagged", "similar")
 """Discrete contact approximations solved by SAP (TAMSI, "tamsi", cannot simulate the mimic finger)."""
 CONTACT_MODELS = ("point", "hydroelastic", "hydroelastic_with_fallback")
@@ -19,14 +27,20 @@ CONTACT_MODELS = ("point", "hydroelastic", "hydroelastic_with_fallback")
 def scenario_problems(scenario: Scenario) -> list[str]:
     """The reasons ``scenario``'s settings cannot be used (empty when they are fine; the scene is
     validated on its own, by ``validate_scene``)."""
-    problems: list[str] = []
+    problems: list[str] = [f"planner.hlp.{p}" for p in planner_config_problems(scenario.planner.hlp)]
 
-    def positive(where: str, value: float, *, zero_ok: bool = False) -> None:
+    def positive(where: str, value: float, *, zero_ok: bool = False, upper: float = MAX_SETTING) -> None:
         if not math.isfinite(value) or value < 0 or (value == 0 and not zero_ok):
             problems.append(f"{where} must be {'>= 0' if zero_ok else '> 0'}, got {value}")
+        elif value > upper:
+            problems.append(f"{where} must be <= {upper:g}, got {value:g}")
+
+    def count(where: str, value: int, low: int, high: int) -> None:
+        if not low <= value <= high:
+            problems.append(f"{where} must be between {low} and {high}, got {value}")
 
     plant = scenario.plant
-    positive("plant.time_step", plant.time_step)
+    positive("plant.time_step", plant.time_step, upper=MAX_TIME_STEP)
     if plant.discrete_contact_approximation not in SAP_APPROXIMATIONS:
         problems.append(
             f"plant.discrete_contact_approximation must be one of {', '.join(SAP_APPROXIMATIONS)} "
@@ -41,8 +55,8 @@ def scenario_problems(scenario: Scenario) -> list[str]:
     positive("contact.hunt_crossley_dissipation", contact.hunt_crossley_dissipation, zero_ok=True)
     positive("contact.relaxation_time", contact.relaxation_time, zero_ok=True)
     positive("contact.corner_sphere_radius", contact.corner_sphere_radius, zero_ok=True)
-    if contact.rim_spheres < 0 or contact.rim_spheres == 1 or contact.rim_spheres == 2:
-        problems.append(f"contact.rim_spheres must be 0 or >= 3, got {contact.rim_spheres}")
+    if contact.rim_spheres < 0 or contact.rim_spheres in (1, 2) or contact.rim_spheres > 64:
+        problems.append(f"contact.rim_spheres must be 0 or between 3 and 64, got {contact.rim_spheres}")
     for name in ("table_friction", "object_friction", "gripper_friction"):
         positive(f"contact.{name}", getattr(contact, name))
     bodies = scenario.bodies
@@ -70,21 +84,20 @@ def scenario_problems(scenario: Scenario) -> list[str]:
         positive(f"ik.{name}", getattr(ik, name))
     for name in ("table_clearance", "base_under_table", "base_lateral_margin", "start_base_clearance"):
         positive(f"ik.{name}", getattr(ik, name), zero_ok=True)
-    if ik.max_iterations < 1 or ik.attempts < 1:
-        problems.append(
-            f"ik.max_iterations and ik.attempts must be >= 1, got {ik.max_iterations}, {ik.attempts}"
-        )
+    count("ik.max_iterations", ik.max_iterations, 1, 100_000)
+    count("ik.attempts", ik.attempts, 1, 1000)
     positive("motion.tcp_speed", scenario.motion.tcp_speed)
     positive("motion.transit_speed", scenario.motion.transit_speed)
     positive("motion.joint_speed_fraction", scenario.motion.joint_speed_fraction)
     positive("motion.min_segment_duration", scenario.motion.min_segment_duration)
     sto, grasp = scenario.optimiser, scenario.grasp
-    for name in ("samples", "max_iterations", "max_rollouts", "workers"):
-        if int(getattr(sto, name)) < 1:
-            problems.append(f"optimiser.{name} must be >= 1, got {getattr(sto, name)}")
-    for name in ("alternatives", "max_verifications"):
-        if int(getattr(sto, name)) < 0:
-            problems.append(f"optimiser.{name} must be >= 0, got {getattr(sto, name)}")
+    count("optimiser.samples", sto.samples, 1, 1000)
+    count("optimiser.max_iterations", sto.max_iterations, 1, 10_000)
+    count("optimiser.max_rollouts", sto.max_rollouts, 1, 1_000_000)
+    count("optimiser.workers", sto.workers, 1, MAX_WORKERS)
+    count("optimiser.alternatives", sto.alternatives, 0, 100)
+    count("optimiser.max_verifications", sto.max_verifications, 0, 1000)
+    count("optimiser.seed", sto.seed, 0, MAX_SEED)
     rim = sto.rollout_trims.rim_spheres
     if rim < 0 or rim in (1, 2):
         problems.append(f"optimiser.rollout_trims.rim_spheres must be 0 or >= 3, got {rim}")
@@ -92,12 +105,12 @@ def scenario_problems(scenario: Scenario) -> list[str]:
     for name in (
         "step_duration",
         "mppi_temperature",
-        "rollout_time_step",
         "sample_period",
         "max_object_speed",
         "max_sink",
     ):
         positive(f"optimiser.{name}", getattr(sto, name))
+    positive("optimiser.rollout_time_step", sto.rollout_time_step, upper=MAX_TIME_STEP)
     positive("optimiser.settle_s", sto.settle_s, zero_ok=True)
     positive("optimiser.weld_clearance", sto.weld_clearance)
     positive("optimiser.weld_lookahead", sto.weld_lookahead, zero_ok=True)

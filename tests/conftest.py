@@ -81,7 +81,9 @@ def unstructured(dataset):
     from hlp_drake.dataset import UNSTRUCTURED
 
     if not dataset.select(category=UNSTRUCTURED):
-        missing(f"no unstructured trials in the dataset (place hlp-vr-unstructured-part1.tar.xz in {DEFAULT_DATA})")
+        missing(
+            f"no unstructured trials in the dataset (place hlp-vr-unstructured-part1.tar.xz in {DEFAULT_DATA})"
+        )
     return dataset
 
 
@@ -109,3 +111,11 @@ def paper_models(dataset):
 
     demonstrations = segment_dataset(dataset, mode="fixed").demonstrations
     return DecisionModels(PRESETS["paper"]).fit(training_data(demonstrations, mode="fixed"))
+
+
+def pytest_terminal_summary(terminalreporter) -> None:
+    """What the fuzz suite's checks saw (``fuzz_support.STATS``), when any fuzz test ran."""
+    stats = sys.modules.get("fuzz_support")
+    if stats is not None and stats.STATS:
+        counts = ", ".join(f"{name} {count}" for name, count in sorted(stats.STATS.items()))
+        terminalreporter.write_line(f"fuzz: {counts}")

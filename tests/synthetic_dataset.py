@@ -76,7 +76,7 @@ def write_dataset(root: Path, trials: dict[int, str] | None = None) -> Path:
     root.mkdir(parents=True, exist_ok=True)
     (root / "participant_list.csv").write_text("ppid,handedness,gender,age\nsub_01,right,female,44\n")
     rows = [
-        f"basic/ICRA01/S001,basic,ICRA01,1,{n},1,{n},100.0,101.0,main,,100.5,100.9,{outcome}"
+        f"basic/ICRA01/S001,basic,ICRA01,1,{n},1,{n},100.0,100.0556,main,,100.0222,100.0444,{outcome}"
         for n, outcome in trials.items()
     ]
     (root / "sub_01").mkdir()

@@ -79,6 +79,31 @@ def test_damaged_cache_is_rebuilt(folder, tmp_path):
     assert len(rebuilt.trial("sub_01/T010").trackers["hand"]) == 6
 
 
+@pytest.mark.parametrize(
+    "edit",
+    [
+        lambda trials: [t for t in trials if t["trial"] != 10],  # a trial removed
+        lambda trials: [*trials, trials[0]],  # a trial repeated
+        lambda trials: [{}],
+        lambda trials: 5,
+    ],
+    ids=["removed", "repeated", "[{}]", "5"],
+)
+def test_an_edited_cache_index_is_rebuilt_even_with_its_digest_updated(folder, tmp_path, edit):
+    import hashlib
+    import json
+
+    ds = load(folder, tmp_path)
+    index_path = ds.cache_path / "index.json"
+    index = json.loads(index_path.read_text())
+    index["trials"] = edit(index["trials"])
+    text = json.dumps(index)
+    index_path.write_text(text)
+    (ds.cache_path / "index.sha256").write_text(hashlib.sha256(text.encode()).hexdigest())
+    rebuilt = load(folder, tmp_path)
+    assert rebuilt.cache_status == "built" and [r.key for r in rebuilt.records] == [r.key for r in ds.records]
+
+
 def test_truncated_movement_file_is_reported_by_path_and_only_its_trial_dropped(folder, tmp_path):
     path = folder / "sub_01" / "T010" / "movement" / "ElbowTracker_movement_T010.csv"
     path.write_text(path.read_text()[:-12])  # cut the last line in the middle
@@ -112,15 +137,16 @@ def test_unreadable_and_non_numeric_files_are_reported(folder, tmp_path):
     assert [r.key for r in ds.records] == ["sub_01/T005"]
 
 
-def test_nan_samples_are_kept_as_nan(folder, tmp_path):
+def test_a_nan_sample_leaves_its_trial_out_with_the_file_and_line(folder, tmp_path):
     path = folder / "sub_01" / "T010" / "movement" / "HandTracker_movement_T010.csv"
     lines = path.read_text().splitlines()
     fields = lines[3].split(",")
     fields[1] = "NaN"
     lines[3] = ",".join(fields)
     path.write_text("\n".join(lines) + "\n")
-    hand = load(folder, tmp_path).trial("sub_01/T010").trackers["hand"]
-    assert np.isnan(hand.position[2, 1]) and not np.isnan(hand.position[1, 1])
+    ds = load(folder, tmp_path)
+    assert "sub_01/T010" not in ds and "sub_01/T005" in ds
+    assert ds.problems == [{"path": str(path), "reason": "line 4: non-finite value"}]
 
 
 def test_overlapping_objects_in_a_layout_reject_the_trial(folder, tmp_path):
@@ -150,8 +176,14 @@ def test_bad_paths_raise_one_clear_error(tmp_path, monkeypatch):
 
 
 def test_summary_cli_missing_dataset_is_one_line(tmp_path):
-    result = run_module("hlp_drake.dataset", "summary", "--dataset", str(tmp_path / "nope"), "--json",
-                        str(tmp_path / "out.json"))
+    result = run_module(
+        "hlp_drake.dataset",
+        "summary",
+        "--dataset",
+        str(tmp_path / "nope"),
+        "--json",
+        str(tmp_path / "out.json"),
+    )
     assert result.returncode == 2
     assert result.stderr.count("\n") == 1 and result.stderr.startswith("error: ")
     assert "Traceback" not in result.stderr
@@ -161,8 +193,15 @@ def test_summary_cli_missing_dataset_is_one_line(tmp_path):
 def test_summary_cli_reports_problems_and_counts(folder, tmp_path):
     (folder / "sub_01" / "T011" / "movement" / "Target_movement_T011.csv").unlink()
     out = tmp_path / "summary.json"
-    result = run_module("hlp_drake.dataset", "summary", "--dataset", str(folder), "--json", str(out),
-                        env={"HLP_CACHE": str(tmp_path / "cache")})
+    result = run_module(
+        "hlp_drake.dataset",
+        "summary",
+        "--dataset",
+        str(folder),
+        "--json",
+        str(out),
+        env={"HLP_CACHE": str(tmp_path / "cache")},
+    )
     assert result.returncode == 0, result.stderr
     assert "warning:" in result.stderr and "Target_movement_T011.csv" in result.stderr
     import json

@@ -27,7 +27,7 @@ from hlp_drake.planner.human_arm import sweep_collision
 from hlp_drake.planner.plan import PlanKeypoint
 from hlp_drake.planner.rollout import PrefixTree
 from hlp_drake.scene.generators import generate_scene
-from hlp_drake.scene.geometry import footprint, overlapping_bounds
+from hlp_drake.scene.geometry import footprint
 from hlp_drake.scene.validation import AREA_TOLERANCE, scene_problems
 from hlp_drake.taskspace import DIRECTIONS, Rect, TaskSpace
 from hlp_drake.taskspace.band import convex_rect_overlap
@@ -39,40 +39,28 @@ def models():
     return default_models()
 
 
-def _pairs_by_hand(boxes: np.ndarray, margin: float) -> list[tuple[int, int]]:
-    g = boxes + np.array([-margin, -margin, margin, margin])
-    n = len(g)
-    return [(i, j) for i in range(n) for j in range(i + 1, n)
-            if g[i, 0] < g[j, 2] and g[j, 0] < g[i, 2] and g[i, 1] < g[j, 3] and g[j, 1] < g[i, 3]]
-
-
-def test_sort_and_sweep_finds_every_overlapping_pair():
-    rng = np.random.default_rng(0)
-    for trial in range(600):
-        n = int(rng.integers(0, 25))
-        low, size = rng.uniform(0, 1, (n, 2)), rng.uniform(0, 0.3, (n, 2))
-        if trial % 3 == 0:  # shared and touching edges, zero sizes
-            low, size = np.round(low, 1), np.round(size, 1)
-        boxes, margin = np.column_stack([low, low + size]), (0.0, 1e-6, 0.05)[trial % 3]
-        assert [tuple(p) for p in overlapping_bounds(boxes, margin).tolist()] == _pairs_by_hand(boxes, margin)
-
-
 def test_validation_rejects_the_same_overlaps_as_checking_every_pair():
     rng = np.random.default_rng(1)
     for seed in range(40):
         scene = generate_scene(("vr", "gen1", "gen2")[seed % 3], seed)
         obstacles = list(scene.obstacles)
         i, j = rng.integers(len(obstacles), size=2)
-        obstacles[i] = replace(obstacles[i], x=obstacles[j].x + rng.normal(0, 0.04), y=obstacles[j].y + rng.normal(0, 0.04),
-                               yaw=float(rng.uniform(0, np.pi)))
+        obstacles[i] = replace(
+            obstacles[i],
+            x=obstacles[j].x + rng.normal(0, 0.04),
+            y=obstacles[j].y + rng.normal(0, 0.04),
+            yaw=float(rng.uniform(0, np.pi)),
+        )
         scene = replace(scene, obstacles=tuple(obstacles))
         objects = [(scene.target, "target")] + [(o, "obstacle") for o in scene.obstacles]
         expected = []
         for k, (a, role_a) in enumerate(objects):
-            for b, role_b in objects[k + 1:]:
+            for b, role_b in objects[k + 1 :]:
                 area = footprint(a).intersection(footprint(b)).area
                 if area > AREA_TOLERANCE:
-                    expected.append(f"{role_a} {a.name!r} and {role_b} {b.name!r} overlap ({area * 1e4:.2f} cm^2)")
+                    expected.append(
+                        f"{role_a} {a.name!r} and {role_b} {b.name!r} overlap ({area * 1e4:.2f} cm^2)"
+                    )
         assert [p for p in scene_problems(scene) if " overlap (" in p] == expected
 
 
@@ -84,7 +72,9 @@ def test_polygon_box_overlap_is_exact_and_exactly_zero_or_full_at_the_extremes()
         triangle = np.vstack([corners, corners[-1:]])  # the sweep's triangles repeat a corner
         expected = shapely.Polygon(corners).intersection(shapely.box(*box[0])).area
         assert convex_rect_overlap(triangle[None], box)[0, 0] == pytest.approx(expected, abs=1e-12)
-    apart = np.array([[[1.2, 0.1], [1.9, 0.8], [1.1, 1.4], [1.1, 1.4]]])  # beside the box's corner, bounding boxes meet
+    apart = np.array(
+        [[[1.2, 0.1], [1.9, 0.8], [1.1, 1.4], [1.1, 1.4]]]
+    )  # beside the box's corner, bounding boxes meet
     assert convex_rect_overlap(apart, box)[0, 0] == 0.0
     around = np.array([[[-0.3, -0.1], [1.7, -0.2], [1.1, 0.9], [-0.2, 0.8]]])
     assert convex_rect_overlap(around, box)[0, 0] == 0.5
@@ -101,13 +91,18 @@ def test_arm_sweep_matches_the_sum_of_its_two_triangles():
         for link in range(3):
             a0, b0, a1, b1 = before[0, link], before[0, link + 1], after[0, link], after[0, link + 1]
             triangles = [shapely.Polygon([a0, b0, b1]), shapely.Polygon([a0, b1, a1])]
-            expected += np.mean([min(sum(t.intersection(o).area for t in triangles) / o.area, 1.0) for o in inflated])
+            expected += np.mean(
+                [min(sum(t.intersection(o).area for t in triangles) / o.area, 1.0) for o in inflated]
+            )
         got = sweep_collision(before, after, occluders, np.ones((1, 2), bool), band=band, faithful=False)[0]
         assert got == pytest.approx(expected, abs=1e-12)
     # A forearm sweeping right across an occluder covers all of it, exactly.
     before = np.array([[[0.0, -0.5], [0.0, -0.4], [0.0, -0.3], [0.9, -0.3]]])
     after = before + np.array([0.0, 0.6])
-    assert sweep_collision(before, after, occluders[:1], np.ones((1, 1), bool), band=band, faithful=False)[0] == 1.0
+    assert (
+        sweep_collision(before, after, occluders[:1], np.ones((1, 1), bool), band=band, faithful=False)[0]
+        == 1.0
+    )
 
 
 @pytest.mark.parametrize("kind", ["vr", "gen2"])
@@ -115,15 +110,19 @@ def test_batched_features_match_the_per_candidate_ones(kind):
     space = TaskSpace(generate_scene(kind, 5))
     table = space.gap_table
     gaps = [g for row in space.gaps for g in row]
-    assert [(g.row, g.index, g.left, g.right) for g in gaps] == list(zip(table.row, table.index, table.left, table.right))
+    assert [(g.row, g.index, g.left, g.right) for g in gaps] == list(
+        zip(table.row, table.index, table.left, table.right)
+    )
     assert [g.center for g in gaps] == [tuple(c) for c in table.centers.tolist()]
     some = np.arange(0, len(gaps), 2)
     assert np.array_equal(gap_features(space, some), gap_features(space)[some])
     some = np.arange(1, len(space.obstacle_names), 2)
     assert np.array_equal(object_features(space, some), object_features(space)[some])
     # All row pairs in one call equal one call per row pair.
-    blocks = [segment_feature_matrix(space, space.nodes(r), space.nodes(r + 1), mode="fixed")
-              for r in range(1, len(space.rows))]
+    blocks = [
+        segment_feature_matrix(space, space.nodes(r), space.nodes(r + 1), mode="fixed")
+        for r in range(1, len(space.rows))
+    ]
     pa, pb, own_a, own_b = [], [], [], []
     for r in range(1, len(space.rows)):
         for a in space.nodes(r):
@@ -152,11 +151,18 @@ def test_direction_table_and_relocation_match_single_obstacles(mode):
 
 def test_nearest_per_row_keeps_the_nearest_of_each_row_in_order():
     rows = np.array([1, 1, 1, 2, 2, 1, 2])
-    centres = np.array([[0.3, 0.4], [0.3, -0.15], [0.3, 0.1], [0.6, 0.0], [0.6, 0.5], [0.3, -0.1], [0.6, -0.2]])
+    centres = np.array(
+        [[0.3, 0.4], [0.3, -0.15], [0.3, 0.1], [0.6, 0.0], [0.6, 0.5], [0.3, -0.1], [0.6, -0.2]]
+    )
     kept = nearest_per_row(rows, centres, np.array([0.0, 0.0]), np.array([1.0, 0.0]), 2)
     assert kept.tolist() == [2, 3, 5, 6]  # row 1: 0.1 and -0.1 (a tie) beat -0.15; row 2: 0.0 and -0.2
-    ties = nearest_per_row(np.array([1, 1, 1]), np.array([[0.3, 0.1], [0.3, -0.1], [0.3, 0.1]]), np.zeros(2),
-                           np.array([1.0, 0.0]), 2)
+    ties = nearest_per_row(
+        np.array([1, 1, 1]),
+        np.array([[0.3, 0.1], [0.3, -0.1], [0.3, 0.1]]),
+        np.zeros(2),
+        np.array([1.0, 0.0]),
+        2,
+    )
     assert ties.tolist() == [0, 1]  # equally near: the first ones
 
 
@@ -187,10 +193,14 @@ def test_direction_votes_count_every_one_vs_one_pair(models):
 
 
 def test_prefix_tree_shares_equal_prefixes():
-    start, gap, move, target = (PlanKeypoint(a, (float(i), 0.0)) for i, a in enumerate(("start", "gap", "move", "target")))
+    start, gap, move, target = (
+        PlanKeypoint(a, (float(i), 0.0)) for i, a in enumerate(("start", "gap", "move", "target"))
+    )
     paths = [[start, gap, target], [start, gap, move, target], [start, move, target]]
     tree = PrefixTree.of(paths)
-    assert len(tree.keypoints) == 7  # start; gap and its target; gap's move and its target; move and its target
+    assert (
+        len(tree.keypoints) == 7
+    )  # start; gap and its target; gap's move and its target; move and its target
     assert [[tree.keypoints[n] for n in [0, *nodes]] for nodes in tree.paths] == paths
     assert all(tree.parent[n] < n for n in range(1, len(tree.parent)))
 
@@ -200,6 +210,12 @@ def test_single_blas_thread_nests_and_restores():
     before = [lib.num_threads for lib in controller.select(user_api="blas").lib_controllers]
     with single_blas_thread():
         with single_blas_thread():
-            assert all(lib.num_threads == 1 for lib in ThreadpoolController().select(user_api="blas").lib_controllers)
-        assert all(lib.num_threads == 1 for lib in ThreadpoolController().select(user_api="blas").lib_controllers)
-    assert [lib.num_threads for lib in ThreadpoolController().select(user_api="blas").lib_controllers] == before
+            assert all(
+                lib.num_threads == 1 for lib in ThreadpoolController().select(user_api="blas").lib_controllers
+            )
+        assert all(
+            lib.num_threads == 1 for lib in ThreadpoolController().select(user_api="blas").lib_controllers
+        )
+    assert [
+        lib.num_threads for lib in ThreadpoolController().select(user_api="blas").lib_controllers
+    ] == before

@@ -64,7 +64,7 @@ def test_malformed_and_missing_files(tmp_path):
 def test_failed_generation_writes_no_file(tmp_path):
     out = tmp_path / "crowded.yaml"
     result = run_module(
-        "hlp_drake.scene", "generate", "--kind", "gen2", "--objects", "300", "--seed", "1", "--out", str(out)
+        "hlp_drake.scene", "generate", "--kind", "gen2", "--objects", "100", "--seed", "1", "--out", str(out)
     )
     assert_one_line_error(result, "could not place")
     assert list(tmp_path.iterdir()) == []

@@ -84,6 +84,8 @@ def test_bad_requests():
     with pytest.raises(SceneError, match="always have 6 obstacles"):
         generate_scene("vr", 1, objects=4)
     with pytest.raises(SceneError, match="could not place"):
-        generate_scene("gen2", 1, objects=400)
+        generate_scene("gen2", 1, objects=100)
+    with pytest.raises(SceneError, match="must be an integer of at most 100, got 400"):
+        generate_scene("gen2", 1, objects=400)  # refused before any placement is tried
     with pytest.raises(SceneError, match="at least 1 object"):
         generate_scene("gen2", 1, objects=0)

@@ -137,7 +137,7 @@ def test_malformed_files_name_the_field(tmp_path, mutate, message):
 
 def test_nan_in_yaml_is_rejected(tmp_path):
     text = yaml.safe_dump(scene_to_dict(small_scene())).replace("x: 0.4\n", "x: .nan\n", 1)
-    with pytest.raises(SceneError, match="x must be a finite number, got nan"):
+    with pytest.raises(SceneError, match=r"obstacles\[0\]\.x: expected a finite number, got nan"):
         load_scene(write_yaml(tmp_path, text))
 
 

@@ -47,7 +47,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = make_parser("python -m hlp_drake.dataset", __doc__)
     commands = parser.add_subparsers(dest="command", required=True)
     summary = commands.add_parser("summary", help="trial and success counts per category")
-    summary.add_argument("--dataset", help="the archive or the unpacked dataset/ folder (default: $HLP_DATASET)")
+    summary.add_argument(
+        "--dataset", help="the archive or the unpacked dataset/ folder (default: $HLP_DATASET)"
+    )
     summary.add_argument("--json", help="also write the summary as JSON to this file")
     args = parser.parse_args(argv)
     dataset = Dataset(args.dataset)

@@ -7,6 +7,7 @@ The cache is keyed by the source's fingerprint and ``CACHE_VERSION`` and written
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import re
@@ -21,6 +22,7 @@ import numpy as np
 from tqdm import tqdm
 
 from hlp_drake.dataset.convert import scene_from_layouts, stale_start
+from hlp_drake.dataset.index import check_index
 from hlp_drake.dataset.parse import (
     optional_float,
     parse_interactions,
@@ -30,9 +32,11 @@ from hlp_drake.dataset.parse import (
 )
 from hlp_drake.dataset.records import TRACKERS, category_of, trial_key
 from hlp_drake.dataset.source import PARTICIPANTS_FILE, Source
-from hlp_drake.errors import HlpError
+from hlp_drake.errors import HlpError, short
 
-CACHE_VERSION = 2
+CACHE_VERSION = 4  # 4: the track array holds the kept trials' tracks only, in index order
+COVERAGE_TOLERANCE = 0.1  # s: a track may start or end this much inside its trial (the data: <= 12 ms)
+INDEX_DIGEST = "index.sha256"  # beside index.json: a cache whose index was edited or damaged is rebuilt
 CACHE_ENV_VAR = "HLP_CACHE"
 _TRIAL_FILE = re.compile(r"^(sub_\d+)/T(\d{3})/(scene|movement)/(.+)$")
 _MOVEMENT = re.compile(r"^(.+)_movement_T\d{3}\.csv$")
@@ -111,6 +115,7 @@ class _Collector:
         if movement:
             block = parse_movement(content, movement.group(1))
             files.setdefault("tracks", {})[movement.group(1)] = [self.rows, len(block)]
+            files.setdefault("track_times", {})[movement.group(1)] = (float(block[0, 0]), float(block[-1, 0]))
             self.blocks.append(block)
             self.rows += len(block)
 
@@ -126,7 +131,9 @@ def _assemble(collector: _Collector) -> list[dict[str, Any]]:
     subjects = sorted({s for s, _ in collector.trial_files} | set(collector.results))
     for subject in subjects:
         if subject not in collector.results:
-            collector.problem(f"{subject}/{RESULTS_FILE}", "missing or unreadable: the subject's trials are skipped")
+            collector.problem(
+                f"{subject}/{RESULTS_FILE}", "missing or unreadable: the subject's trials are skipped"
+            )
             continue
         handedness = (participants.get(subject, {}).get("handedness") or "unknown").strip().lower()
         if subject not in participants and collector.participants is not None:
@@ -136,8 +143,10 @@ def _assemble(collector: _Collector) -> list[dict[str, Any]]:
             try:
                 number = int(row["trial_num"])
                 category = category_of(number)
-                times = [optional_float(row.get(c)) for c in
-                         ("start_time", "end_time", "start_moved_time", "target_reached_time")]
+                times = [
+                    optional_float(row.get(c))
+                    for c in ("start_time", "end_time", "start_moved_time", "target_reached_time")
+                ]
             except (TypeError, ValueError) as error:
                 collector.problem(where, f"line {line}: {error}")
                 continue
@@ -153,8 +162,12 @@ def _assemble(collector: _Collector) -> list[dict[str, Any]]:
 
 
 def _trial_entry(
-    collector: _Collector, key: tuple[str, int], category: str, handedness: str,
-    row: dict[str, str], times: list[float | None],
+    collector: _Collector,
+    key: tuple[str, int],
+    category: str,
+    handedness: str,
+    row: dict[str, str],
+    times: list[float | None],
 ) -> dict[str, Any] | None:
     subject, number = key
     folder = trial_key(subject, number)
@@ -164,18 +177,38 @@ def _trial_entry(
     if files is None:
         collector.problem(folder, f"listed in {RESULTS_FILE} but its folder is missing")
         return None
-    missing = [f"{folder}/scene/{name}_T{number:03d}.csv"
-               for field, name in (("scene_layout", "scene_layout"), ("objects_layout", "grid_objects_layout"))
-               if field not in files]
+    missing = [
+        f"{folder}/scene/{name}_T{number:03d}.csv"
+        for field, name in (("scene_layout", "scene_layout"), ("objects_layout", "grid_objects_layout"))
+        if field not in files
+    ]
     if "interactions" not in files:
         missing.append(f"{folder}/movement/interaction_log_T{number:03d}.csv")
     if "objects_layout" in files:
         tracks = files.get("tracks", {})
-        missing += [f"{folder}/movement/{name}_movement_T{number:03d}.csv"
-                    for name in [*TRACKERS, *(r[0] for r in files["objects_layout"])] if name not in tracks]
+        missing += [
+            f"{folder}/movement/{name}_movement_T{number:03d}.csv"
+            for name in [*TRACKERS, *(r[0] for r in files["objects_layout"])]
+            if name not in tracks
+        ]
     if missing:
         for path in missing:
             collector.problem(path, "missing: trial skipped")
+        return None
+    start_time, end_time = times[0], times[1]
+    short_tracks = [
+        (name, first, last)
+        for name, (first, last) in files["track_times"].items()
+        if (start_time is not None and first > start_time + COVERAGE_TOLERANCE)
+        or (end_time is not None and last < end_time - COVERAGE_TOLERANCE)
+    ]
+    for name, first, last in short_tracks:
+        collector.problem(
+            f"{folder}/movement/{name}_movement_T{number:03d}.csv",
+            f"truncated: the track spans {first:.3f}-{last:.3f} s, the trial "
+            f"{start_time}-{end_time} s ({RESULTS_FILE}): trial skipped",
+        )
+    if short_tracks:
         return None
     try:
         start_x = optional_float(row.get("start_pos_x"))
@@ -185,9 +218,11 @@ def _trial_entry(
         return None
     stale = stale_start(files["scene_layout"], start_x)
     if stale is not None:
-        collector.note(f"{folder}/scene/scene_layout_T{number:03d}.csv",
-                       f"StartPoint x {stale:.4f} is stale: {subject}/{RESULTS_FILE} start_pos_x {start_x:.4f} "
-                       f"used (start at world y {scene.start[1]:+.4f} m)")
+        collector.note(
+            f"{folder}/scene/scene_layout_T{number:03d}.csv",
+            f"StartPoint x {stale:.4f} is stale: {subject}/{RESULTS_FILE} start_pos_x {start_x:.4f} "
+            f"used (start at world y {scene.start[1]:+.4f} m)",
+        )
     return {
         "subject": subject,
         "trial": number,
@@ -204,15 +239,36 @@ def _trial_entry(
     }
 
 
+def _kept_tracks(blocks: list[np.ndarray], trials: list[dict[str, Any]]) -> np.ndarray:
+    """The kept ``trials``' track blocks end to end in index order, their spans renumbered to match
+    (so the spans tile the array exactly: ``check_index`` refuses an index with a trial removed)."""
+    by_start, start = {}, 0
+    for block in blocks:
+        by_start[start], start = block, start + len(block)
+    kept, rows = [], 0
+    for entry in trials:
+        for name, (first, count) in entry["tracks"].items():
+            kept.append(by_start[first])
+            entry["tracks"][name] = [rows, count]
+            rows += count
+    return np.concatenate(kept) if kept else np.empty((0, 7))
+
+
 def build_cache(source: Source, directory: Path, *, progress: bool = True) -> None:
     """Parse the whole source once and write the cache into ``directory`` (atomically)."""
     collector = _Collector(source)
-    with tqdm(desc="reading VR dataset (first load, cached afterwards)", unit="B", unit_scale=True,
-              disable=not progress, file=sys.stderr, mininterval=1.0) as bar:
+    with tqdm(
+        desc="reading VR dataset (first load, cached afterwards)",
+        unit="B",
+        unit_scale=True,
+        disable=not progress,
+        file=sys.stderr,
+        mininterval=1.0,
+    ) as bar:
         for relative, where, content in source.files(bar):
             collector.add(relative, where, content)
     trials = _assemble(collector)
-    tracks = np.concatenate(collector.blocks) if collector.blocks else np.empty((0, 7))
+    tracks = _kept_tracks(collector.blocks, trials)
     index = {
         "version": CACHE_VERSION,
         "source": source.describe_parts(),
@@ -225,7 +281,9 @@ def build_cache(source: Source, directory: Path, *, progress: bool = True) -> No
     staging = Path(tempfile.mkdtemp(prefix=f".{directory.name}.", dir=directory.parent))
     try:
         np.save(staging / "tracks.npy", tracks)
-        (staging / "index.json").write_text(json.dumps(index), encoding="utf-8")
+        text = json.dumps(index).encode("utf-8")
+        (staging / "index.json").write_bytes(text)
+        (staging / INDEX_DIGEST).write_text(hashlib.sha256(text).hexdigest(), encoding="utf-8")
         if directory.exists():
             shutil.rmtree(directory)
         os.rename(staging, directory)
@@ -237,14 +295,20 @@ def build_cache(source: Source, directory: Path, *, progress: bool = True) -> No
 
 
 def load_cache(directory: Path) -> tuple[dict[str, Any], np.ndarray]:
-    """Read a cache; raise ``ValueError`` if it is absent, stale or damaged."""
+    """Read a cache; raise ``ValueError`` if it is absent, stale or damaged (an index whose digest
+    or structure is wrong, spans past the track array, a track array of another shape)."""
     try:
-        index = json.loads((directory / "index.json").read_text(encoding="utf-8"))
+        text = (directory / "index.json").read_bytes()
+        recorded = (directory / INDEX_DIGEST).read_text(encoding="utf-8").strip()
+        if hashlib.sha256(text).hexdigest() != recorded:
+            raise ValueError("the index does not match its digest")
+        index = json.loads(text)
         tracks = np.load(directory / "tracks.npy", mmap_mode="r", allow_pickle=False)
-    except (OSError, ValueError) as error:
-        raise ValueError(f"unreadable cache: {error}") from None
+    except (OSError, ValueError, RecursionError) as error:
+        raise ValueError(f"unreadable cache: {short(str(error), 120)}") from None
     if not isinstance(index, dict) or index.get("version") != CACHE_VERSION:
         raise ValueError("cache version differs")
-    if tracks.ndim != 2 or tracks.shape != (index.get("rows"), 7):
+    if tracks.ndim != 2 or tracks.dtype != np.float64 or tracks.shape != (index.get("rows"), 7):
         raise ValueError("track array does not match the index")
+    check_index(index)
     return index, tracks

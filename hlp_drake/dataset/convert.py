@@ -66,8 +66,9 @@ class TableFrame:
         )
 
 
-def scene_from_layouts(scene_layout: list[list], objects_layout: list[list], name: str, *,
-                       start_x: float | None = None) -> Scene:
+def scene_from_layouts(
+    scene_layout: list[list], objects_layout: list[list], name: str, *, start_x: float | None = None
+) -> Scene:
     """Build and validate the Scene of a trial from its two layout files (rows as parsed) and
     ``trial_results.csv``'s start (``start_x``, Unity x; see ``TableFrame``).
 

@@ -10,11 +10,12 @@ from typing import Any
 
 import numpy as np
 
-from hlp_drake.dataset.cache import build_cache, default_cache_root, load_cache
+from hlp_drake.dataset.cache import CACHE_VERSION, INDEX_DIGEST, build_cache, default_cache_root, load_cache
 from hlp_drake.dataset.convert import TableFrame, scene_from_layouts
+from hlp_drake.dataset.parse import check_track
 from hlp_drake.dataset.records import TRACKERS, Interaction, Trial, TrialRecord, trial_key
 from hlp_drake.dataset.source import Source, resolve_source
-from hlp_drake.errors import DatasetError
+from hlp_drake.errors import DatasetError, SceneError
 from hlp_drake.scene.model import Scene
 
 
@@ -48,7 +49,7 @@ class Dataset:
     ) -> None:
         self.source: Source = resolve_source(path)
         root = Path(cache_dir) if cache_dir is not None else default_cache_root()
-        self.cache_path = root / f"vr-{self.source.fingerprint()[:16]}"
+        self.cache_path = root / f"vr-v{CACHE_VERSION}-{self.source.fingerprint()[:16]}"
         try:
             index, tracks = load_cache(self.cache_path)
             self.cache_status = "warm"
@@ -99,7 +100,12 @@ class Dataset:
     def scene(self, key: str) -> Scene:
         """The Scene of one trial, without loading its tracks."""
         entry = self._entry(key)
-        return scene_from_layouts(entry["scene_layout"], entry["objects_layout"], key, start_x=entry["start_x"])
+        try:
+            return scene_from_layouts(
+                entry["scene_layout"], entry["objects_layout"], key, start_x=entry["start_x"]
+            )
+        except (ValueError, SceneError) as error:  # it was valid when the cache was built
+            raise self._damaged(f"{key}'s scene: {error}") from None
 
     def _entry(self, key: str) -> dict[str, Any]:
         entry = self._entries.get(key)
@@ -112,6 +118,7 @@ class Dataset:
 
         Raises:
             KeyError: no such trial (or it was left out as a problem).
+            DatasetError: the cache is found damaged (it is rebuilt on the next load).
         """
         entry = self._entry(key)
         frame = TableFrame(entry["scene_layout"], entry["start_x"])
@@ -134,7 +141,17 @@ class Dataset:
 
     def _block(self, span: list[int]) -> np.ndarray:
         start, rows = span
-        return np.asarray(self._tracks[start : start + rows])
+        try:
+            return check_track(np.asarray(self._tracks[start : start + rows]))
+        except ValueError as error:  # it was valid when the cache was built
+            raise self._damaged(f"a track: {error}") from None
+
+    def _damaged(self, reason: str) -> DatasetError:
+        """The error of a cache found damaged in use; the cache is dropped, so the next load rebuilds it."""
+        (self.cache_path / INDEX_DIGEST).unlink(missing_ok=True)
+        return DatasetError(
+            f"{self.cache_path}: the dataset cache is damaged ({reason}); it is rebuilt on the next load"
+        )
 
 
 def _record(entry: dict[str, Any]) -> TrialRecord:

@@ -8,7 +8,10 @@ import math
 
 import numpy as np
 
+from hlp_drake.errors import short
+
 MOVEMENT_COLUMNS = 7  # time, pos_x, pos_y, pos_z, rot_x, rot_y, rot_z
+MIN_SAMPLES = 2  # a track of fewer samples has no motion
 LAYOUT_HEADER = ["object", "x", "y", "z", "width", "height", "depth"]
 LOG_HEADER = ["start_time", "end_time", "dominant_object", "non_dominant_object", "interaction_type"]
 
@@ -46,13 +49,29 @@ def parse_movement(data: bytes, name: str) -> np.ndarray:
     if columns != expected:
         raise ValueError(f"unexpected header {header.strip()!r} (expected {','.join(expected)!r})")
     if not body.strip():
-        return np.empty((0, MOVEMENT_COLUMNS))
+        raise ValueError("no samples (a header only)")
     try:
         values = np.loadtxt(io.StringIO(body), delimiter=",", ndmin=2, dtype=np.float64)
     except ValueError as error:
-        raise ValueError(f"malformed row: {error}") from None
+        raise ValueError(f"malformed row: {short(str(error), 120)}") from None
     if values.shape[1] != MOVEMENT_COLUMNS:
         raise ValueError(f"rows have {values.shape[1]} columns, expected {MOVEMENT_COLUMNS}")
+    return check_track(values)
+
+
+def check_track(values: np.ndarray) -> np.ndarray:
+    """``values`` (N, 7) if they are a usable track: at least 2 samples, all finite, times strictly
+    increasing; else ``ValueError`` naming the first bad row (line numbers count the header)."""
+    if len(values) < MIN_SAMPLES:
+        raise ValueError(f"{len(values)} sample(s), a track needs at least {MIN_SAMPLES}")
+    bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1))
+    if len(bad):
+        raise ValueError(f"line {bad[0] + 2}: non-finite value")
+    back = np.flatnonzero(np.diff(values[:, 0]) <= 0)
+    if len(back):
+        raise ValueError(
+            f"line {back[0] + 3}: time does not increase ({values[back[0] + 1, 0]!r} after {values[back[0], 0]!r})"
+        )
     return values
 
 
@@ -75,8 +94,13 @@ def parse_interactions(data: bytes) -> list[list]:
     for i, row in enumerate(_rows(data, LOG_HEADER), start=2):
         if len(row) != len(LOG_HEADER):
             raise ValueError(f"line {i}: {len(row)} fields, expected {len(LOG_HEADER)}")
+        start = _float(row[0], f"line {i}")
         end = _float(row[1], f"line {i}") if row[1].strip() else None
-        parsed.append([_float(row[0], f"line {i}"), end, row[2].strip(), row[3].strip(), row[4].strip()])
+        if not math.isfinite(start) or (end is not None and not math.isfinite(end)):
+            raise ValueError(f"line {i}: non-finite time in {row[:2]!r}")
+        if end is not None and end < start:
+            raise ValueError(f"line {i}: ends ({end!r}) before it starts ({start!r})")
+        parsed.append([start, end, row[2].strip(), row[3].strip(), row[4].strip()])
     return parsed
 
 
@@ -93,4 +117,7 @@ def optional_float(text: str | None) -> float | None:
     """'' or None -> None, else the number (raises ValueError)."""
     if text is None or not text.strip():
         return None
-    return float(text)
+    value = float(text)
+    if not math.isfinite(value):
+        raise ValueError(f"not a finite number: {text.strip()[:40]!r}")
+    return value

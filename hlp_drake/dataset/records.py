@@ -14,7 +14,12 @@ CATEGORIES = (PRACTICE, STRUCTURED, UNSTRUCTURED)
 SUCCESS = "Success"
 
 # Tracker files -> names used here. The "ShoulderTracker" is strapped to the upper arm.
-TRACKERS = {"HandTracker": "hand", "WristTracker": "wrist", "ElbowTracker": "elbow", "ShoulderTracker": "upper_arm"}
+TRACKERS = {
+    "HandTracker": "hand",
+    "WristTracker": "wrist",
+    "ElbowTracker": "elbow",
+    "ShoulderTracker": "upper_arm",
+}
 
 
 def category_of(trial: int) -> str:

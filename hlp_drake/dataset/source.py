@@ -176,7 +176,9 @@ def _resolve_part(given: Path) -> list[SourcePart]:
     if (resolved / ARCHIVE_NAME).is_file():
         overlays = sorted(resolved.glob(OVERLAY_PATTERN))
         return [part for path in (resolved / ARCHIVE_NAME, *overlays) for part in _resolve_part(path)]
-    raise DatasetError(f"{given}: no VR dataset here (expected sub_XX folders, a dataset/ folder or {ARCHIVE_NAME})")
+    raise DatasetError(
+        f"{given}: no VR dataset here (expected sub_XX folders, a dataset/ folder or {ARCHIVE_NAME})"
+    )
 
 
 def resolve_source(path: str | os.PathLike[str] | Sequence[str | os.PathLike[str]] | None = None) -> Source:

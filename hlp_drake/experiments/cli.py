@@ -22,12 +22,21 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from hlp_drake.cli import add_conditions, add_perception, add_quiet, make_parser
-from hlp_drake.errors import HlpError
+from hlp_drake.cli import (
+    MAX_SEED,
+    MAX_WORKERS,
+    add_conditions,
+    add_perception,
+    add_quiet,
+    integer,
+    make_parser,
+)
+from hlp_drake.documents import read_document
 from hlp_drake.experiments.executors import EXECUTORS
 from hlp_drake.experiments.experiment import DERIVED, RESULTS, ExperimentSettings, run_experiment
 from hlp_drake.experiments.runner import KINDS, JobFunction, run_job
 from hlp_drake.experiments.summary import summary_markdown
+from hlp_drake.scene.generators import MAX_GENERATED
 
 PROG = "python -m hlp_drake.experiments"
 
@@ -36,18 +45,30 @@ def _parser() -> argparse.ArgumentParser:
     parser = make_parser(PROG, __doc__)
     parser.add_argument("kind", choices=KINDS, help="gen1: Table II; gen2: Table III")
     parser.add_argument(
-        "--scenes", type=int, default=100, metavar="N", help="scenes per condition (default 100)"
+        "--scenes",
+        type=integer(1, 100_000),
+        default=100,
+        metavar="N",
+        help="scenes per condition (default 100)",
     )
     parser.add_argument(
         "--objects",
-        type=int,
+        type=integer(1, MAX_GENERATED),
         nargs="+",
         default=[5, 7, 9],
         metavar="K",
         help="gen2's object counts, one condition each (default 5 7 9; gen1 ignores it: 6)",
     )
-    parser.add_argument("--seed", type=int, default=0, metavar="S", help="scene i has seed S + i (default 0)")
-    parser.add_argument("--workers", type=int, metavar="N", help="jobs at a time (default: one per core)")
+    parser.add_argument(
+        "--seed",
+        type=integer(0, MAX_SEED - 100_000),
+        default=0,
+        metavar="S",
+        help="scene i has seed S + i (default 0)",
+    )
+    parser.add_argument(
+        "--workers", type=integer(1, MAX_WORKERS), metavar="N", help="jobs at a time (default: one per core)"
+    )
     parser.add_argument(
         "--executor",
         choices=EXECUTORS,
@@ -79,12 +100,7 @@ def main(argv: Sequence[str] | None = None, *, job: JobFunction = run_job) -> in
     args = _parser().parse_args(argv)
     config_yaml = None
     if args.config:
-        try:
-            config_yaml = Path(args.config).read_text(encoding="utf-8")
-        except FileNotFoundError:
-            raise HlpError(f"{args.config}: scenario file not found") from None
-        except (OSError, UnicodeDecodeError) as error:
-            raise HlpError(f"{args.config}: cannot read the scenario: {error}") from None
+        config_yaml = read_document(args.config, missing="scenario file not found")
     if args.execution is not None or args.uncertainty is not None:
         from hlp_drake.systems.scenario import load_scenario, with_conditions
 

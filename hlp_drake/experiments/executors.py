@@ -8,13 +8,13 @@ not depend on the executor (jobs are pure functions of their ``Job``). Close the
 from __future__ import annotations
 
 import contextlib
-import multiprocessing
 from collections.abc import Iterator, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from types import ModuleType
 
 from hlp_drake.errors import HlpError
 from hlp_drake.experiments.runner import Job, JobFunction, Row
+from hlp_drake.processes import interrupts_held, terminate_workers, worker_pool
 
 EXECUTORS = ("local", "dask")
 CLUSTER_EXTRA = 'pip install "hlp_drake[cluster]"'
@@ -77,28 +77,17 @@ def run_jobs(
 def _in_process_pool(
     job_function: JobFunction, jobs: Sequence[Job], workers: int
 ) -> Iterator[tuple[Job, Row]]:
-    spawn = multiprocessing.get_context("spawn")  # fresh interpreters: never fork a process holding Drake
-    pool = ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=spawn)
+    pool = worker_pool(min(workers, len(jobs)))  # spawned: never fork a process holding Drake
     try:
-        futures = {pool.submit(job_function, job): job for job in jobs}
+        with interrupts_held():  # the workers start here
+            futures = {pool.submit(job_function, job): job for job in jobs}
         for future in as_completed(futures):
             yield futures[future], future.result()
     except BaseException:  # Ctrl-C, a failed job, or the caller stopped early: do not wait for the rest
-        _terminate_workers(pool)
+        terminate_workers(pool)
         raise
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
-
-
-def _terminate_workers(pool: ProcessPoolExecutor) -> None:
-    """Stop the pool's processes now: a job inside a long Drake call would not see Ctrl-C until it ends."""
-    terminate = getattr(pool, "terminate_workers", None)  # Python >= 3.14
-    if terminate is not None:
-        terminate()
-        return
-    processes = getattr(pool, "_processes", None) or {}  # private before 3.14, hence the fallbacks
-    for process in list(processes.values()):
-        process.terminate()
 
 
 def _on_dask(

@@ -9,6 +9,7 @@ the demonstrations.
 from __future__ import annotations
 
 import numpy as np
+from scipy.special import expit
 from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.ensemble import GradientBoostingClassifier
 from sklearn.linear_model import LogisticRegression
@@ -39,10 +40,21 @@ class RowChoiceClassifier(ClassifierMixin, BaseEstimator):
         random_state: seed of the subsamples and folds.
     """
 
-    def __init__(self, learner: str = "boosted", n_estimators: int = 150, max_depth: int = 3,
-                 learning_rate: float = 0.1, subsample: float = 0.8, C: float = 1.0, kernel_scale: float = 0.25,
-                 calibration_folds: int = 2, novelty_neighbours: int = 5, novelty_quantile: float = 0.99,
-                 novelty_samples: int = 1000, random_state: int = 0) -> None:
+    def __init__(
+        self,
+        learner: str = "boosted",
+        n_estimators: int = 150,
+        max_depth: int = 3,
+        learning_rate: float = 0.1,
+        subsample: float = 0.8,
+        C: float = 1.0,
+        kernel_scale: float = 0.25,
+        calibration_folds: int = 2,
+        novelty_neighbours: int = 5,
+        novelty_quantile: float = 0.99,
+        novelty_samples: int = 1000,
+        random_state: int = 0,
+    ) -> None:
         self.learner = learner
         self.n_estimators = n_estimators
         self.max_depth = max_depth
@@ -63,21 +75,35 @@ class RowChoiceClassifier(ClassifierMixin, BaseEstimator):
 
     def _learner(self):
         if self.learner == "boosted":
-            return GradientBoostingClassifier(n_estimators=self.n_estimators, max_depth=self.max_depth,
-                                              learning_rate=self.learning_rate, subsample=self.subsample,
-                                              random_state=self.random_state)
+            return GradientBoostingClassifier(
+                n_estimators=self.n_estimators,
+                max_depth=self.max_depth,
+                learning_rate=self.learning_rate,
+                subsample=self.subsample,
+                random_state=self.random_state,
+            )
         if self.learner == "svm":
             return RbfSvmClassifier(C=self.C, kernel_scale=self.kernel_scale, random_state=self.random_state)
         raise ValueError(f"unknown learner {self.learner!r}; choose one of {', '.join(LEARNERS)}")
 
-    def _fit_learner(self, X: np.ndarray, y: np.ndarray,
-                     sample_weight: np.ndarray | None) -> BoostedTrees | RbfSvmClassifier:
+    def _fit_learner(
+        self, X: np.ndarray, y: np.ndarray, sample_weight: np.ndarray | None
+    ) -> BoostedTrees | RbfSvmClassifier:
         """Fit one learner: the boosted trees (as arrays), or the SVM."""
         model = self._learner().fit(X, y, sample_weight=sample_weight)
-        return BoostedTrees(boosted_tree_arrays(model, X)) if isinstance(model, GradientBoostingClassifier) else model
+        return (
+            BoostedTrees(boosted_tree_arrays(model, X))
+            if isinstance(model, GradientBoostingClassifier)
+            else model
+        )
 
-    def fit(self, X: np.ndarray, y: np.ndarray, sample_weight: np.ndarray | None = None,
-            groups: np.ndarray | None = None) -> RowChoiceClassifier:
+    def fit(
+        self,
+        X: np.ndarray,
+        y: np.ndarray,
+        sample_weight: np.ndarray | None = None,
+        groups: np.ndarray | None = None,
+    ) -> RowChoiceClassifier:
         """Fit on candidates ``X`` labelled ``y`` (two classes; the second is "taken").
 
         Args:
@@ -95,12 +121,20 @@ class RowChoiceClassifier(ClassifierMixin, BaseEstimator):
             learner = self._fit_learner(X[train], positive[train], None if weight is None else weight[train])
             oof[test] = learner.decision_function(X[test])
         platt = LogisticRegression(C=1e6).fit(oof[:, None], positive) if folds else None
-        self.calibration_ = (np.array([float(platt.coef_[0, 0]), float(platt.intercept_[0])]) if platt is not None
-                             else np.array([1.0, 0.0]))
+        self.calibration_ = (
+            np.array([float(platt.coef_[0, 0]), float(platt.intercept_[0])])
+            if platt is not None
+            else np.array([1.0, 0.0])
+        )
         self._learner_ = self._fit_learner(X, positive, weight)
         rng = np.random.default_rng(self.random_state)
-        self.novelty_ = fit_novelty(X, rng, samples=self.novelty_samples, neighbours=self.novelty_neighbours,
-                                    quantile=self.novelty_quantile)
+        self.novelty_ = fit_novelty(
+            X,
+            rng,
+            samples=self.novelty_samples,
+            neighbours=self.novelty_neighbours,
+            quantile=self.novelty_quantile,
+        )
         self._novelty_weights = distance_weights(self.novelty_["points"])
         return self
 
@@ -110,8 +144,11 @@ class RowChoiceClassifier(ClassifierMixin, BaseEstimator):
         if groups is not None and len(np.unique(groups)) >= k:
             folds = list(GroupKFold(n_splits=k).split(positive, positive, groups))
         elif np.bincount(positive, minlength=2).min() >= k:
-            folds = list(StratifiedKFold(n_splits=k, shuffle=True, random_state=self.random_state)
-                         .split(positive, positive))
+            folds = list(
+                StratifiedKFold(n_splits=k, shuffle=True, random_state=self.random_state).split(
+                    positive, positive
+                )
+            )
         else:
             return []
         return [(tr, te) for tr, te in folds if len(np.unique(positive[tr])) == 2]
@@ -125,7 +162,7 @@ class RowChoiceClassifier(ClassifierMixin, BaseEstimator):
         """(n, 2) calibrated probabilities of ``classes_``."""
         score = self.decision_function(X)
         a, b = self.calibration_
-        p = 1.0 / (1.0 + np.exp(-(a * score + b)))
+        p = expit(a * score + b)  # the logistic function, without overflow for large scores
         return np.column_stack([1.0 - p, p])
 
     def predict(self, X: np.ndarray) -> np.ndarray:
@@ -140,16 +177,22 @@ class RowChoiceClassifier(ClassifierMixin, BaseEstimator):
         """The fitted arrays (for safe saving)."""
         check_is_fitted(self)
         state = {"classes": self.classes_, "calibration": self.calibration_}
-        learner = self._learner_.get_state() if isinstance(self._learner_, RbfSvmClassifier) else self._learner_.arrays
+        learner = (
+            self._learner_.get_state()
+            if isinstance(self._learner_, RbfSvmClassifier)
+            else self._learner_.arrays
+        )
         state.update({f"learner.{k}": v for k, v in learner.items()})
         state.update({f"novelty.{k}": v for k, v in self.novelty_.items()})
         return state
 
     def set_state(self, state: dict[str, np.ndarray]) -> RowChoiceClassifier:
         self.classes_, self.calibration_ = state["classes"], state["calibration"]
-        learner = {k[len("learner."):]: v for k, v in state.items() if k.startswith("learner.")}
-        self._learner_ = RbfSvmClassifier().set_state(learner) if self.learner == "svm" else BoostedTrees(learner)
-        self.novelty_ = {k[len("novelty."):]: v for k, v in state.items() if k.startswith("novelty.")}
+        learner = {k[len("learner.") :]: v for k, v in state.items() if k.startswith("learner.")}
+        self._learner_ = (
+            RbfSvmClassifier().set_state(learner) if self.learner == "svm" else BoostedTrees(learner)
+        )
+        self.novelty_ = {k[len("novelty.") :]: v for k, v in state.items() if k.startswith("novelty.")}
         self.n_features_in_ = len(self.novelty_["mean"])
         self._novelty_weights = distance_weights(self.novelty_["points"])
         return self

@@ -1,8 +1,9 @@
 """``DecisionModels``: a planner's learners together, fitted from training sets, saved in a safe format.
 
 Files: ``models.json`` (format, version, settings, checksum) and ``models.npz`` (plain arrays,
-read with ``allow_pickle=False``). Nothing is ever unpickled; a file whose checksum, format,
-version or arrays do not match is refused with a ``ModelError``.
+read with ``allow_pickle=False``). Nothing is ever unpickled; every field and every array's name,
+dtype and shape is checked against the format (``learners.model_format``, which also states the
+trust model) before use, and any damage is one ``ModelError``.
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ import hashlib
 import io
 import json
 import os
-import zipfile
+import re
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
@@ -20,19 +21,32 @@ import numpy as np
 
 from hlp_drake.atomic import atomic_path, write_text_atomic
 from hlp_drake.dataset.records import STRUCTURED, UNSTRUCTURED, category_of
+from hlp_drake.documents import brief, parse_json, read_bytes
 from hlp_drake.errors import ModelError
 from hlp_drake.features.training import TrainingData
 from hlp_drake.learners.arm import CATEGORICAL as ARM_CATEGORICAL
 from hlp_drake.learners.arm import ArmRegressor
+from hlp_drake.learners.choice import LEARNERS as ROW_LEARNERS
 from hlp_drake.learners.choice import RowChoiceClassifier
 from hlp_drake.learners.direction import CATEGORICAL as DIRECTION_CATEGORICAL
 from hlp_drake.learners.direction import DirectionClassifier
+from hlp_drake.learners.model_format import (
+    MAX_MODEL_BYTES,
+    check_pin,
+    check_values,
+    digest,
+    expected_arrays,
+    read_arrays,
+)
 from hlp_drake.learners.svm import RbfSvmClassifier
-from hlp_drake.segmentation.modes import is_faithful
+from hlp_drake.segmentation.modes import Mode, is_faithful
+from hlp_drake.typed_yaml import document_problems
 
 FORMAT = "hlp_drake.decision_models"
 VERSION = 2
 PLANNERS = ("rows", "paper")
+MAX_META_BYTES = 2**20
+"""Largest ``models.json`` read, bytes."""
 # The learners each planner uses: the row-by-row planner (Cr, Cd, Ra) or the paper's Algorithm 1
 # (Cg, Co, Cc, Cd, Ra).
 LEARNERS = {"rows": ("row", "direction", "arm"), "paper": ("gap", "object", "segment", "direction", "arm")}
@@ -87,6 +101,56 @@ PRESETS = {
 DEFAULT_PRESET = "boosted"
 
 
+@dataclass(frozen=True)
+class ModelDescription:
+    """The fields of ``models.json`` (the schema it is checked against)."""
+
+    format: str
+    version: int
+    mode: Mode
+    settings: LearnerSettings
+    subjects: tuple[str, ...]
+    sha256: str
+
+
+def _settings(meta: Any, where: Path) -> LearnerSettings:
+    """The learner settings of the ``models.json`` document ``meta``, once every field is checked."""
+    if not isinstance(meta, dict) or meta.get("format") != FORMAT:
+        raise ModelError(f"{where}: not an hlp_drake model file")
+    if meta.get("version") != VERSION:
+        raise ModelError(
+            f"{where}: model format version {brief(meta.get('version'))}, this hlp_drake reads {VERSION}"
+        )
+    problems = document_problems(ModelDescription, meta, top="models.json")
+    settings = meta.get("settings") if isinstance(meta.get("settings"), dict) else {}
+    if settings.get("planner", "paper") not in PLANNERS:
+        problems.append(
+            f"settings.planner: expected one of {', '.join(PLANNERS)}, got {brief(settings['planner'])}"
+        )
+    if settings.get("row_learner", "boosted") not in ROW_LEARNERS:
+        problems.append(
+            f"settings.row_learner: expected one of {', '.join(ROW_LEARNERS)}, "
+            f"got {brief(settings['row_learner'])}"
+        )
+    subjects = meta.get("subjects")
+    if isinstance(subjects, list) and (
+        len(subjects) > 1000 or any(isinstance(s, str) and len(s) > 100 for s in subjects)
+    ):
+        problems.append("subjects: more than 1000 subjects or a name longer than 100 characters")
+    if isinstance(meta.get("sha256"), str) and not re.fullmatch(r"[0-9a-f]{64}", meta["sha256"]):
+        problems.append("sha256: expected 64 hexadecimal digits")
+    if problems:
+        raise ModelError(*(f"{where}: {p}" for p in problems))
+    return LearnerSettings(**settings)
+
+
+def model_digest(directory: str | os.PathLike[str]) -> str:
+    """The SHA-256 (hex) of the ``models.json`` in ``directory``: what ``DecisionModels.load``'s
+    ``sha256`` pins (``sha256sum models.json`` prints the same)."""
+    path = Path(directory) / "models.json"
+    return digest(read_bytes(path, ModelError, missing="model file not found", limit=MAX_META_BYTES))
+
+
 def _category_weights(keys: np.ndarray, structured_weight: float) -> np.ndarray | None:
     """Per row: ``structured_weight`` for structured trials where unstructured ones are present too."""
     categories = np.array([category_of(int(str(k).split("/T")[1])) for k in keys])
@@ -112,20 +176,35 @@ class DecisionModels:
         if s.planner not in PLANNERS:
             raise ModelError(f"unknown planner {s.planner!r}; choose one of {', '.join(PLANNERS)}")
         self.learners = LEARNERS[s.planner]
-        self.direction = DirectionClassifier(C=s.C, categorical=DIRECTION_CATEGORICAL, random_state=s.random_state)
-        self.arm = ArmRegressor(max_samples=s.arm_max_samples, categorical=ARM_CATEGORICAL,
-                                random_state=s.random_state)
+        self.direction = DirectionClassifier(
+            C=s.C, categorical=DIRECTION_CATEGORICAL, random_state=s.random_state
+        )
+        self.arm = ArmRegressor(
+            max_samples=s.arm_max_samples, categorical=ARM_CATEGORICAL, random_state=s.random_state
+        )
         if s.planner == "rows":
-            self.row = RowChoiceClassifier(learner=s.row_learner, n_estimators=s.n_estimators, max_depth=s.max_depth,
-                                           learning_rate=s.learning_rate, C=s.C, kernel_scale=s.kernel_scale,
-                                           random_state=s.random_state)
+            self.row = RowChoiceClassifier(
+                learner=s.row_learner,
+                n_estimators=s.n_estimators,
+                max_depth=s.max_depth,
+                learning_rate=s.learning_rate,
+                C=s.C,
+                kernel_scale=s.kernel_scale,
+                random_state=s.random_state,
+            )
         else:
-            self.gap = RbfSvmClassifier(C=s.C, kernel_scale=s.kernel_scale, balance=s.balance_gap_object,
-                                        random_state=s.random_state)
-            self.object = RbfSvmClassifier(C=s.C, kernel_scale=s.kernel_scale, balance=s.balance_gap_object,
-                                           random_state=s.random_state)
-            self.segment = RbfSvmClassifier(C=s.C, kernel_scale=s.kernel_scale,
-                                            max_per_class=s.segment_max_per_class, random_state=s.random_state)
+            self.gap = RbfSvmClassifier(
+                C=s.C, kernel_scale=s.kernel_scale, balance=s.balance_gap_object, random_state=s.random_state
+            )
+            self.object = RbfSvmClassifier(
+                C=s.C, kernel_scale=s.kernel_scale, balance=s.balance_gap_object, random_state=s.random_state
+            )
+            self.segment = RbfSvmClassifier(
+                C=s.C,
+                kernel_scale=s.kernel_scale,
+                max_per_class=s.segment_max_per_class,
+                random_state=s.random_state,
+            )
         self.mode_ = "fixed"
         self.subjects_: list[str] = []
 
@@ -136,7 +215,9 @@ class DecisionModels:
     def fit(self, data: TrainingData) -> DecisionModels:
         """Fit the planner's learners on ``data``."""
         if self.planner == "rows" and is_faithful(data.mode):
-            raise ModelError("the row-by-row planner's learners need fixed-mode data (the paper preset reads faithful)")
+            raise ModelError(
+                "the row-by-row planner's learners need fixed-mode data (the paper preset reads faithful)"
+            )
         for name in self.learners:
             labelled = getattr(data, name)
             if name in ("gap", "object") and not self.settings.gap_object_from_all_trials:
@@ -145,8 +226,12 @@ class DecisionModels:
                 raise ModelError(f"no training rows for the {name} learner")
             estimator = getattr(self, name)
             if name == "row":
-                estimator.fit(labelled.X, labelled.y, groups=labelled.subjects,
-                              sample_weight=_category_weights(labelled.keys, self.settings.structured_weight))
+                estimator.fit(
+                    labelled.X,
+                    labelled.y,
+                    groups=labelled.subjects,
+                    sample_weight=_category_weights(labelled.keys, self.settings.structured_weight),
+                )
             else:
                 estimator.fit(labelled.X, labelled.y)
         self.mode_ = data.mode
@@ -158,8 +243,11 @@ class DecisionModels:
     # -- persistence ---------------------------------------------------------------------------
 
     def _arrays(self) -> dict[str, np.ndarray]:
-        arrays = {f"{name}.{key}": np.asarray(value) for name in self.learners
-                  for key, value in getattr(self, name).get_state().items()}
+        arrays = {
+            f"{name}.{key}": np.asarray(value)
+            for name in self.learners
+            for key, value in getattr(self, name).get_state().items()
+        }
         arrays["priors.start_arm"] = np.asarray(self.start_arm_)
         arrays["priors.link_lengths"] = np.asarray(self.link_lengths_)
         return arrays
@@ -173,54 +261,59 @@ class DecisionModels:
         payload = buffer.getvalue()
         with atomic_path(directory / "models.npz") as tmp:
             Path(tmp).write_bytes(payload)
-        meta = {"format": FORMAT, "version": VERSION, "mode": self.mode_, "settings": asdict(self.settings),
-                "subjects": self.subjects_, "sha256": hashlib.sha256(payload).hexdigest()}
+        meta = {
+            "format": FORMAT,
+            "version": VERSION,
+            "mode": self.mode_,
+            "settings": asdict(self.settings),
+            "subjects": self.subjects_,
+            "sha256": hashlib.sha256(payload).hexdigest(),
+        }
         write_text_atomic(directory / "models.json", json.dumps(meta, indent=2) + "\n")
         return directory
 
     @classmethod
-    def load(cls, directory: str | os.PathLike[str]) -> DecisionModels:
-        """Read models saved by ``save``; refuse anything else with a ``ModelError``."""
+    def load(cls, directory: str | os.PathLike[str], *, sha256: str | None = None) -> DecisionModels:
+        """Read models saved by ``save``; refuse anything else with a ``ModelError``.
+
+        Args:
+            sha256: the SHA-256 (hex) of the trusted ``models.json`` (``model_digest``); given, any
+                other files are refused (see ``learners.model_format`` for the trust model).
+        """
         directory = Path(directory)
         meta_path, npz_path = directory / "models.json", directory / "models.npz"
-        for path in (meta_path, npz_path):
-            if not path.is_file():
-                raise ModelError(f"{path}: model file not found")
+        meta_bytes = read_bytes(meta_path, ModelError, missing="model file not found", limit=MAX_META_BYTES)
+        if not npz_path.is_file():
+            raise ModelError(f"{npz_path}: model file not found")
+        check_pin(meta_bytes, sha256, str(meta_path))
         try:
-            meta = json.loads(meta_path.read_text())
-        except (UnicodeDecodeError, json.JSONDecodeError) as error:
-            raise ModelError(f"{meta_path}: not a model description ({error.__class__.__name__})") from None
-        if not isinstance(meta, dict) or meta.get("format") != FORMAT:
-            raise ModelError(f"{meta_path}: not an hlp_drake model file")
-        if meta.get("version") != VERSION:
-            raise ModelError(f"{meta_path}: model format version {meta.get('version')!r}, this hlp_drake reads {VERSION}")
-        payload = npz_path.read_bytes()
-        if hashlib.sha256(payload).hexdigest() != meta.get("sha256"):
+            meta = parse_json(meta_bytes.decode("utf-8"), str(meta_path), ModelError)
+        except (UnicodeDecodeError, ModelError) as error:
+            reason = (
+                error.problems[0].removeprefix(f"{meta_path}: ")
+                if isinstance(error, ModelError)
+                else "not UTF-8"
+            )
+            raise ModelError(f"{meta_path}: not a model description ({reason})") from None
+        settings = _settings(meta, meta_path)
+        payload = read_bytes(npz_path, ModelError, missing="model file not found", limit=MAX_MODEL_BYTES)
+        if hashlib.sha256(payload).hexdigest() != meta["sha256"]:
             raise ModelError(f"{npz_path}: checksum mismatch (the file was modified or damaged)")
         try:
-            with np.load(io.BytesIO(payload), allow_pickle=False) as npz:
-                arrays = {key: npz[key] for key in npz.files}
-        except (ValueError, OSError, zipfile.BadZipFile) as error:
-            raise ModelError(f"{npz_path}: unreadable model arrays ({error})") from None
-        try:
-            settings = LearnerSettings(**meta["settings"])
-        except (KeyError, TypeError) as error:
-            raise ModelError(f"{meta_path}: bad settings ({error})") from None
-        if settings.planner not in PLANNERS:
-            raise ModelError(f"{meta_path}: unknown planner {settings.planner!r}")
+            arrays = read_arrays(payload, expected_arrays(settings.planner, settings.row_learner))
+            check_values(arrays)
+        except ValueError as error:
+            raise ModelError(f"{npz_path}: {error}") from None
         models = cls(settings)
-        try:
-            for name in models.learners:
-                prefix = f"{name}."
-                getattr(models, name).set_state({k[len(prefix):]: v for k, v in arrays.items() if k.startswith(prefix)})
-            models.start_arm_ = arrays["priors.start_arm"]
-            models.link_lengths_ = arrays["priors.link_lengths"]
-        except KeyError as missing:
-            raise ModelError(f"{npz_path}: missing array {missing}") from None
-        if not all(np.all(np.isfinite(v)) for v in arrays.values() if v.dtype.kind == "f"):
-            raise ModelError(f"{npz_path}: non-finite model parameters")
-        models.mode_ = meta.get("mode", "fixed")
-        models.subjects_ = list(meta.get("subjects", []))
+        for name in models.learners:
+            prefix = f"{name}."
+            getattr(models, name).set_state(
+                {k[len(prefix) :]: v for k, v in arrays.items() if k.startswith(prefix)}
+            )
+        models.start_arm_ = arrays["priors.start_arm"]
+        models.link_lengths_ = arrays["priors.link_lengths"]
+        models.mode_ = meta["mode"]
+        models.subjects_ = list(meta["subjects"])
         return models
 
     def describe(self) -> dict[str, Any]:

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import typing
 from dataclasses import dataclass
 
+from hlp_drake.documents import brief
 from hlp_drake.segmentation.modes import Mode
 
 
@@ -52,3 +54,26 @@ class PlannerConfig:
     beam: int = 3
     min_share: float = 0.05
     collision_weight: float = 0.0
+
+
+def planner_config_problems(config: PlannerConfig) -> list[str]:
+    """Why ``config`` cannot be used (empty when it is fine): counts between 1 and 1000, lengths
+    and weights finite and non-negative, shares in [0, 1]."""
+    problems = []
+    for name in ("max_gaps_per_row", "max_objects_per_row", "max_paths", "classify_per_row", "beam"):
+        value = getattr(config, name)
+        if not isinstance(value, int) or isinstance(value, bool) or not 1 <= value <= 1000:
+            problems.append(f"{name} must be an integer between 1 and 1000, got {brief(value)}")
+    numbers = {
+        name: getattr(config, name)
+        for name in ("min_gap_width", "arm_band", "min_evidence", "min_share", "collision_weight")
+    }
+    if config.hand_width is not None:
+        numbers["hand_width"] = config.hand_width
+    for name, value in numbers.items():
+        ok = isinstance(value, int | float) and not isinstance(value, bool) and 0.0 <= value <= 1e6
+        if not ok or (name == "min_share" and value > 1.0) or (name == "hand_width" and value <= 0.0):
+            problems.append(f"{name} must be a finite number in range, got {brief(value)}")
+    if config.mode not in typing.get_args(Mode):
+        problems.append(f"mode must be one of {', '.join(typing.get_args(Mode))}, got {brief(config.mode)}")
+    return problems

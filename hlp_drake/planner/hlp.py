@@ -6,12 +6,13 @@ import time
 
 import numpy as np
 
+from hlp_drake.errors import SceneError, short
 from hlp_drake.features import table_diagonal
 from hlp_drake.features.row_choice import HUMAN_HAND_WIDTH
 from hlp_drake.learners.models import DecisionModels
 from hlp_drake.planner.blas import single_blas_thread
 from hlp_drake.planner.candidates import classify, enumerate_paths, informed, row_candidates, segment_scores
-from hlp_drake.planner.config import PlannerConfig
+from hlp_drake.planner.config import PlannerConfig, planner_config_problems
 from hlp_drake.planner.plan import HighLevelPlan, PlanCandidate, PlanKeypoint
 from hlp_drake.planner.rollout import PrefixTree, arm_configurations, expected_collisions, path_keypoints
 from hlp_drake.planner.row_plan import plan_rows
@@ -23,12 +24,23 @@ from hlp_drake.taskspace import TaskSpace
 
 
 def _no_plan(scene: Scene, reason: str, started: float) -> HighLevelPlan:
-    return HighLevelPlan(scene.name, (), reason=reason, planning_time_s=time.perf_counter() - started)
+    name = getattr(scene, "name", "") if isinstance(scene, Scene) else ""
+    return HighLevelPlan(
+        name if isinstance(name, str) else "",
+        (),
+        reason=short(reason, 2000),
+        planning_time_s=time.perf_counter() - started,
+    )
 
 
-def plan(scene: Scene, models: DecisionModels, config: PlannerConfig | None = None, *,
-         start_arm: tuple[float, float] | None = None,
-         link_lengths: tuple[float, float] | None = None) -> HighLevelPlan:
+def plan(
+    scene: Scene,
+    models: DecisionModels,
+    config: PlannerConfig | None = None,
+    *,
+    start_arm: tuple[float, float] | None = None,
+    link_lengths: tuple[float, float] | None = None,
+) -> HighLevelPlan:
     """Plan how a person would reach the target of ``scene``.
 
     The models decide the planner: the row-by-row planner (``planner.row_plan``) for models of the
@@ -45,12 +57,19 @@ def plan(scene: Scene, models: DecisionModels, config: PlannerConfig | None = No
         The plan, or a plan with ``reason`` set (never an exception for a bad scene).
     """
     started = time.perf_counter()
-    config = config or PlannerConfig(mode=models.mode_)
-    if config.mode != models.mode_:
-        return _no_plan(scene, f"models were trained in {models.mode_} mode, the planner runs in {config.mode}", started)
     problems = scene_problems(scene)
     if problems:
-        return _no_plan(scene, "invalid scene: " + "; ".join(problems), started)
+        return _no_plan(scene, "invalid scene: " + "; ".join(SceneError(*problems).problems), started)
+    config = config or PlannerConfig(mode=models.mode_)
+    if not isinstance(config, PlannerConfig) or planner_config_problems(config):
+        reasons = (
+            planner_config_problems(config) if isinstance(config, PlannerConfig) else ["not a PlannerConfig"]
+        )
+        return _no_plan(scene, "invalid planner settings: " + "; ".join(reasons), started)
+    if config.mode != models.mode_:
+        return _no_plan(
+            scene, f"models were trained in {models.mode_} mode, the planner runs in {config.mode}", started
+        )
     scale = table_diagonal(scene.table) / table_diagonal(VR_TABLE)  # arm lengths scale with the table
     links = link_lengths if link_lengths is not None else tuple(np.asarray(models.link_lengths_) * scale)
     q0 = np.asarray(start_arm if start_arm is not None else models.start_arm_, float)
@@ -62,8 +81,14 @@ def plan(scene: Scene, models: DecisionModels, config: PlannerConfig | None = No
         return _plan(space, models, config, q0, links, started)
 
 
-def _plan(space: TaskSpace, models: DecisionModels, config: PlannerConfig, q0: np.ndarray,
-          links: tuple[float, float], started: float) -> HighLevelPlan:
+def _plan(
+    space: TaskSpace,
+    models: DecisionModels,
+    config: PlannerConfig,
+    q0: np.ndarray,
+    links: tuple[float, float],
+    started: float,
+) -> HighLevelPlan:
     """Steps 1-6 of ``plan`` on a valid scene's task space."""
     faithful = is_faithful(config.mode)
 
@@ -72,8 +97,11 @@ def _plan(space: TaskSpace, models: DecisionModels, config: PlannerConfig, q0: n
     gap_scores, object_scores = classify(space, models, config.classify_per_row)
     table, names = space.gap_table, space.obstacle_names
     details = {
-        "gap_scores": {f"{r}:{i}": s for r, i, s in zip(table.row.tolist(), table.index.tolist(), gap_scores.tolist())
-                       if np.isfinite(s)},
+        "gap_scores": {
+            f"{r}:{i}": s
+            for r, i, s in zip(table.row.tolist(), table.index.tolist(), gap_scores.tolist())
+            if np.isfinite(s)
+        },
         "object_scores": {n: s for n, s in zip(names, object_scores.tolist()) if np.isfinite(s)},
     }
     candidates = row_candidates(space, models, gap_scores, object_scores, config)
@@ -91,12 +119,23 @@ def _plan(space: TaskSpace, models: DecisionModels, config: PlannerConfig, q0: n
     # 6. The path with the least expected collision (ties: the first).
     best = min(range(len(keypoints)), key=lambda i: costs[i])
     chosen = tuple(
-        PlanKeypoint(k.action, (float(k.position[0]), float(k.position[1])), k.row, k.element, k.direction,
-                     (float(q[0]), float(q[1])))
+        PlanKeypoint(
+            k.action,
+            (float(k.position[0]), float(k.position[1])),
+            k.row,
+            k.element,
+            k.direction,
+            (float(q[0]), float(q[1])),
+        )
         for k, q in zip(keypoints[best], arms[[0, *tree.paths[best]]].tolist())
     )
-    alternatives = tuple(sorted((PlanCandidate(tuple(k), c) for i, (k, c) in enumerate(zip(keypoints, costs))
-                                 if i != best), key=lambda c: c.expected_collision))
+    alternatives = tuple(
+        sorted(
+            (PlanCandidate(tuple(k), c) for i, (k, c) in enumerate(zip(keypoints, costs)) if i != best),
+            key=lambda c: c.expected_collision,
+        )
+    )
     details["candidates"] = {str(r + 1): [n.element for n in c] for r, c in enumerate(candidates)}
-    return HighLevelPlan(space.scene.name, chosen, costs[best], alternatives, time.perf_counter() - started, None,
-                         details)
+    return HighLevelPlan(
+        space.scene.name, chosen, costs[best], alternatives, time.perf_counter() - started, None, details
+    )

@@ -10,8 +10,8 @@ from __future__ import annotations
 import sys
 from collections.abc import Sequence
 
-from hlp_drake.cli import make_parser, run_cli
-from hlp_drake.scene.generators import KINDS, generate_scene
+from hlp_drake.cli import MAX_SEED, integer, make_parser, run_cli
+from hlp_drake.scene.generators import KINDS, MAX_GENERATED, generate_scene
 from hlp_drake.scene.io import load_scene, save_scene
 from hlp_drake.scene.rows import find_rows
 
@@ -21,8 +21,10 @@ def _parser():
     commands = parser.add_subparsers(dest="command", required=True)
     generate = commands.add_parser("generate", help="write a seeded random scene")
     generate.add_argument("--kind", choices=KINDS, required=True)
-    generate.add_argument("--objects", type=int, help="number of obstacles (gen2, unstructured)")
-    generate.add_argument("--seed", type=int, required=True)
+    generate.add_argument(
+        "--objects", type=integer(1, MAX_GENERATED), help="number of obstacles (gen2, unstructured)"
+    )
+    generate.add_argument("--seed", type=integer(0, MAX_SEED), required=True)
     generate.add_argument("--out", required=True, help="output file, .yaml or .json")
     show = commands.add_parser("show", help="draw a scene file top-down")
     show.add_argument("file")

@@ -24,6 +24,7 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
+from hlp_drake.documents import brief
 from hlp_drake.errors import SceneError
 from hlp_drake.scene.geometry import footprint
 from hlp_drake.scene.model import Scene, SceneObject, Table
@@ -67,6 +68,10 @@ class RobotSceneRanges:
 GEN1 = RobotSceneRanges()
 DECIMALS = 4  # generated values are rounded to 0.1 mm / 0.1 mrad so files read cleanly
 MAX_PLACEMENT_ATTEMPTS = 2000
+MAX_SEED = 2**32 - 1
+"""Seeds lie in [0, MAX_SEED] (numpy's seeds are non-negative)."""
+MAX_GENERATED = 100
+"""Most obstacles a generator places (tables fill up well before)."""
 
 
 def _rounded(value: float) -> float:
@@ -373,7 +378,13 @@ def generate_scene(kind: str, seed: int, objects: int | None = None) -> Scene:
         objects: number of obstacles (gen2: default 7; unstructured: default 6; vr and gen1: 6 only).
     """
     if kind not in KINDS:
-        raise SceneError(f"unknown scene kind {kind!r} (expected one of {', '.join(KINDS)})")
+        raise SceneError(f"unknown scene kind {brief(kind)} (expected one of {', '.join(KINDS)})")
+    if not isinstance(seed, int | np.integer) or not 0 <= seed <= MAX_SEED:
+        raise SceneError(f"the seed must be an integer between 0 and {MAX_SEED}, got {brief(seed)}")
+    if objects is not None and (not isinstance(objects, int | np.integer) or objects > MAX_GENERATED):
+        raise SceneError(
+            f"the number of obstacles must be an integer of at most {MAX_GENERATED}, got {brief(objects)}"
+        )
     if kind in FIXED_OBJECT_COUNT:
         if objects is not None and objects != FIXED_OBJECT_COUNT[kind]:
             raise SceneError(

@@ -15,10 +15,11 @@ from typing import Any
 import yaml
 
 from hlp_drake.atomic import write_text_atomic
+from hlp_drake.documents import parse_json, parse_yaml, read_document
 from hlp_drake.errors import SceneError
 from hlp_drake.scene.model import Scene, SceneObject
-from hlp_drake.scene.validation import validate_scene
-from hlp_drake.typed_yaml import load_typed, parse_yaml
+from hlp_drake.scene.validation import MAX_OBSTACLES, scene_problems, validate_scene
+from hlp_drake.typed_yaml import load_typed
 
 DEFAULT_SCENE_FILE = Path(__file__).resolve().parents[1] / "scenes" / "default.yaml"
 """The bundled default scene (Generalization I, seed 3), which ``run_scene`` runs without arguments."""
@@ -61,11 +62,15 @@ def scene_from_dict(data: Any, *, where: str = "") -> Scene:
         SceneError: every problem on its own line, located (``obstacles[0].x: expected a number``)
             and prefixed with ``where`` when given.
     """
+    prefix = f"{where}: " if where else ""
+    obstacles = data.get("obstacles") if isinstance(data, dict) else None
+    if isinstance(obstacles, list) and len(obstacles) > MAX_OBSTACLES:
+        raise SceneError(f"{prefix}scene.obstacles: more than {MAX_OBSTACLES} obstacles ({len(obstacles)})")
     scene = load_typed(Scene, data, where=where, top="scene", error=SceneError)
-    try:
-        return validate_scene(scene)
-    except SceneError as error:
-        raise SceneError(*(f"{where}: {p}" if where else p for p in error.problems)) from None
+    problems = scene_problems(scene)
+    if problems:
+        raise SceneError(*(prefix + p for p in problems))
+    return scene
 
 
 def _suffix(path: Path) -> str:
@@ -86,24 +91,15 @@ def load_scene(path: str | os.PathLike[str]) -> Scene:
     """Read and validate a scene file (.yaml, .yml or .json).
 
     Raises:
-        SceneError: the file is missing, unreadable, not YAML/JSON, or describes an invalid scene;
-            every message starts with the file's path.
+        SceneError: the file is missing, unreadable, too large, not YAML/JSON (or breaks the
+            limits of ``hlp_drake.documents``), or describes an invalid scene; every message starts
+            with the file's path.
     """
     path = Path(path)
     suffix = _suffix(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise SceneError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise SceneError(f"{path}: cannot read: {error}") from None
-    if suffix in JSON_SUFFIXES:
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as error:
-            raise SceneError(f"{path}: not valid JSON: {error}") from None
-    else:
-        data = parse_yaml(text, str(path), SceneError)
+    text = read_document(path, SceneError)
+    parse = parse_json if suffix in JSON_SUFFIXES else parse_yaml
+    data = parse(text, str(path), SceneError)
     return scene_from_dict(data, where=str(path))
 
 

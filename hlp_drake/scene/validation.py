@@ -1,45 +1,99 @@
-"""Scene validation: one clear message per problem."""
+"""Scene validation: one clear message per problem, at a cost of O(n log n) in the object count.
+
+The limits (``TABLE_RANGE``, ``SIZE_RANGE``, ``MAX_OBSTACLES``, ``YAW_LIMIT``, ``MAX_NAME``) keep
+every number the planner and Drake see physically sane; overlaps are found with a shapely
+``STRtree`` and listed up to ``MAX_PROBLEMS`` pairs.
+"""
 
 from __future__ import annotations
 
 import math
-from functools import cache
+from collections.abc import Sequence
 from numbers import Real
 
 import numpy as np
 import shapely
 
-from hlp_drake.errors import SceneError
-from hlp_drake.scene.geometry import footprint, footprint_bounds, overlapping_bounds
-from hlp_drake.scene.model import SHAPES, Scene, SceneObject
+from hlp_drake.documents import brief
+from hlp_drake.errors import MAX_PROBLEMS, SceneError
+from hlp_drake.scene.geometry import footprint_bounds, footprints
+from hlp_drake.scene.model import SHAPES, Scene, SceneObject, Table
 
 LENGTH_TOLERANCE = 1e-9  # m: how far a footprint may poke past the table edge (float noise)
 AREA_TOLERANCE = 1e-9  # m^2: overlap area below which two objects only touch
-BOUNDS_MARGIN = 1e-6  # m: boxes this close may touch (footprints vs their float bounding boxes)
+TABLE_RANGE = (0.2, 5.0)
+"""m: the table's length, width and height each lie in this range."""
+SIZE_RANGE = (0.005, 1.0)
+"""m: every size of an object (its two footprint extents and its height) lies in this range."""
+MAX_OBSTACLES = 10_000
+"""Most obstacles a scene may have."""
+YAW_LIMIT = 2.0 * math.pi + 1e-9
+"""rad: largest magnitude of an object's yaw or the start's heading."""
+MAX_NAME = 100
+"""Longest object or scene name, characters."""
+_PAIRS_PER_BATCH = 4096  # candidate pairs whose overlap areas are computed at a time
 
 
 def _is_finite(value: object) -> bool:
     if type(value) is float:  # the common case, without the abstract-class check
         return math.isfinite(value)
-    return isinstance(value, Real) and not isinstance(value, bool) and math.isfinite(value)
+    try:
+        return isinstance(value, Real) and not isinstance(value, bool) and math.isfinite(value)
+    except OverflowError:  # an integer beyond a float's range
+        return False
+
+
+def _numbers(value: object, count: int) -> bool:
+    """Whether ``value`` is a list, tuple or array of ``count`` finite numbers."""
+    if not isinstance(value, tuple | list | np.ndarray) or len(value) != count:
+        return False
+    if isinstance(value, np.ndarray) and value.ndim != 1:
+        return False
+    return all(map(_is_finite, value))
+
+
+def _name_problem(name: object, limit: int) -> str | None:
+    if not isinstance(name, str):
+        return f"name must be text, got {brief(name)}"
+    if len(name) > limit:
+        return f"name is longer than {limit} characters ({brief(name)})"
+    if not name.isprintable():
+        return f"name has control characters ({brief(name)})"
+    return None
 
 
 def _label(obj: SceneObject, role: str) -> str:
     return f"{role} {obj.name!r}"
 
 
-def _object_problems(obj: SceneObject, role: str) -> list[str]:
+def _in_range(value: float, limits: tuple[float, float]) -> bool:
+    return limits[0] <= value <= limits[1]
+
+
+def _object_problems(obj: object, role: str, index: int) -> list[str]:
+    """What is wrong with one object on its own (its placement is checked with the others)."""
+    if not isinstance(obj, SceneObject):
+        return [f"{role} {index}: expected a SceneObject, got {brief(obj)}"]
+    named = _name_problem(obj.name, MAX_NAME)
+    if named is not None:
+        return [f"{role} {index}: {named}"]
+    if not obj.name:
+        return [f"a {role} has no name"]
     problems = []
-    if obj.shape not in SHAPES:
-        problems.append(f"unknown shape {obj.shape!r} (expected one of {', '.join(SHAPES)})")
+    if not isinstance(obj.shape, str) or obj.shape not in SHAPES:
+        problems.append(f"unknown shape {brief(obj.shape)} (expected one of {', '.join(SHAPES)})")
     for attr, value in (("x", obj.x), ("y", obj.y), ("yaw", obj.yaw)):
         if not _is_finite(value):
-            problems.append(f"{attr} must be a finite number, got {value!r}")
+            problems.append(f"{attr} must be a finite number, got {brief(value)}")
+    if _is_finite(obj.yaw) and abs(obj.yaw) > YAW_LIMIT:
+        problems.append(f"yaw must be within +-2 pi rad, got {obj.yaw!r}")
     size = obj.size
-    if len(size) != 3 or not all(map(_is_finite, size)):
-        problems.append(f"size must be 3 finite numbers, got {list(size)!r}")
+    if not _numbers(size, 3):
+        problems.append(f"size must be 3 finite numbers, got {brief(size)}")
     elif min(size) <= 0.0:
         problems.append(f"size must be positive, got {list(size)!r}")
+    elif not all(_in_range(v, SIZE_RANGE) for v in size):
+        problems.append(f"sizes must be between {SIZE_RANGE[0]} and {SIZE_RANGE[1]} m, got {list(size)!r}")
     elif obj.shape == "cylinder" and not math.isclose(size[0], size[1], rel_tol=1e-6, abs_tol=1e-9):
         problems.append(
             "a cylinder's first two sizes are its diameter and must be equal, "
@@ -48,10 +102,10 @@ def _object_problems(obj: SceneObject, role: str) -> list[str]:
     return [f"{_label(obj, role)}: {problem}" for problem in problems]
 
 
-def _off_table(obj: SceneObject, role: str, bounds: tuple[float, ...], scene: Scene) -> str | None:
-    """What sides of the table the footprint ``bounds`` pokes past, if any."""
+def _off_table(obj: SceneObject, role: str, bounds: Sequence[float], table: Table) -> str:
+    """What sides of the table the footprint ``bounds`` pokes past."""
     x_min, y_min, x_max, y_max = bounds
-    tx_min, ty_min, tx_max, ty_max = scene.table.bounds
+    tx_min, ty_min, tx_max, ty_max = table.bounds
     tol = LENGTH_TOLERANCE
     sides = []
     if x_min < tx_min - tol:
@@ -62,53 +116,78 @@ def _off_table(obj: SceneObject, role: str, bounds: tuple[float, ...], scene: Sc
         sides.append(f"{ty_min - y_min:.3f} m past the right edge")
     if y_max > ty_max + tol:
         sides.append(f"{y_max - ty_max:.3f} m past the left edge")
-    if not sides:
-        return None
     return f"{_label(obj, role)} is off the table ({', '.join(sides)})"
 
 
-def scene_problems(scene: Scene) -> list[str]:
-    """Every problem of ``scene``, one message each; empty when the scene is valid."""
+def _scene_shape_problems(scene: Scene) -> list[str]:
+    """The problems of the scene's own fields (table, start, heading, name, obstacle count)."""
     problems: list[str] = []
     table = scene.table
-    table_ok = True
-    for attr in ("length", "width", "height"):
-        value = getattr(table, attr)
-        if not _is_finite(value) or value <= 0.0:
-            problems.append(f"table: {attr} must be a positive number, got {value!r}")
-            table_ok = False
-
-    start_ok = len(scene.start) == 2 and all(_is_finite(v) for v in scene.start)
-    if not start_ok:
-        problems.append(f"start must be 2 finite numbers (x, y), got {list(scene.start)!r}")
+    if not isinstance(table, Table):
+        problems.append(f"table: expected a Table, got {brief(table)}")
+    else:
+        for attr in ("length", "width", "height"):
+            value = getattr(table, attr)
+            if not _is_finite(value) or value <= 0.0:
+                problems.append(f"table: {attr} must be a positive number, got {brief(value)}")
+            elif not _in_range(value, TABLE_RANGE):
+                problems.append(
+                    f"table: {attr} must be between {TABLE_RANGE[0]} and {TABLE_RANGE[1]} m, got {value!r}"
+                )
+    if not _numbers(scene.start, 2):
+        problems.append(f"start must be 2 finite numbers (x, y), got {brief(scene.start)}")
     if not _is_finite(scene.start_yaw):
-        problems.append(f"start_yaw must be a finite number, got {scene.start_yaw!r}")
+        problems.append(f"start_yaw must be a finite number, got {brief(scene.start_yaw)}")
+    elif abs(scene.start_yaw) > YAW_LIMIT:
+        problems.append(f"start_yaw must be within +-2 pi rad, got {scene.start_yaw!r}")
+    named = _name_problem(scene.name, 2 * MAX_NAME)
+    if named is not None:
+        problems.append(f"scene {named}")
+    if not isinstance(scene.obstacles, tuple | list):
+        problems.append(f"obstacles must be a tuple of SceneObjects, got {brief(scene.obstacles)}")
+    elif len(scene.obstacles) > MAX_OBSTACLES:
+        problems.append(f"more than {MAX_OBSTACLES} obstacles ({len(scene.obstacles)})")
+    return problems
+
+
+def scene_problems(scene: Scene) -> list[str]:
+    """Every problem of ``scene``, one message each; empty when the scene is valid. Any object
+    passes (a non-Scene, wrong types, huge numbers): the answer is then its problems."""
+    if not isinstance(scene, Scene):
+        return [f"expected a Scene, got {brief(scene)}"]
+    problems = _scene_shape_problems(scene)
+    if any(p.startswith(("obstacles must", "more than")) for p in problems):
+        return problems
+    table_ok = not any(p.startswith("table:") for p in problems)
+    start_ok = not any(p.startswith("start must") for p in problems)
 
     if scene.target is None:
         problems.append("scene has no target")
-        roles: list[tuple[SceneObject, str]] = []
+        roles: list[tuple[object, str]] = []
     else:
         roles = [(scene.target, "target")]
-        if scene.target.shape != "cylinder":
-            problems.append(f"target {scene.target.name!r} must be a cylinder, got {scene.target.shape!r}")
+        if isinstance(scene.target, SceneObject) and scene.target.shape != "cylinder":
+            problems.append(
+                f"target {scene.target.name!r} must be a cylinder, got {brief(scene.target.shape)}"
+            )
     roles += [(obstacle, "obstacle") for obstacle in scene.obstacles]
 
     seen: set[str] = set()
     sound: list[tuple[SceneObject, str]] = []
-    for obj, role in roles:
-        if not isinstance(obj.name, str) or not obj.name:
-            problems.append(f"a {role} has no name")
-        elif obj.name in seen:
-            problems.append(f"two objects are named {obj.name!r}")
-        seen.add(obj.name)
-        own = _object_problems(obj, role)
+    for index, (obj, role) in enumerate(roles):
+        own = _object_problems(obj, role, index)
+        if isinstance(obj, SceneObject) and isinstance(obj.name, str) and obj.name:
+            if obj.name in seen:
+                problems.append(f"two objects are named {obj.name!r}")
+            seen.add(obj.name)
         problems += own
         if not own:
             sound.append((obj, role))
 
-    bounds = [footprint_bounds(obj) for obj, _ in sound]
-    boxes = np.array(bounds, dtype=float).reshape(-1, 4)
+    shapes = footprints([obj for obj, _ in sound])
+    boxes = np.array([footprint_bounds(obj) for obj, _ in sound], dtype=float).reshape(-1, 4)
     if table_ok:
+        table = scene.table
         if start_ok:
             x, y = scene.start
             x_min, y_min, x_max, y_max = table.bounds
@@ -120,45 +199,39 @@ def scene_problems(scene: Scene) -> list[str]:
             boxes[:, 2:] > edges[2:] + LENGTH_TOLERANCE, axis=1
         )
         for k in np.flatnonzero(outside).tolist():  # the message names the sides
-            problems.append(_off_table(*sound[k], bounds[k], scene))
-    problems += _overlaps(sound, boxes)
+            problems.append(_off_table(*sound[k], boxes[k], table))
+    tree = shapely.STRtree(shapes)
+    problems += _overlaps(sound, shapes, tree)
     if start_ok:
-        problems += _start_inside(sound, bounds, scene.start)
+        point = shapely.Point(float(scene.start[0]), float(scene.start[1]))
+        inside = sorted(tree.query(point, predicate="within").tolist())
+        problems += [f"start point lies inside {_label(*sound[k])}" for k in inside]
     return problems
 
 
-def _overlaps(sound: list[tuple[SceneObject, str]], bounds: np.ndarray) -> list[str]:
-    """A message per pair of footprints sharing more than ``AREA_TOLERANCE`` (only pairs whose
-    bounding boxes meet are intersected)."""
-    problems = []
-    pairs = overlapping_bounds(bounds, BOUNDS_MARGIN).tolist()
-    shape = cache(lambda i: footprint(sound[i][0])) if pairs else None
-    for i, j in pairs:
-        (a, role_a), (b, role_b) = sound[i], sound[j]
-        poly_a, poly_b = shape(i), shape(j)
-        if not poly_a.intersects(poly_b):
-            continue
-        area = poly_a.intersection(poly_b).area
-        if area > AREA_TOLERANCE:
-            problems.append(f"{_label(a, role_a)} and {_label(b, role_b)} overlap ({area * 1e4:.2f} cm^2)")
+def _overlaps(sound: list[tuple[SceneObject, str]], shapes: np.ndarray, tree: shapely.STRtree) -> list[str]:
+    """A message per pair of footprints sharing more than ``AREA_TOLERANCE``, in index order; after
+    ``MAX_PROBLEMS - 1`` pairs one line says more overlap (so a pile of n equal objects costs O(n))."""
+    problems: list[str] = []
+    first, chunk = 0, 1
+    while first < len(shapes):  # chunks of 1, 2, 4, ... 256 objects: a pile is found in the first
+        a, b = tree.query(shapes[first : first + chunk], predicate="intersects")
+        a = a + first
+        first, chunk = first + chunk, min(2 * chunk, 256)
+        keep = a < b
+        order = np.lexsort((b[keep], a[keep]))
+        a, b = a[keep][order], b[keep][order]
+        for start in range(0, len(a), _PAIRS_PER_BATCH):
+            i, j = a[start : start + _PAIRS_PER_BATCH], b[start : start + _PAIRS_PER_BATCH]
+            areas = shapely.area(shapely.intersection(shapes[i], shapes[j]))
+            for k in np.flatnonzero(areas > AREA_TOLERANCE).tolist():
+                if len(problems) == MAX_PROBLEMS - 1:  # with the line below: what an error shows
+                    return [*problems, f"more objects overlap (the first {len(problems)} pairs are listed)"]
+                (obj_a, role_a), (obj_b, role_b) = sound[i[k]], sound[j[k]]
+                problems.append(
+                    f"{_label(obj_a, role_a)} and {_label(obj_b, role_b)} overlap ({areas[k] * 1e4:.2f} cm^2)"
+                )
     return problems
-
-
-def _start_inside(
-    sound: list[tuple[SceneObject, str]], bounds: list[tuple[float, ...]], start: tuple[float, float]
-) -> list[str]:
-    """A message per footprint the start point lies in (only footprints whose box holds it are tested)."""
-    x, y = start
-    m = BOUNDS_MARGIN
-    near = [
-        obj_role
-        for obj_role, (x0, y0, x1, y1) in zip(sound, bounds)
-        if x0 - m < x < x1 + m and y0 - m < y < y1 + m
-    ]
-    point = shapely.Point(x, y) if near else None
-    return [
-        f"start point lies inside {_label(obj, role)}" for obj, role in near if footprint(obj).contains(point)
-    ]
 
 
 def validate_scene(scene: Scene) -> Scene:

@@ -1,0 +1,254 @@
+"""The model-file format as data: ``models.json``'s fields and every array of ``models.npz`` by
+name, dtype and shape, checked before any array is used.
+
+Shapes are written with symbols: a number is a fixed size, a name a size every array that uses it
+must share (``F`` the row-choice features, ``P`` the kept novelty points, ...). The npz members'
+headers are read first (within ``MAX_HEADER``), so a header declaring a huge array is refused
+before anything is allocated; then the values are checked (indices in range, scales positive, every number within ``MAX_VALUE``).
+Every damage is one ``ModelError``.
+
+Trust: ``allow_pickle=False`` and this check make a model file plain data: loading one never runs
+code. The SHA-256 in ``models.json`` only detects damage (anyone who edits the arrays can update it);
+a user who must know the models are the ones they trained pins them with the SHA-256 of their
+``models.json`` (which holds the arrays' digest): ``DecisionModels.load(directory, sha256=...)``,
+or ``planner.models_sha256`` in a scenario.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import tokenize
+import zipfile
+import zlib
+from math import comb
+from typing import Any
+
+import numpy as np
+
+from hlp_drake.documents import brief
+from hlp_drake.errors import ModelError
+from hlp_drake.features.arm import ARM_FEATURES
+from hlp_drake.features.direction import DIRECTION_FEATURES
+from hlp_drake.features.row_choice import ROW_CHOICE_FEATURES
+from hlp_drake.features.scene_features import GAP_FEATURES, OBJECT_FEATURES
+from hlp_drake.features.segment import SEGMENT_FEATURES
+from hlp_drake.learners.arm import CATEGORICAL as ARM_CATEGORICAL
+from hlp_drake.learners.direction import CATEGORICAL as DIRECTION_CATEGORICAL
+from hlp_drake.learners.encoding import N_DIRECTIONS
+from hlp_drake.learners.trees import LEAF
+
+MAX_MODEL_BYTES = 256 * 2**20
+"""Largest ``models.npz`` read, bytes (the bundled one is ~0.5 MB)."""
+MAX_ARRAY_BYTES = 64 * 2**20
+"""Largest single array, bytes."""
+MAX_HEADER = 4096
+"""Longest .npy header read, bytes."""
+MAX_DEPTH = 64
+"""Deepest boosted tree."""
+MAX_VALUE = 1e9
+"""Largest magnitude of a stored number, and the inverse of the smallest scale (trained models
+stay within 1e5; beyond, z-scores and kernels overflow)."""
+
+Spec = tuple[str, tuple[int | str, ...]]
+
+
+def _encoded(features: int, categorical: int) -> int:
+    """Columns after one-hot encoding ``categorical`` of ``features`` columns into directions."""
+    return features - categorical + categorical * N_DIRECTIONS
+
+
+FIXED = {
+    "F": len(ROW_CHOICE_FEATURES),
+    "D": _encoded(len(DIRECTION_FEATURES), len(DIRECTION_CATEGORICAL)),
+    "Q": comb(N_DIRECTIONS, 2),  # the one-vs-one direction pairs
+    "C": N_DIRECTIONS,
+    "A": _encoded(len(ARM_FEATURES), len(ARM_CATEGORICAL)),
+    "O": 2,  # the arm's two angles
+    "Fg": len(GAP_FEATURES),
+    "Fo": len(OBJECT_FEATURES),
+    "Fs": len(SEGMENT_FEATURES),
+}
+"""The sizes the feature code fixes (models of other sizes cannot plan)."""
+
+
+def _svm(prefix: str, features: str) -> dict[str, Spec]:
+    sv = f"S_{prefix}"
+    return {
+        f"{prefix}classes": ("float64", (2,)),
+        f"{prefix}mean": ("float64", (features,)),
+        f"{prefix}scale": ("float64", (features,)),
+        f"{prefix}gamma": ("float64", ()),
+        f"{prefix}support_vectors": ("float64", (sv, features)),
+        f"{prefix}dual_coef": ("float64", (sv,)),
+        f"{prefix}intercept": ("float64", ()),
+    }
+
+
+def _trees(prefix: str) -> dict[str, Spec]:
+    arrays: dict[str, Spec] = {
+        f"{prefix}{name}": (dtype, ("T", "N"))
+        for name, dtype in (
+            ("feature", "int32"),
+            ("threshold", "float64"),
+            ("left", "int32"),
+            ("right", "int32"),
+            ("value", "float64"),
+        )
+    }
+    return arrays | {f"{prefix}depth": ("int64", ()), f"{prefix}offset": ("float64", ())}
+
+
+def expected_arrays(planner: str, row_learner: str) -> dict[str, Spec]:
+    """Every array of a ``models.npz`` of ``planner`` ("rows" or "paper") by name: (dtype, shape)."""
+    arrays: dict[str, Spec] = {}
+    if planner == "rows":
+        arrays |= {"row.classes": ("float64", (2,)), "row.calibration": ("float64", (2,))}
+        arrays |= _trees("row.learner.") if row_learner == "boosted" else _svm("row.learner.", "F")
+        arrays |= {
+            "row.novelty.mean": ("float64", ("F",)),
+            "row.novelty.scale": ("float64", ("F",)),
+            "row.novelty.points": ("float64", ("P", "F")),
+            "row.novelty.neighbours": ("int64", ()),
+            "row.novelty.threshold": ("float64", ()),
+        }
+    else:
+        for name, features in (("gap", "Fg"), ("object", "Fo"), ("segment", "Fs")):
+            arrays |= _svm(f"{name}.", features)
+    arrays |= {
+        "direction.classes": ("float64", ("C",)),
+        "direction.coef": ("float64", ("Q", "D")),
+        "direction.intercept": ("float64", ("Q",)),
+    }
+    arrays |= {f"arm.{name}": ("float64", ("A",)) for name in ("mean", "scale")}
+    arrays |= {"arm.train": ("float64", ("M", "A")), "arm.alpha": ("float64", ("O", "M"))}
+    arrays |= {
+        f"arm.{name}": ("float64", ("O",)) for name in ("length_scale", "amplitude", "y_mean", "y_std")
+    }
+    arrays |= {
+        "arm.outputs": ("int64", ()),
+        "priors.start_arm": ("float64", (2,)),
+        "priors.link_lengths": ("float64", (2,)),
+    }
+    return arrays
+
+
+def _header(member: Any) -> tuple[tuple[int, ...], np.dtype]:
+    version = np.lib.format.read_magic(member)
+    read = {(1, 0): np.lib.format.read_array_header_1_0, (2, 0): np.lib.format.read_array_header_2_0}.get(
+        version
+    )
+    if read is None:
+        raise ValueError(f"unknown .npy version {version}")
+    try:
+        shape, fortran, dtype = read(member, max_header_size=MAX_HEADER)
+    except (SyntaxError, TypeError, RecursionError, tokenize.TokenError) as error:
+        # numpy's header parser: literal_eval, then its Python 2 header filter (tokenize)
+        raise ValueError(f"unreadable .npy header ({type(error).__name__})") from None
+    if fortran:
+        raise ValueError("Fortran-ordered array")
+    return shape, dtype
+
+
+def _check_shape(
+    name: str, spec: Spec, shape: tuple[int, ...], dtype: np.dtype, sizes: dict[str, int]
+) -> None:
+    kind, dims = spec
+    if dtype != np.dtype(kind):
+        raise ValueError(f"array {name!r} has dtype {dtype}, the format has {kind}")
+    if len(shape) != len(dims):
+        raise ValueError(f"array {name!r} has shape {shape}, the format has {len(dims)} dimensions")
+    for size, dim in zip(shape, dims):
+        want = dim if isinstance(dim, int) else sizes.setdefault(dim, size)
+        if size != want or size < 1:
+            raise ValueError(f"array {name!r} has shape {shape}, the format needs {dim} = {want}")
+    if int(np.prod(shape, dtype=np.int64)) * dtype.itemsize > MAX_ARRAY_BYTES:
+        raise ValueError(f"array {name!r} of shape {shape} is larger than {MAX_ARRAY_BYTES // 2**20} MiB")
+
+
+def read_arrays(payload: bytes, expected: dict[str, Spec]) -> dict[str, np.ndarray]:
+    """The arrays of the npz ``payload``, each checked against ``expected`` before it is read.
+
+    Raises:
+        ValueError: any damage (a member missing, unexpected or of another dtype or shape, a size
+            inconsistent with the others, a broken zip or header).
+    """
+    sizes = dict(FIXED)
+    try:
+        with zipfile.ZipFile(io.BytesIO(payload)) as archive:
+            infos = archive.infolist()
+            names = [info.filename.removesuffix(".npy") for info in infos]
+            if len(set(names)) != len(names):
+                raise ValueError("an array is stored twice")
+            unknown, missing = sorted(set(names) - set(expected)), sorted(set(expected) - set(names))
+            if unknown or missing:
+                raise ValueError(
+                    f"arrays {brief(unknown)} are not in the format"
+                    if unknown
+                    else f"missing arrays {brief(missing)}"
+                )
+            for info, name in zip(infos, names):
+                if info.file_size > MAX_ARRAY_BYTES + MAX_HEADER:
+                    raise ValueError(f"array {name!r} is larger than {MAX_ARRAY_BYTES // 2**20} MiB")
+                with archive.open(info) as member:
+                    shape, dtype = _header(member)
+                    _check_shape(name, expected[name], shape, dtype, sizes)
+                    if member.tell() + int(np.prod(shape)) * dtype.itemsize != info.file_size:
+                        raise ValueError(f"array {name!r} is truncated or padded")
+            with np.load(io.BytesIO(payload), allow_pickle=False) as npz:
+                return {name: npz[name] for name in expected}
+    except (OSError, EOFError, zipfile.BadZipFile, zlib.error, NotImplementedError, RuntimeError) as error:
+        raise ValueError(f"unreadable arrays ({type(error).__name__})") from None
+
+
+def _range(name: str, values: np.ndarray, low: float, high: float) -> None:
+    if values.size and (values.min() < low or values.max() > high):
+        raise ValueError(f"array {name!r} has values outside [{low:g}, {high:g}]")
+
+
+def check_values(arrays: dict[str, np.ndarray]) -> None:
+    """Raise ``ValueError`` for values the planner cannot use (checked shapes assumed)."""
+    for name, values in arrays.items():
+        if values.dtype.kind == "f" and not np.all(np.isfinite(values)):
+            raise ValueError(f"array {name!r} has non-finite values")
+        if values.dtype.kind == "f":
+            _range(name, values, -MAX_VALUE, MAX_VALUE)
+    positive = [
+        n
+        for n in arrays
+        if n.endswith(("scale", "gamma", "threshold", "y_std", "length_scale"))
+        and not n.endswith("learner.threshold")
+    ]
+    for name in positive:
+        _range(name, arrays[name], 1 / MAX_VALUE, MAX_VALUE)
+    if "row.learner.feature" in arrays:
+        nodes = arrays["row.learner.feature"].shape[1]
+        _range("row.learner.feature", arrays["row.learner.feature"], 0, FIXED["F"] - 1)
+        for side in ("left", "right"):
+            _range(f"row.learner.{side}", arrays[f"row.learner.{side}"], LEAF, nodes - 1)
+        if np.any((arrays["row.learner.left"] == LEAF) != (arrays["row.learner.right"] == LEAF)):
+            raise ValueError("array 'row.learner.left' and 'row.learner.right' disagree on the leaves")
+        _range("row.learner.depth", arrays["row.learner.depth"], 0, min(MAX_DEPTH, nodes))
+    if "row.novelty.neighbours" in arrays:
+        _range(
+            "row.novelty.neighbours", arrays["row.novelty.neighbours"], 1, len(arrays["row.novelty.points"])
+        )
+    for name in [n for n in arrays if n.endswith("classes")]:
+        if len(np.unique(arrays[name])) != len(arrays[name]):
+            raise ValueError(f"array {name!r} repeats a class")
+    _range("arm.outputs", arrays["arm.outputs"], 0, FIXED["O"])
+
+
+def digest(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def check_pin(meta_bytes: bytes, sha256: str | None, where: str) -> None:
+    """Refuse ``models.json`` (its bytes) unless its SHA-256 is ``sha256`` (when one is given)."""
+    if sha256 is None or sha256 == "":
+        return
+    if digest(meta_bytes) != sha256.strip().lower():
+        raise ModelError(
+            f"{where}: SHA-256 {digest(meta_bytes)[:16]}... is not the pinned {brief(sha256)} "
+            "(these are not the trusted models)"
+        )

@@ -1,0 +1,61 @@
+"""Worker processes that leave Ctrl-C to their parent.
+
+A Ctrl-C in a terminal reaches the whole process group: the command and every worker it started.
+A worker that took it as a KeyboardInterrupt would print its own traceback; instead, workers are
+spawned with SIGINT blocked (the mask is inherited, so even a worker still starting up cannot see
+it), then ignore it and unblock it before their first task. The parent alone turns it into a
+KeyboardInterrupt (``cli.run_cli``: one line, exit 130) and stops the workers
+(``terminate_workers``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import multiprocessing
+import signal
+import threading
+from collections.abc import Iterator
+from concurrent.futures import ProcessPoolExecutor
+
+
+def ignore_interrupts() -> None:
+    """In a worker: ignore SIGINT (the parent handles it), then unblock it."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
+@contextlib.contextmanager
+def interrupts_held() -> Iterator[None]:
+    """Hold SIGINT back from this thread (and the processes it starts) inside the block; one that
+    arrives meanwhile is delivered, as a KeyboardInterrupt, when the block ends."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+def worker_pool(workers: int, *, method: str | None = "spawn") -> ProcessPoolExecutor:
+    """A process pool whose workers ignore SIGINT. Submit its first ``workers`` tasks inside
+    ``interrupts_held()``: processes start on submission.
+
+    Args:
+        method: the multiprocessing start method ("spawn": fresh interpreters, needed once Drake is
+            imported; None: the platform's default).
+    """
+    context = multiprocessing.get_context(method)
+    return ProcessPoolExecutor(workers, mp_context=context, initializer=ignore_interrupts)
+
+
+def terminate_workers(pool: ProcessPoolExecutor) -> None:
+    """Stop the pool's processes now: a task inside a long Drake call would not end soon."""
+    terminate = getattr(pool, "terminate_workers", None)  # Python >= 3.14
+    if terminate is not None:
+        terminate()
+        return
+    processes = getattr(pool, "_processes", None) or {}  # private before 3.14, hence the fallbacks
+    for process in list(processes.values()):
+        process.terminate()

@@ -1,0 +1,118 @@
+"""The fuzz suite's profiles and hostile values (hypothesis).
+
+Every fuzz test runs twice: the ``fast`` profile in the default run (few examples, derandomized so
+CI sees the same inputs every time) and the ``long`` profile marked ``slow`` (``pytest -m slow``;
+thousands of random examples: the figures of docs/method.md#hostile-input). ``STATS`` counts what
+the checks saw; ``conftest.py`` prints it at the end of a run.
+"""
+
+from __future__ import annotations
+
+import collections
+import contextlib
+import math
+import tempfile
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from hlp_drake.errors import MAX_LINE, MAX_PROBLEMS, HlpError
+
+PROFILES = [pytest.param("fast", id="fast"), pytest.param("long", id="long", marks=pytest.mark.slow)]
+STATS: collections.Counter[str] = collections.Counter()
+
+
+def run(
+    profile: str, examples: tuple[int, int], strategy: st.SearchStrategy, check: Callable[[Any], None]
+) -> None:
+    """Run ``check`` on ``examples[0]`` (fast) or ``examples[1]`` (long) values of ``strategy``."""
+    fast = profile == "fast"
+    options = settings(
+        max_examples=examples[0] if fast else examples[1],
+        deadline=None,
+        derandomize=fast,
+        database=None,
+        print_blob=not fast,
+        suppress_health_check=[
+            HealthCheck.too_slow,
+            HealthCheck.data_too_large,
+            HealthCheck.filter_too_much,
+            HealthCheck.large_base_example,
+        ],
+    )
+
+    def example(value: Any) -> None:  # a new function per run: settings apply to one function once
+        check(value)
+
+    given(strategy)(options(example))()
+
+
+def check_error(error: HlpError) -> None:
+    """A user error is a few short lines (the README's promise)."""
+    assert 1 <= len(error.problems) <= MAX_PROBLEMS + 1
+    assert all(len(line) <= MAX_LINE and "\n" not in line for line in error.problems), error.problems
+
+
+@contextlib.contextmanager
+def scene_file(case: tuple[str, str]) -> Iterator[Path]:
+    """A temporary file ``scene<suffix>`` holding ``text`` (a ``scene_texts`` case), even invalid UTF-8."""
+    suffix, text = case
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / f"scene{suffix}"
+        path.write_text(text, encoding="utf-8", errors="surrogatepass")
+        yield path
+
+
+HUGE_INT = 10**400
+numbers = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from([HUGE_INT, -HUGE_INT, 2**63, -(2**63) - 1, 1e160, 1e308, -1e308, 5e-324, -0.0, 0, 1, -1]),
+    st.integers(min_value=-(10**30), max_value=10**30),
+)
+junk = st.one_of(
+    numbers,
+    st.none(),
+    st.booleans(),
+    st.text(max_size=30),
+    st.text(min_size=290, max_size=400),
+    st.lists(st.integers(), max_size=5),
+    st.dictionaries(st.text(max_size=5), st.integers(), max_size=3),
+)
+"""Values that do not belong where they are put."""
+
+
+def _places(value: Any):
+    """Every (container, key) in a parsed document, depth first."""
+    items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
+    for key, sub in items:
+        yield value, key
+        yield from _places(sub)
+
+
+def mutate(document: dict, draw: Callable, most: int = 3) -> dict:
+    """Up to ``most`` random edits of the parsed ``document`` (in place): a value replaced by junk
+    or nudged (valid-looking documents the generators would not make), a key deleted or added."""
+    for _ in range(draw(st.integers(0, most))):
+        places = list(_places(document))
+        if not places:
+            break
+        container, key = places[draw(st.integers(0, len(places) - 1))]
+        operation = draw(st.sampled_from(["junk", "nudge", "nudge", "delete", "unknown"]))
+        value = container[key]
+        if operation == "junk":
+            container[key] = draw(junk)
+        elif operation == "nudge" and isinstance(value, int | float) and not isinstance(value, bool):
+            factor = draw(st.floats(0.5, 1.5))
+            try:
+                container[key] = value * factor if math.isfinite(value) and value else factor - 1.0
+            except OverflowError:  # an integer beyond floats (a junk value put there before): kept
+                pass
+        elif operation == "delete":
+            container.pop(key)
+        elif operation == "unknown" and isinstance(container, dict):
+            container[draw(st.text(min_size=1, max_size=8))] = draw(junk)
+    return document

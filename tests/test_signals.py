@@ -1,0 +1,79 @@
+"""Ctrl-C to the whole process group (what a terminal sends) during ``run_scene`` with rollout workers.
+
+Expected at any moment: exit status 130, stderr the one line "interrupted" (no worker's
+KeyboardInterrupt traceback), no output file, and no process of the group left behind.
+"""
+
+from __future__ import annotations
+
+import os
+import selectors
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+_READY = "rollout workers ready"
+
+
+def _interrupt(tmp_path, *, after: str | None, delay: float) -> None:
+    out = tmp_path / "run.json"
+    process = subprocess.Popen(
+        [sys.executable, "-m", "hlp_drake.run_scene", "--workers", "2", "--quiet", "--json", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+        cwd=tmp_path,
+    )
+    seen = ""
+    if after is not None:  # wait for the line, then for ``delay``
+        selector = selectors.DefaultSelector()
+        selector.register(process.stdout, selectors.EVENT_READ)
+        deadline = time.monotonic() + 120
+        while after not in seen and time.monotonic() < deadline and process.poll() is None:
+            if selector.select(timeout=1.0):
+                seen += process.stdout.readline()
+        assert after in seen, seen
+    time.sleep(delay)
+    os.killpg(process.pid, signal.SIGINT)
+    stdout, stderr = process.communicate(timeout=120)
+    assert process.returncode == 130, (seen + stdout, stderr)
+    assert stderr == "interrupted\n", stderr
+    assert not out.exists() and not list(tmp_path.glob(".run.json.*"))
+    deadline = time.monotonic() + 10  # the workers are gone too (reaped by init once the command exits)
+    while _group_alive(process.pid) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert not _group_alive(process.pid)
+
+
+def _group_alive(group: int) -> bool:
+    try:
+        os.killpg(group, 0)
+    except ProcessLookupError:
+        return False
+    return True
+
+
+def test_ctrl_c_while_optimising_is_one_line_and_exit_130(tmp_path):
+    _interrupt(tmp_path, after=_READY, delay=1.5)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    ("after", "delay"),
+    [
+        (None, 0.3),
+        (None, 1.5),
+        ("starting", 0.5),
+        ("starting", 2.5),
+        (_READY, 0.0),
+        (_READY, 3.0),
+        (_READY, 6.0),
+        (_READY, 9.0),
+    ],
+)
+def test_ctrl_c_at_any_moment_is_one_line_and_exit_130(tmp_path, after, delay):
+    _interrupt(tmp_path, after=after, delay=delay)

@@ -39,8 +39,12 @@ def row_evidence(models: DecisionModels, kind: str, objects: int | None, scenes:
             novelty += values
             rows.append(min(values, default=np.inf) <= 1.0)
     novelty = np.array(novelty)
-    return {"candidates": len(novelty), "with_evidence": float(np.mean(novelty <= 1.0)),
-            "rows_with_evidence": float(np.mean(rows)), "median_novelty": float(np.median(novelty))}
+    return {
+        "candidates": len(novelty),
+        "with_evidence": float(np.mean(novelty <= 1.0)),
+        "rows_with_evidence": float(np.mean(rows)),
+        "median_novelty": float(np.median(novelty)),
+    }
 
 
 def paper_evidence(models: DecisionModels, kind: str, objects: int | None, scenes: int) -> dict[str, float]:
@@ -50,7 +54,9 @@ def paper_evidence(models: DecisionModels, kind: str, objects: int | None, scene
     for seed in range(scenes):
         space = TaskSpace(generate_scene(kind, seed, objects))
         margins["gap"].append(models.gap.decision_function(gap_features(space)) - models.gap.intercept_)
-        margins["object"].append(models.object.decision_function(object_features(space)) - models.object.intercept_)
+        margins["object"].append(
+            models.object.decision_function(object_features(space)) - models.object.intercept_
+        )
     values = np.concatenate(margins["gap"] + margins["object"])
     out = {"candidates": len(values), "with_evidence": float(np.mean(informed(values, 0.0, min_evidence)))}
     for name, parts in margins.items():
@@ -67,14 +73,18 @@ def main() -> None:
     models = DecisionModels.load(args.models) if args.models else default_models()
     measure = row_evidence if models.planner == "rows" else paper_evidence
     results = {}
-    print(f"{models.planner} planner's models ({models.settings.row_learner if models.planner == 'rows' else 'paper'})")
+    print(
+        f"{models.planner} planner's models ({models.settings.row_learner if models.planner == 'rows' else 'paper'})"
+    )
     print(f"{'scenes':<14} {'candidates':>10} {'with evidence':>14}")
     for kind, objects in KINDS:
         label = kind if objects is None else f"{kind}-{objects}"
         row = results[label] = measure(models, kind, objects, args.scenes)
         print(f"{label:<14} {row['candidates']:>10d} {row['with_evidence']:>14.1%}")
     if args.json:
-        args.json.write_text(json.dumps({"scenes": args.scenes, "planner": models.planner, **results}, indent=2) + "\n")
+        args.json.write_text(
+            json.dumps({"scenes": args.scenes, "planner": models.planner, **results}, indent=2) + "\n"
+        )
 
 
 if __name__ == "__main__":

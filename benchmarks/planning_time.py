@@ -63,18 +63,34 @@ def two_row_scene(objects: int, seed: int) -> Scene:
     for row, (count, x) in enumerate(zip(per_row, (0.35, 0.6)), start=1):
         slots = np.linspace(-width / 2 + 0.08, width / 2 - 0.08, count)
         for i, y in enumerate(slots):
-            obstacles.append(SceneObject(f"r{row}_{i}", "box", x, float(y + rng.uniform(-0.01, 0.01)),
-                                         (0.05, float(rng.uniform(0.05, 0.08)), 0.12)))
-    return Scene(Table(1.0, width, 0.75), (0.1, 0.0), SceneObject("Target", "cylinder", 0.85, 0.0, (0.06, 0.06, 0.12)),
-                 tuple(obstacles), name=f"two-row-{objects}-{seed}")
+            obstacles.append(
+                SceneObject(
+                    f"r{row}_{i}",
+                    "box",
+                    x,
+                    float(y + rng.uniform(-0.01, 0.01)),
+                    (0.05, float(rng.uniform(0.05, 0.08)), 0.12),
+                )
+            )
+    return Scene(
+        Table(1.0, width, 0.75),
+        (0.1, 0.0),
+        SceneObject("Target", "cylinder", 0.85, 0.0, (0.06, 0.06, 0.12)),
+        tuple(obstacles),
+        name=f"two-row-{objects}-{seed}",
+    )
 
 
 def scene_groups(dataset_path: str, count: int) -> tuple[dict[str, list[Scene]], dict[str, str]]:
     """The scenes of every group, and the groups the generator could not make (with the reason)."""
     dataset = Dataset(dataset_path, progress=False)
     _, test = subject_splits(dataset.subjects, n_train=19, splits=1, seed=0)[0]
-    groups = {"vr_structured": [dataset.scene(r.key) for r in demonstration_records(dataset, test, (STRUCTURED,))],
-              "vr_unstructured": [dataset.scene(r.key) for r in demonstration_records(dataset, None, (UNSTRUCTURED,))]}
+    groups = {
+        "vr_structured": [dataset.scene(r.key) for r in demonstration_records(dataset, test, (STRUCTURED,))],
+        "vr_unstructured": [
+            dataset.scene(r.key) for r in demonstration_records(dataset, None, (UNSTRUCTURED,))
+        ],
+    }
     failed = {}
     for objects in (6, 12, 25, 50):
         try:
@@ -98,10 +114,21 @@ def time_rounds(groups: dict[str, list[Scene]], pythons: dict[str, str], rounds:
                 out = Path(tmp) / f"{name}.json"
                 subprocess.run([pythons[name], "-c", WORKER, str(scenes), str(out)], cwd=tmp, check=True)
                 times = {g: np.array(t) for g, t in json.loads(out.read_text()).items()}
-                best[name] = times if name not in best else {g: np.minimum(best[name][g], t) for g, t in times.items()}
-    return {name: {g: {"scenes": len(t), "median_ms": float(np.median(t) * 1e3), "p95_ms": float(np.percentile(t, 95) * 1e3),
-                       "p99_ms": float(np.percentile(t, 99) * 1e3)} for g, t in per_group.items()}
-            for name, per_group in best.items()}
+                best[name] = (
+                    times if name not in best else {g: np.minimum(best[name][g], t) for g, t in times.items()}
+                )
+    return {
+        name: {
+            g: {
+                "scenes": len(t),
+                "median_ms": float(np.median(t) * 1e3),
+                "p95_ms": float(np.percentile(t, 95) * 1e3),
+                "p99_ms": float(np.percentile(t, 99) * 1e3),
+            }
+            for g, t in per_group.items()
+        }
+        for name, per_group in best.items()
+    }
 
 
 def plot(report: dict, path: str) -> None:
@@ -111,7 +138,9 @@ def plot(report: dict, path: str) -> None:
         medians = [report["planners"][name][g]["median_ms"] for g in groups]
         p99 = [report["planners"][name][g]["p99_ms"] - m for g, m in zip(groups, medians)]
         x = np.arange(len(groups)) + (k - 0.5) * 0.4
-        axes.bar(x, medians, 0.4, yerr=[np.zeros(len(groups)), p99], capsize=2, label=f"{name} (median, to p99)")
+        axes.bar(
+            x, medians, 0.4, yerr=[np.zeros(len(groups)), p99], capsize=2, label=f"{name} (median, to p99)"
+        )
     axes.set_xticks(np.arange(len(groups)), groups, rotation=30, ha="right", fontsize=8)
     axes.set_ylabel("planning time per scene, ms")
     axes.grid(axis="y", alpha=0.3)
@@ -124,7 +153,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--dataset", default=str(DEFAULT))
     parser.add_argument("--scenes", type=int, default=50, help="generated scenes per object count")
-    parser.add_argument("--rounds", type=int, default=3, help="plan every scene this often, keep its fastest time")
+    parser.add_argument(
+        "--rounds", type=int, default=3, help="plan every scene this often, keep its fastest time"
+    )
     parser.add_argument("--baseline", type=Path, help="a checkout with its own .venv to time beside this one")
     parser.add_argument("--json")
     parser.add_argument("--png")
@@ -133,12 +164,21 @@ def main() -> None:
     pythons = {"this": sys.executable}
     if args.baseline is not None:
         pythons["baseline"] = str(args.baseline.resolve() / ".venv" / "bin" / "python")
-    report = {"machine": f"{platform.processor() or platform.machine()}, Python {platform.python_version()}",
-              "rounds": args.rounds, "baseline": str(args.baseline) if args.baseline else None,
-              "rows_mean": {g: float(np.mean([len(TaskSpace(s).rows) for s in scenes])) for g, scenes in groups.items()},
-              "not_generated": failed, "planners": time_rounds(groups, pythons, args.rounds)}
-    print(f"{'group':18s} {'rows':>5s}" + "".join(f" {n + ' median':>16s} {'p95':>7s} {'p99':>7s}" for n in pythons)
-          + ("   ratio" if len(pythons) > 1 else ""))
+    report = {
+        "machine": f"{platform.processor() or platform.machine()}, Python {platform.python_version()}",
+        "rounds": args.rounds,
+        "baseline": str(args.baseline) if args.baseline else None,
+        "rows_mean": {
+            g: float(np.mean([len(TaskSpace(s).rows) for s in scenes])) for g, scenes in groups.items()
+        },
+        "not_generated": failed,
+        "planners": time_rounds(groups, pythons, args.rounds),
+    }
+    print(
+        f"{'group':18s} {'rows':>5s}"
+        + "".join(f" {n + ' median':>16s} {'p95':>7s} {'p99':>7s}" for n in pythons)
+        + ("   ratio" if len(pythons) > 1 else "")
+    )
     for g in groups:
         line = f"{g:18s} {report['rows_mean'][g]:5.1f}"
         for name in pythons:

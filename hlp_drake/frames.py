@@ -15,9 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 
-def unity_to_world(
-    points: np.ndarray, *, table_front_z: float, table_center_x: float = 0.0
-) -> np.ndarray:
+def unity_to_world(points: np.ndarray, *, table_front_z: float, table_center_x: float = 0.0) -> np.ndarray:
     """Convert Unity positions (..., 3) in (x, y, z) order into world positions (..., 3).
 
     Args:

@@ -1,8 +1,8 @@
 """``python -m hlp_drake.segment``: segment the VR demonstrations into per-row decisions.
 
-    python -m hlp_drake.segment [--dataset PATH] [--mode fixed|faithful] [--category structured|unstructured]
-        --out demos.csv
-    python -m hlp_drake.segment --trial sub_01/T050 --png OUT.png [--mode ...]
+python -m hlp_drake.segment [--dataset PATH] [--mode fixed|faithful] [--category structured|unstructured]
+    --out demos.csv
+python -m hlp_drake.segment --trial sub_01/T050 --png OUT.png [--mode ...]
 """
 
 from __future__ import annotations
@@ -40,8 +40,18 @@ def demonstrations_csv(result: SegmentationResult) -> str:
     writer.writerow(CSV_COLUMNS)
     for demo in result.demonstrations:
         for d in demo.decisions:
-            writer.writerow([demo.subject, demo.trial, d.row, d.decision, d.element, d.direction or "",
-                             len(demo.keypoints), "left" if demo.left_handed else "right"])
+            writer.writerow(
+                [
+                    demo.subject,
+                    demo.trial,
+                    d.row,
+                    d.decision,
+                    d.element,
+                    d.direction or "",
+                    len(demo.keypoints),
+                    "left" if demo.left_handed else "right",
+                ]
+            )
     return out.getvalue()
 
 
@@ -53,8 +63,12 @@ def report(result: SegmentationResult, total: int, seconds: float, category: str
         lines.append("object-row flags: " + ", ".join(f"{list(k)} {v}" for k, v in sorted(flags.items())))
     decisions = Counter(d.decision for demo in result.demonstrations for d in demo.decisions)
     rows = Counter(len(demo.decisions) for demo in result.demonstrations)
-    lines.append("rows per trial: " + ", ".join(f"{k}: {v}" for k, v in sorted(rows.items()))
-                 + "; row decisions: " + ", ".join(f"{k} {v}" for k, v in sorted(decisions.items())))
+    lines.append(
+        "rows per trial: "
+        + ", ".join(f"{k}: {v}" for k, v in sorted(rows.items()))
+        + "; row decisions: "
+        + ", ".join(f"{k} {v}" for k, v in sorted(decisions.items()))
+    )
     lines.append(f"agreement with the interaction logs (first PickedUp obstacle per row): {agreement:.1%}")
     for reason, count in result.reasons().most_common():
         lines.append(f"rejected {count}: {reason}")
@@ -63,13 +77,23 @@ def report(result: SegmentationResult, total: int, seconds: float, category: str
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = make_parser("python -m hlp_drake.segment", __doc__)
-    parser.add_argument("--dataset", help="the archive or the unpacked dataset/ folder (default: $HLP_DATASET)")
-    parser.add_argument("--mode", choices=MODES, default=DEFAULT_MODE,
-                        help="fixed: what the paper says (default); faithful: the released code, bugs included")
+    parser.add_argument(
+        "--dataset", help="the archive or the unpacked dataset/ folder (default: $HLP_DATASET)"
+    )
+    parser.add_argument(
+        "--mode",
+        choices=MODES,
+        default=DEFAULT_MODE,
+        help="fixed: what the paper says (default); faithful: the released code, bugs included",
+    )
     parser.add_argument("--out", help="CSV of the per-row decisions of every kept trial")
     parser.add_argument("--json", help="also write the counts and every rejection as JSON")
-    parser.add_argument("--category", choices=(STRUCTURED, UNSTRUCTURED), default=STRUCTURED,
-                        help="the successful trials to segment (default structured; unstructured: fixed mode)")
+    parser.add_argument(
+        "--category",
+        choices=(STRUCTURED, UNSTRUCTURED),
+        default=STRUCTURED,
+        help="the successful trials to segment (default structured; unstructured: fixed mode)",
+    )
     parser.add_argument("--trial", help="segment one trial, e.g. sub_01/T050 (with --png)")
     parser.add_argument("--png", help="picture of --trial's segmentation")
     add_quiet(parser)
@@ -79,7 +103,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.trial is not None and args.png is None:
         parser.error("--trial needs --png")
     if args.category == UNSTRUCTURED and args.mode == "faithful":
-        parser.error("unstructured trials are segmented in fixed mode only (the released code reads two rows)")
+        parser.error(
+            "unstructured trials are segmented in fixed mode only (the released code reads two rows)"
+        )
     dataset = Dataset(args.dataset)
     if args.trial is not None:
         if args.trial not in dataset:
@@ -101,7 +127,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     write_text_atomic(args.out, demonstrations_csv(result))
     if args.json:
         summary = {
-            "mode": result.mode, "category": args.category, "trials": total, "kept": len(result.demonstrations),
+            "mode": result.mode,
+            "category": args.category,
+            "trials": total,
+            "kept": len(result.demonstrations),
             "log_agreement": agreement,
             "flags": {"".join(map(str, k)): v for k, v in sorted(result.flag_counts().items())},
             "rejection_reasons": dict(result.reasons()),

@@ -24,12 +24,22 @@ from hlp_drake.segmentation import DEFAULT_MODE, MODES, demonstration_records, s
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = make_parser("python -m hlp_drake.train", __doc__)
-    parser.add_argument("--dataset", help="the archive or the unpacked dataset/ folder (default: $HLP_DATASET)")
+    parser.add_argument(
+        "--dataset", help="the archive or the unpacked dataset/ folder (default: $HLP_DATASET)"
+    )
     parser.add_argument("--mode", choices=MODES, default=DEFAULT_MODE)
-    parser.add_argument("--preset", choices=sorted(PRESETS), default=DEFAULT_PRESET,
-                        help=f"{DEFAULT_PRESET} (default, the bundled models), svm, or paper (reference section 5)")
-    parser.add_argument("--categories", nargs="+", choices=(STRUCTURED, UNSTRUCTURED),
-                        help="the trials to learn from (default: structured and unstructured; faithful: structured)")
+    parser.add_argument(
+        "--preset",
+        choices=sorted(PRESETS),
+        default=DEFAULT_PRESET,
+        help=f"{DEFAULT_PRESET} (default, the bundled models), svm, or paper (reference section 5)",
+    )
+    parser.add_argument(
+        "--categories",
+        nargs="+",
+        choices=(STRUCTURED, UNSTRUCTURED),
+        help="the trials to learn from (default: structured and unstructured; faithful: structured)",
+    )
     parser.add_argument("--subjects", nargs="+", help="train on these subjects only (default: all)")
     parser.add_argument("--out", required=True, help="directory for models.json and models.npz")
     add_quiet(parser)
@@ -49,12 +59,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     segmented = time.perf_counter()
     models = DecisionModels(PRESETS[args.preset]).fit(data)
     models.save(args.out)
-    print(f"segmented {len(result.demonstrations)} demonstrations of {len(models.subjects_)} subjects "
-          f"({args.mode} mode) in {segmented - started:.1f} s; fitted {args.preset} models in "
-          f"{time.perf_counter() - segmented:.1f} s")
+    print(
+        f"segmented {len(result.demonstrations)} demonstrations of {len(models.subjects_)} subjects "
+        f"({args.mode} mode) in {segmented - started:.1f} s; fitted {args.preset} models in "
+        f"{time.perf_counter() - segmented:.1f} s"
+    )
     counts = Counter(category_of(d.trial) for d in result.demonstrations)
-    print("trials: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())) + "; rows: " + ", ".join(
-        f"{name} {len(getattr(data, name))}" for name in models.learners))
+    print(
+        "trials: "
+        + ", ".join(f"{k} {v}" for k, v in sorted(counts.items()))
+        + "; rows: "
+        + ", ".join(f"{name} {len(getattr(data, name))}" for name in models.learners)
+    )
     print(f"wrote {args.out}/models.json and models.npz")
     return 0
 

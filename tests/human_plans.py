@@ -26,16 +26,21 @@ def keypoints(scene: Scene, steps: list[Step]) -> tuple[PlanKeypoint, ...]:
             out.append(PlanKeypoint("gap", gap.center, int(what), str(how)))
         else:
             rect, row = space.rects[what], row_of[what]
-            out += [PlanKeypoint("move", rect.center, row, what, how),
-                    PlanKeypoint("release", relocated(rect, how, space.alpha).center, row, what, how)]
+            out += [
+                PlanKeypoint("move", rect.center, row, what, how),
+                PlanKeypoint("release", relocated(rect, how, space.alpha).center, row, what, how),
+            ]
     out.append(PlanKeypoint("target", space.target.center, None, scene.target.name))
     return tuple(out)
 
 
 def human_plan(scene: Scene, steps: list[Step], alternatives: list[list[Step]] = ()) -> HighLevelPlan:
     """The plan of ``steps`` (and its next candidates ``alternatives``, best first)."""
-    return HighLevelPlan(scene.name, keypoints(scene, steps),
-                         alternatives=tuple(PlanCandidate(keypoints(scene, a), 0.0) for a in alternatives))
+    return HighLevelPlan(
+        scene.name,
+        keypoints(scene, steps),
+        alternatives=tuple(PlanCandidate(keypoints(scene, a), 0.0) for a in alternatives),
+    )
 
 
 # gen1 seed 27: a backward move with no room for the robot's sideways push, then a push to the right.
@@ -43,18 +48,44 @@ GEN1_27 = [("move", "FailOnTouchObstacleMed", "BL"), ("move", "FailOnTouchObstac
 # gen1 seed 19: through gap 2, then FailOnTouchObstacleLong-1 forwards, over the table.
 GEN1_19 = [("gap", 1, 2), ("move", "FailOnTouchObstacleLong-1", "FF")]
 # gen2 seed 12, 9 objects.
-GEN2_9_12 = [("move", "obstacle_4", "BL"), ("gap", 2, 2), ("move", "obstacle_1", "RR"), ("gap", 4, 3), ("gap", 5, 2)]
+GEN2_9_12 = [
+    ("move", "obstacle_4", "BL"),
+    ("gap", 2, 2),
+    ("move", "obstacle_1", "RR"),
+    ("gap", 4, 3),
+    ("gap", 5, 2),
+]
 # gen2 seed 39, 9 objects, and its next four candidates.
-GEN2_9_39 = [("move", "obstacle_1", "FF"), ("move", "obstacle_9", "LL"), ("move", "obstacle_6", "FF"),
-             ("move", "obstacle_3", "LL"), ("gap", 5, 1)]
+GEN2_9_39 = [
+    ("move", "obstacle_1", "FF"),
+    ("move", "obstacle_9", "LL"),
+    ("move", "obstacle_6", "FF"),
+    ("move", "obstacle_3", "LL"),
+    ("gap", 5, 1),
+]
 GEN2_9_39_NEXT = [
-    [("gap", 1, 3), ("move", "obstacle_9", "LL"), ("move", "obstacle_6", "FF"), ("move", "obstacle_3", "LL"),
-     ("gap", 5, 1)],
+    [
+        ("gap", 1, 3),
+        ("move", "obstacle_9", "LL"),
+        ("move", "obstacle_6", "FF"),
+        ("move", "obstacle_3", "LL"),
+        ("gap", 5, 1),
+    ],
     [("gap", 1, 3), ("move", "obstacle_9", "LL"), ("gap", 3, 2), ("move", "obstacle_3", "LL"), ("gap", 5, 1)],
-    [("move", "obstacle_1", "FF"), ("move", "obstacle_9", "LL"), ("gap", 3, 2), ("move", "obstacle_3", "LL"),
-     ("gap", 5, 1)],
-    [("gap", 1, 3), ("move", "obstacle_9", "LL"), ("move", "obstacle_6", "FF"), ("gap", 4, 2),
-     ("move", "obstacle_5", "LL")],
+    [
+        ("move", "obstacle_1", "FF"),
+        ("move", "obstacle_9", "LL"),
+        ("gap", 3, 2),
+        ("move", "obstacle_3", "LL"),
+        ("gap", 5, 1),
+    ],
+    [
+        ("gap", 1, 3),
+        ("move", "obstacle_9", "LL"),
+        ("move", "obstacle_6", "FF"),
+        ("gap", 4, 2),
+        ("move", "obstacle_5", "LL"),
+    ],
 ]
 # gen1 seed 15: both moves; on the way to the first push start open fingers straddle a small obstacle.
 GEN1_15 = [("move", "FailOnTouchObstacleLong", "BL"), ("move", "FailOnTouchObstacleMed-1", "RR")]

@@ -61,7 +61,9 @@ def write_trial(root: Path, subject: str, number: int) -> Path:
         )
     for name, x, z, _ in [("Target", 0.0, 0.175, 0.05), *OBSTACLES]:
         positions = np.tile([x, 0.79, z], (FRAMES, 1))
-        (folder / "movement" / f"{name}_movement_T{number:03d}.csv").write_text(_movement(name, positions, False))
+        (folder / "movement" / f"{name}_movement_T{number:03d}.csv").write_text(
+            _movement(name, positions, False)
+        )
     (folder / "movement" / f"interaction_log_T{number:03d}.csv").write_text(
         "start_time,end_time,dominant_object,non_dominant_object,interaction_type\n"
         "100.0111,100.0333,Hand,FailOnTouchObstacleMed,LeftGate\n"

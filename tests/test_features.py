@@ -45,8 +45,13 @@ def test_gap_features_by_hand(space):
     gap = gaps[5]
     c, start, target = np.array(gap.center), np.array(space.scene.start), np.array(space.target.center)
     d = table_diagonal(space.scene.table)
-    expected = [np.linalg.norm(c - start) / d, np.linalg.norm(c - target) / d, math.hypot(gap.width, 0.05) / d,
-                math.atan2(c[0] - start[0], -(c[1] - start[1])), math.atan2(c[0] - target[0], -(c[1] - target[1]))]
+    expected = [
+        np.linalg.norm(c - start) / d,
+        np.linalg.norm(c - target) / d,
+        math.hypot(gap.width, 0.05) / d,
+        math.atan2(c[0] - start[0], -(c[1] - start[1])),
+        math.atan2(c[0] - target[0], -(c[1] - target[1])),
+    ]
     assert features[5] == pytest.approx(expected)
 
 
@@ -68,7 +73,9 @@ def test_direction_features_modes_differ_as_the_original(space):
     assert fixed.shape == (10,)
     centre = np.array(space.rects[name].center)
     assert DIRECTIONS[int(fixed[8])] in {"FF", "FL", "FR"}  # the obstacle is ahead of the start
-    faithful_train = direction_features(space, name, hand=hand, mode="faithful", training=True, hand_to_object="BL")
+    faithful_train = direction_features(
+        space, name, hand=hand, mode="faithful", training=True, hand_to_object="BL"
+    )
     assert DIRECTIONS[int(faithful_train[8])] == "BL"  # the demonstration's own label is used (B6)
     faithful_plan = direction_features(space, name, hand=hand, mode="faithful")
     assert centre[0] > hand[0] and DIRECTIONS[int(faithful_plan[8])][0] == "F"
@@ -93,7 +100,7 @@ def test_segment_matrix_matches_single_pairs_and_excludes_own_obstacles(space):
     # A segment from an obstacle to the gap right behind it does not collide with that obstacle.
     obstacle = next(n for n in near if n.kind == "object")
     i = near.index(obstacle)
-    assert np.all(matrix[i * len(far):(i + 1) * len(far), 2] < 0.5)
+    assert np.all(matrix[i * len(far) : (i + 1) * len(far), 2] < 0.5)
 
 
 def test_arm_features_mirror_a_left_arm():

@@ -33,9 +33,7 @@ def test_unity_yaw_is_clockwise_degrees():
 
 
 def scene_with(xs_ys) -> Scene:
-    obstacles = tuple(
-        SceneObject(f"o{i}", "box", x, y, (0.05, 0.06, 0.1)) for i, (x, y) in enumerate(xs_ys)
-    )
+    obstacles = tuple(SceneObject(f"o{i}", "box", x, y, (0.05, 0.06, 0.1)) for i, (x, y) in enumerate(xs_ys))
     target = SceneObject("Target", "cylinder", 0.9, 0.0, (0.05, 0.05, 0.1))
     return Scene(Table(1.0, 1.2, 0.7), (0.1, 0.0), target, obstacles)
 

@@ -47,7 +47,9 @@ def test_svm_decision_function_matches_scikit_learn():
     X, y = _blobs()
     model = RbfSvmClassifier(kernel_scale=0.5, balance=False).fit(X, y)
     reference = SVC(C=1.0, gamma=4.0).fit((X - model.mean_) / model.scale_, y)
-    assert model.decision_function(X) == pytest.approx(reference.decision_function((X - model.mean_) / model.scale_))
+    assert model.decision_function(X) == pytest.approx(
+        reference.decision_function((X - model.mean_) / model.scale_)
+    )
 
 
 def test_direction_classifier_and_arm_regressor_learn():
@@ -93,17 +95,22 @@ def test_tampered_or_foreign_model_files_are_refused(tmp_path):
 
 # Refitting with weights equals refitting on repeated rows only where no fold or resampling sees the
 # rows: the cross-validated calibration and the SVM's minority oversampling draw from the rows.
-SAMPLE_WEIGHT_CHECK = {"check_sample_weight_equivalence_on_dense_data":
-                       "calibration folds and class oversampling are drawn from the rows, not the weights"}
+SAMPLE_WEIGHT_CHECK = {
+    "check_sample_weight_equivalence_on_dense_data": "calibration folds and class oversampling are drawn from the rows, not the weights"
+}
 
 
-@pytest.mark.parametrize("estimator", [
-    RowChoiceClassifier(n_estimators=20, novelty_samples=200),
-    RowChoiceClassifier(learner="svm", novelty_samples=200),
-    RbfSvmClassifier(),
-    DirectionClassifier(),
-    ArmRegressor(max_samples=200),
-], ids=["row-boosted", "row-svm", "rbf-svm", "direction", "arm"])
+@pytest.mark.parametrize(
+    "estimator",
+    [
+        RowChoiceClassifier(n_estimators=20, novelty_samples=200),
+        RowChoiceClassifier(learner="svm", novelty_samples=200),
+        RbfSvmClassifier(),
+        DirectionClassifier(),
+        ArmRegressor(max_samples=200),
+    ],
+    ids=["row-boosted", "row-svm", "rbf-svm", "direction", "arm"],
+)
 def test_scikit_learn_conformance(estimator):
     expected = SAMPLE_WEIGHT_CHECK if isinstance(estimator, (RowChoiceClassifier, RbfSvmClassifier)) else {}
     with warnings.catch_warnings():
@@ -119,10 +126,14 @@ def test_row_choice_trees_calibration_and_novelty():
 
     X, y = _blobs(600)
     model = RowChoiceClassifier(n_estimators=50, subsample=1.0).fit(X, y)
-    reference = GradientBoostingClassifier(n_estimators=50, max_depth=3, learning_rate=0.1, random_state=0).fit(X, y)
+    reference = GradientBoostingClassifier(
+        n_estimators=50, max_depth=3, learning_rate=0.1, random_state=0
+    ).fit(X, y)
     assert model.decision_function(X) == pytest.approx(reference.decision_function(X))  # the trees as arrays
     p = model.predict_proba(X)[:, 1]
-    assert abs(p.mean() - y.mean()) < 0.02 and (model.predict(X) == y).mean() > 0.95  # calibrated on held-out folds
+    assert (
+        abs(p.mean() - y.mean()) < 0.02 and (model.predict(X) == y).mean() > 0.95
+    )  # calibrated on held-out folds
     assert np.mean(model.novelty(X) <= 1.0) > 0.97  # the demonstrations lie within their own range
     assert np.all(model.novelty(X[:10] + 10.0) > 1.0)  # far away: outside it
     state = model.get_state()

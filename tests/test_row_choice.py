@@ -22,20 +22,29 @@ def _wall_scene(gap_left: float, gap_right: float) -> Scene:
     table = Table(1.0, 1.0, 0.7)
     left = SceneObject("left", "box", 0.5, (gap_left + 0.5) / 2.0, (0.05, 0.5 - gap_left, 0.1))
     right = SceneObject("right", "box", 0.5, (gap_right - 0.5) / 2.0, (0.05, gap_right + 0.5, 0.1))
-    return Scene(table, (0.1, 0.0), SceneObject("Target", "cylinder", 0.9, 0.0, (0.05, 0.05, 0.1)), (left, right))
+    return Scene(
+        table, (0.1, 0.0), SceneObject("Target", "cylinder", 0.9, 0.0, (0.05, 0.05, 0.1)), (left, right)
+    )
 
 
 def _scaled(scene: Scene, s: float) -> Scene:
     def obj(o: SceneObject) -> SceneObject:
         return replace(o, x=o.x * s, y=o.y * s, size=(o.size[0] * s, o.size[1] * s, o.size[2]))
 
-    return Scene(Table(scene.table.length * s, scene.table.width * s, scene.table.height),
-                 (scene.start[0] * s, scene.start[1] * s), obj(scene.target), tuple(obj(o) for o in scene.obstacles))
+    return Scene(
+        Table(scene.table.length * s, scene.table.width * s, scene.table.height),
+        (scene.start[0] * s, scene.start[1] * s),
+        obj(scene.target),
+        tuple(obj(o) for o in scene.obstacles),
+    )
 
 
 def test_segments_through_rectangles():
     rects = np.array([[0.0, 0.0, 1.0, 1.0]])
-    starts, ends = np.array([[-1.0, 0.5], [-1.0, 1.0], [0.5, 0.5]]), np.array([[2.0, 0.5], [2.0, 1.0], [0.5, 2.0]])
+    starts, ends = (
+        np.array([[-1.0, 0.5], [-1.0, 1.0], [0.5, 0.5]]),
+        np.array([[2.0, 0.5], [2.0, 1.0], [0.5, 2.0]]),
+    )
     assert segment_hits(starts, ends, rects)[:, 0].tolist() == [True, False, True]  # along an edge: no hit
     assert segment_inside(starts, ends, rects)[:, 0] == pytest.approx([1.0, 0.0, 0.5])
 
@@ -73,7 +82,9 @@ def test_routes_go_round_the_obstacles_or_through_a_gap():
     expected = np.linalg.norm(corner_front - start) + 0.1 + np.linalg.norm(goal - corner_back)
     assert routes.to_goal(sight, np.array([0]), frozenset())[0] == pytest.approx(expected, abs=1e-5)
     # With the blocking box moved away the way is straight.
-    assert routes.to_goal(sight, np.array([0]), frozenset({1}))[0] == pytest.approx(np.linalg.norm(goal - start))
+    assert routes.to_goal(sight, np.array([0]), frozenset({1}))[0] == pytest.approx(
+        np.linalg.norm(goal - start)
+    )
     # A gap narrower than the hand closes the way: no route at all.
     closed = _wall_scene(gap_left=0.12, gap_right=0.1)
     space = TaskSpace(closed)
@@ -84,7 +95,7 @@ def test_routes_go_round_the_obstacles_or_through_a_gap():
 def test_candidates_of_a_row_and_their_features():
     scene = _wall_scene(gap_left=0.3, gap_right=0.1)
     features = RowChoiceScene(TaskSpace(scene), 0.05)
-    candidates, = features.candidates(1, np.array(scene.start))
+    (candidates,) = features.candidates(1, np.array(scene.start))
     assert candidates.kinds == ("gap", "object", "object")  # the one gap, then the boxes from left to right
     X = candidates.X
     middle = 0
@@ -94,7 +105,9 @@ def test_candidates_of_a_row_and_their_features():
     assert X[1:, COLUMN["is_object"]].tolist() == [1.0, 1.0]
     right = 2
     assert candidates.obstacles[right] == 1 and X[right, COLUMN["corridor_overlap"]] == pytest.approx(1.0)
-    assert X[right, COLUMN["route_gain"]] > 0.0 and X[1, COLUMN["route_gain"]] == 0.0  # only the one in the way
+    assert (
+        X[right, COLUMN["route_gain"]] > 0.0 and X[1, COLUMN["route_gain"]] == 0.0
+    )  # only the one in the way
     assert X[middle, COLUMN["route_via"]] == pytest.approx(1.0)  # the shortest route passes through it
     assert X[:, COLUMN["row_best_offset"]] == pytest.approx(2.5)
 
@@ -118,7 +131,7 @@ def test_one_call_for_several_hands_equals_one_call_each():
     removed = [frozenset(), frozenset({0}), frozenset({1, 2})]
     together = features.candidates(2, hands, removed, limit=3)
     for hand, gone, batch in zip(hands, removed, together):
-        alone, = features.candidates(2, hand, [gone], limit=3)
+        (alone,) = features.candidates(2, hand, [gone], limit=3)
         assert alone.kinds == batch.kinds
         np.testing.assert_allclose(alone.X, batch.X)
         np.testing.assert_allclose(alone.points, batch.points)

@@ -25,8 +25,9 @@ def _rows_in_order(result) -> list[int]:
     return [k.row for k in result.keypoints if k.action in ("gap", "move")]
 
 
-@pytest.mark.parametrize(("kind", "objects", "seed"), [("gen2", 9, 3), ("gen2", 7, 11), ("unstructured", 6, 2),
-                                                       ("vr", None, 5)])
+@pytest.mark.parametrize(
+    ("kind", "objects", "seed"), [("gen2", 9, 3), ("gen2", 7, 11), ("unstructured", 6, 2), ("vr", None, 5)]
+)
 def test_every_row_on_the_way_once_and_in_order(models, kind, objects, seed):
     scene = generate_scene(kind, seed, objects)
     result = plan(scene, models)
@@ -40,15 +41,19 @@ def test_every_row_on_the_way_once_and_in_order(models, kind, objects, seed):
             assert release.action == "release" and release.element == move.element and release.direction
     assert all(k.arm is not None for k in result.keypoints)
     assert all(result.details["evidence"].values())
-    assert len(result.alternatives) >= 1 and all(a.keypoints[-1].action == "target" for a in result.alternatives)
+    assert len(result.alternatives) >= 1 and all(
+        a.keypoints[-1].action == "target" for a in result.alternatives
+    )
 
 
 def test_rows_beside_or_behind_the_target_are_not_planned(models):
     table = Table(1.0, 1.0, 0.75)
     target = SceneObject("Target", "cylinder", 0.8, 0.0, (0.06, 0.06, 0.1))
-    obstacles = (SceneObject("near", "box", 0.4, 0.05, (0.05, 0.2, 0.1)),
-                 SceneObject("beside", "box", 0.79, 0.25, (0.05, 0.1, 0.1)),  # level with the target
-                 SceneObject("behind", "box", 0.92, -0.2, (0.05, 0.1, 0.1)))
+    obstacles = (
+        SceneObject("near", "box", 0.4, 0.05, (0.05, 0.2, 0.1)),
+        SceneObject("beside", "box", 0.79, 0.25, (0.05, 0.1, 0.1)),  # level with the target
+        SceneObject("behind", "box", 0.92, -0.2, (0.05, 0.1, 0.1)),
+    )
     scene = Scene(table, (0.1, 0.0), target, obstacles)
     result = plan(scene, models)
     assert result.ok and _rows_in_order(result) == [1]
@@ -72,7 +77,9 @@ def test_a_case_outside_the_demonstrations_falls_back_to_the_nearest_gap(models)
     assert result.ok and not any(result.details["evidence"].values())
     rule = nearest_gap_plan(scene)
     first_row = [k for k in result.keypoints if k.row == 1]
-    assert [(k.action, k.element) for k in first_row] == [(k.action, k.element) for k in rule.keypoints if k.row == 1]
+    assert [(k.action, k.element) for k in first_row] == [
+        (k.action, k.element) for k in rule.keypoints if k.row == 1
+    ]
 
 
 def test_ways_through_obstacles_are_reported():
@@ -81,21 +88,41 @@ def test_ways_through_obstacles_are_reported():
     target = PlanKeypoint("target", space.target.center, None, "Target")
     box = scene.obstacles[0]
     start = PlanKeypoint("start", scene.start)
-    through = segment_collisions(space, (start, PlanKeypoint("gap", (box.x + 0.05, box.y), 1, "1"), target), 0.05)
+    through = segment_collisions(
+        space, (start, PlanKeypoint("gap", (box.x + 0.05, box.y), 1, "1"), target), 0.05
+    )
     assert [c["obstacle"] for c in through if c["segment"] == 0] == [box.name]
     way = np.hypot(box.x + 0.05 - scene.start[0], box.y - scene.start[1])
     assert 0.0 < through[0]["depth"] < way  # the part of the way inside the grown obstacle, m
     # Moving the obstacle: the ways to it and with it are not collisions with it.
-    moved = (start, PlanKeypoint("move", (box.x, box.y), 1, box.name, "LL"),
-             PlanKeypoint("release", (box.x, box.y + 0.1), 1, box.name, "LL"), target)
-    assert not [c for c in segment_collisions(space, moved, 0.01) if c["obstacle"] == box.name and c["segment"] < 2]
+    moved = (
+        start,
+        PlanKeypoint("move", (box.x, box.y), 1, box.name, "LL"),
+        PlanKeypoint("release", (box.x, box.y + 0.1), 1, box.name, "LL"),
+        target,
+    )
+    assert not [
+        c for c in segment_collisions(space, moved, 0.01) if c["obstacle"] == box.name and c["segment"] < 2
+    ]
 
 
 def test_planning_from_any_number_of_rows_with_fifty_boxes(models):
     rng = np.random.default_rng(0)
-    obstacles = tuple(SceneObject(f"b{i}", "box", 0.2 + 0.1 * (i // 5), -0.4 + 0.2 * (i % 5) + rng.uniform(-0.02, 0.02),
-                                  (0.04, 0.06, 0.1)) for i in range(50))
-    scene = Scene(Table(1.3, 1.1, 0.75), (0.05, 0.0), SceneObject("Target", "cylinder", 1.25, 0.1, (0.05, 0.05, 0.1)),
-                  obstacles)
+    obstacles = tuple(
+        SceneObject(
+            f"b{i}",
+            "box",
+            0.2 + 0.1 * (i // 5),
+            -0.4 + 0.2 * (i % 5) + rng.uniform(-0.02, 0.02),
+            (0.04, 0.06, 0.1),
+        )
+        for i in range(50)
+    )
+    scene = Scene(
+        Table(1.3, 1.1, 0.75),
+        (0.05, 0.0),
+        SceneObject("Target", "cylinder", 1.25, 0.1, (0.05, 0.05, 0.1)),
+        obstacles,
+    )
     result = plan(scene, models)
     assert result.ok and len(_rows_in_order(result)) == 10

@@ -43,7 +43,16 @@ def test_faithful_mode_reproduces_the_reference_counts(faithful):
 def test_faithful_moving_directions_include_the_forward_default(faithful):
     labels = Counter(d.direction for demo in faithful.demonstrations for d in demo.decisions if d.direction)
     # Reference 3.7: real labels plus 494 obstacles outside every block labelled FF (bug B9).
-    assert labels == {"BL": 678, "RR": 363, "BR": 328, "LL": 232, "FR": 184, "BB": 105, "FL": 58, "FF": 33 + 494}
+    assert labels == {
+        "BL": 678,
+        "RR": 363,
+        "BR": 328,
+        "LL": 232,
+        "FR": 184,
+        "BB": 105,
+        "FL": 58,
+        "FF": 33 + 494,
+    }
 
 
 def test_fixed_mode_labels_directions_from_the_displacement(fixed):
@@ -67,7 +76,11 @@ def test_left_handers_are_mirrored_in_fixed_mode(fixed, faithful):
     assert left_fixed + left_faithful == pytest.approx(np.pi, abs=0.05)
     # Right arms: both modes measure the same angles.
     original = {d.key: d.keypoints[0].arm for d in faithful.demonstrations if not d.left_handed}
-    same = [d.keypoints[0].arm == pytest.approx(original[d.key]) for d in fixed.demonstrations if d.key in original]
+    same = [
+        d.keypoints[0].arm == pytest.approx(original[d.key])
+        for d in fixed.demonstrations
+        if d.key in original
+    ]
     assert len(same) > 1500 and all(same)
 
 
@@ -81,7 +94,9 @@ def test_faithful_training_sets_have_the_reference_sizes(faithful):
     assert data.segment.X.shape == (85848, 4) and data.segment.y.sum() == 1752
     assert data.arm.X.shape == (7731, 5) and data.arm.y.shape == (7731, 2)
     assert np.all(np.isfinite(data.segment.X))
-    assert set(data.gap.subjects) == {faithful.demonstrations[i].subject for i in range(len(faithful.demonstrations))}
+    assert set(data.gap.subjects) == {
+        faithful.demonstrations[i].subject for i in range(len(faithful.demonstrations))
+    }
 
 
 def test_bad_tracks_are_rejected_with_a_reason(dataset):
@@ -90,7 +105,9 @@ def test_bad_tracks_are_rejected_with_a_reason(dataset):
     nan_position = hand.position.copy()
     nan_position[10, 0] = np.nan
     with pytest.raises(Rejected, match="hand track contains NaN"):
-        segment_trial(replace(trial, trackers={**trial.trackers, "hand": replace(hand, position=nan_position)}))
+        segment_trial(
+            replace(trial, trackers={**trial.trackers, "hand": replace(hand, position=nan_position)})
+        )
     short = replace(hand, time=hand.time[:50], position=hand.position[:50], yaw=hand.yaw[:50])
     with pytest.raises(Rejected, match="frames, hand track 50"):
         segment_trial(replace(trial, trackers={**trial.trackers, "hand": short}))
@@ -101,7 +118,10 @@ def test_bad_tracks_are_rejected_with_a_reason(dataset):
 
 def test_a_known_trial(dataset):
     demo = segment_trial(dataset.trial("sub_01/T050"))
-    assert [(d.decision, d.element) for d in demo.decisions] == [("gap", "2"), ("object", "FailOnTouchObstacleLong-1")]
+    assert [(d.decision, d.element) for d in demo.decisions] == [
+        ("gap", "2"),
+        ("object", "FailOnTouchObstacleLong-1"),
+    ]
     assert [k.kind for k in demo.keypoints] == ["start", "gap", "approach", "release", "target"]
     frames = [k.frame for k in demo.keypoints]
     assert frames == sorted(frames) and frames[-1] <= demo.goal_frame

@@ -88,9 +88,15 @@ def test_connecting_space_lies_between_rows():
 @pytest.mark.parametrize(
     ("dx", "dy", "faithful", "expected"),
     [
-        (1.0, 0.0, True, "FF"), (1.0, 0.001, True, "FL"), (1.0, 0.001, False, "FF"),
-        (0.0, -1.0, False, "RR"), (-1.0, -1.0, False, "BR"), (-1.0, 0.9, False, "BL"),
-        (0.2, 1.0, False, "LL"), (-0.5, 0.0, True, "BB"), (0.0, 0.0, True, None),
+        (1.0, 0.0, True, "FF"),
+        (1.0, 0.001, True, "FL"),
+        (1.0, 0.001, False, "FF"),
+        (0.0, -1.0, False, "RR"),
+        (-1.0, -1.0, False, "BR"),
+        (-1.0, 0.9, False, "BL"),
+        (0.2, 1.0, False, "LL"),
+        (-0.5, 0.0, True, "BB"),
+        (0.0, 0.0, True, None),
     ],
 )
 def test_discrete_direction(dx, dy, faithful, expected):
@@ -101,15 +107,18 @@ def test_exact_and_sampled_band_agree_on_simple_cases():
     box_ = Rect(0.4, -0.05, 0.45, 0.05)  # 5 cm deep, 10 cm wide
     # a 5 cm band straight through the middle covers half of it
     exact = band_collision((0.0, 0.0), (1.0, 0.0), [box_], half_width=0.025)
-    sampled = band_collision_sampled((0.0, 0.0), (1.0, 0.0), [box_], offset=(0.0, 1.0), s_minus=0.025, s_plus=0.025)
+    sampled = band_collision_sampled(
+        (0.0, 0.0), (1.0, 0.0), [box_], offset=(0.0, 1.0), s_minus=0.025, s_plus=0.025
+    )
     assert exact == pytest.approx(0.5)
     assert sampled == pytest.approx(exact, rel=0.25)  # sampling resolves 1/49 of the length
     # missing the box: both zero; a second, untouched occluder halves the mean
     assert band_collision((0.0, 0.2), (1.0, 0.2), [box_], half_width=0.025) == 0.0
     far = Rect(0.9, 0.5, 1.0, 0.6)
     two = band_collision((0.0, 0.0), (1.0, 0.0), [box_, far], half_width=0.025)
-    two_sampled = band_collision_sampled((0.0, 0.0), (1.0, 0.0), [box_, far], offset=(0.0, 1.0),
-                                         s_minus=0.025, s_plus=0.025)
+    two_sampled = band_collision_sampled(
+        (0.0, 0.0), (1.0, 0.0), [box_, far], offset=(0.0, 1.0), s_minus=0.025, s_plus=0.025
+    )
     assert two == pytest.approx(0.25) and two_sampled == pytest.approx(two, rel=0.25)
     # a band wider than the box covers all of it
     assert band_collision((0.0, 0.0), (1.0, 0.0), [box_], half_width=0.2) == pytest.approx(1.0)

@@ -50,7 +50,9 @@ def test_the_stale_start_of_t100_is_replaced_by_trial_results(unstructured):
     starts = _start_positions()
     # Every participant's T100 scene file keeps x = 0: one note each, naming the file and both values.
     noted = sorted(n["path"].split(":")[-1].split("/scene")[0] for n in unstructured.notes)
-    assert noted == sorted(f"{s}/T100" for s in {r.subject for r in unstructured.select(category=UNSTRUCTURED)})
+    assert noted == sorted(
+        f"{s}/T100" for s in {r.subject for r in unstructured.select(category=UNSTRUCTURED)}
+    )
     assert all("StartPoint x 0.0000 is stale" in n["reason"] for n in unstructured.notes)
     for record in unstructured.select(category=UNSTRUCTURED):
         trial = unstructured.trial(record.key)
@@ -84,5 +86,10 @@ def test_decisions_agree_with_the_interaction_log(unstructured, segmented):
 
 
 def test_categories_by_trial_number():
-    assert [category_of(n) for n in (9, 10, 99, 100, 129)] == ["practice", "structured", "structured",
-                                                               "unstructured", "unstructured"]
+    assert [category_of(n) for n in (9, 10, 99, 100, 129)] == [
+        "practice",
+        "structured",
+        "structured",
+        "unstructured",
+        "unstructured",
+    ]

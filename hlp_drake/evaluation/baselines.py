@@ -25,7 +25,9 @@ from hlp_drake.taskspace import TaskSpace
 BASELINES = ("nearest_gap", "majority")
 
 
-def _plan(scene: Scene, space: TaskSpace, choices: list[tuple[int, str, str, tuple[float, float]]]) -> HighLevelPlan:
+def _plan(
+    scene: Scene, space: TaskSpace, choices: list[tuple[int, str, str, tuple[float, float]]]
+) -> HighLevelPlan:
     """A plan through ``choices`` (row, "gap"/"object", element, position) with one-hot raw labels."""
     keypoints = [PlanKeypoint("start", (float(scene.start[0]), float(scene.start[1])))]
     gap_scores = {f"{g.row}:{g.index}": -0.5 for gaps in space.gaps for g in gaps}
@@ -35,11 +37,15 @@ def _plan(scene: Scene, space: TaskSpace, choices: list[tuple[int, str, str, tup
             keypoints.append(PlanKeypoint("gap", position, row, element))
             gap_scores[f"{row}:{element}"] = 0.5
         else:
-            keypoints += [PlanKeypoint("move", position, row, element), PlanKeypoint("release", position, row, element)]
+            keypoints += [
+                PlanKeypoint("move", position, row, element),
+                PlanKeypoint("release", position, row, element),
+            ]
             object_scores[element] = 0.5
     keypoints.append(PlanKeypoint("target", space.target.center, None, scene.target.name))
-    return HighLevelPlan(scene.name, tuple(keypoints),
-                         details={"gap_scores": gap_scores, "object_scores": object_scores})
+    return HighLevelPlan(
+        scene.name, tuple(keypoints), details={"gap_scores": gap_scores, "object_scores": object_scores}
+    )
 
 
 def nearest_gap_plan(scene: Scene) -> HighLevelPlan:

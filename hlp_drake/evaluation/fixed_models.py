@@ -12,8 +12,9 @@ from hlp_drake.learners.models import DecisionModels
 from hlp_drake.segmentation.demonstration import Demonstration
 
 
-def evaluate_models(models: DecisionModels, demonstrations: Sequence[Demonstration], *, category: str,
-                    progress: bool = False) -> SplitResult:
+def evaluate_models(
+    models: DecisionModels, demonstrations: Sequence[Demonstration], *, category: str, progress: bool = False
+) -> SplitResult:
     """Plan and score every demonstration of ``category`` with ``models``.
 
     The majority baseline takes the majority decision of the other subjects' demonstrations (of
@@ -24,5 +25,11 @@ def evaluate_models(models: DecisionModels, demonstrations: Sequence[Demonstrati
     others = [d for d in demonstrations if d.subject not in tested] or list(demonstrations)
     outcomes, baselines = score_plans(models, tests, majority_decision(others), progress=progress)
     rows = row_choice_set(tests) if models.planner == "rows" else None
-    return SplitResult(sorted(models.subjects_), sorted(tested), outcomes, baselines, category,
-                       calibration(models, rows) if rows is not None else {})
+    return SplitResult(
+        sorted(models.subjects_),
+        sorted(tested),
+        outcomes,
+        baselines,
+        category,
+        calibration(models, rows) if rows is not None else {},
+    )

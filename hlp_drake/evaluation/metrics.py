@@ -66,7 +66,9 @@ def score_trial(demo: Demonstration, plan: HighLevelPlan, *, faithful: bool) -> 
     object_truth = np.array(object_labels(demo, space)) > 0
     gaps = [g for row in space.gaps for g in row]
     gap_raw = np.array([plan.details.get("gap_scores", {}).get(f"{g.row}:{g.index}", -1.0) > 0 for g in gaps])
-    object_raw = np.array([plan.details.get("object_scores", {}).get(n, -1.0) > 0 for n in space.obstacle_names])
+    object_raw = np.array(
+        [plan.details.get("object_scores", {}).get(n, -1.0) > 0 for n in space.obstacle_names]
+    )
     planned = planned_rows(plan)
     rows = []
     for decision in demo.decisions:
@@ -83,11 +85,24 @@ def score_trial(demo: Demonstration, plan: HighLevelPlan, *, faithful: bool) -> 
         else:
             element_ok = False
         decision_ok = hlp_decision == decision.decision
-        rows.append(RowOutcome(decision.row, decision.decision, decision.element, hlp_decision, hlp_element,
-                               decision_ok, element_ok, decision_ok and hlp_element == decision.element))
+        rows.append(
+            RowOutcome(
+                decision.row,
+                decision.decision,
+                decision.element,
+                hlp_decision,
+                hlp_element,
+                decision_ok,
+                element_ok,
+                decision_ok and hlp_element == decision.element,
+            )
+        )
     return TrialOutcome(
-        demo.key, tuple(rows),
-        int((gap_raw == gap_truth).sum()), len(gaps),
-        int((object_raw == object_truth).sum()), len(object_truth),
+        demo.key,
+        tuple(rows),
+        int((gap_raw == gap_truth).sum()),
+        len(gaps),
+        int((object_raw == object_truth).sum()),
+        len(object_truth),
         plan.planning_time_s,
     )

@@ -26,16 +26,32 @@ from hlp_drake.planner import PlannerConfig, plan
 from hlp_drake.segmentation.demonstration import GAP, OBJECT, Demonstration
 from hlp_drake.segmentation.modes import is_faithful
 
-PAPER_TABLE_I = {"gap_accuracy": 0.95, "object_accuracy": 0.85, "shlp": 0.70, "shlp_decision": 0.79,
-                 "shlp_element": 0.67}
-METRICS = ("gap_accuracy", "object_accuracy", "shlp", "shlp_decision", "shlp_element", "shlp_element_plan",
-           "shlp_plan")
+PAPER_TABLE_I = {
+    "gap_accuracy": 0.95,
+    "object_accuracy": 0.85,
+    "shlp": 0.70,
+    "shlp_decision": 0.79,
+    "shlp_element": 0.67,
+}
+METRICS = (
+    "gap_accuracy",
+    "object_accuracy",
+    "shlp",
+    "shlp_decision",
+    "shlp_element",
+    "shlp_element_plan",
+    "shlp_plan",
+)
 PLANNERS = ("hlp", *BASELINES)
-SETTINGS = {"a": "trained on structured trials only (zero-shot transfer)",
-            "b": "trained on structured + unstructured trials of the training participants"}
+SETTINGS = {
+    "a": "trained on structured trials only (zero-shot transfer)",
+    "b": "trained on structured + unstructured trials of the training participants",
+}
 
 
-def subject_splits(subjects: Sequence[str], *, n_train: int, splits: int, seed: int) -> list[tuple[list[str], list[str]]]:
+def subject_splits(
+    subjects: Sequence[str], *, n_train: int, splits: int, seed: int
+) -> list[tuple[list[str], list[str]]]:
     """``splits`` seeded random (train, test) subject splits with ``n_train`` training subjects."""
     rng = np.random.default_rng(seed)
     subjects = sorted(subjects)
@@ -71,7 +87,8 @@ def metrics_of(outcomes: Sequence[TrialOutcome]) -> dict[str, float]:
     rows = [r for o in outcomes for r in o.rows]
     return {
         "gap_accuracy": sum(o.gap_correct for o in outcomes) / max(sum(o.gap_total for o in outcomes), 1),
-        "object_accuracy": sum(o.object_correct for o in outcomes) / max(sum(o.object_total for o in outcomes), 1),
+        "object_accuracy": sum(o.object_correct for o in outcomes)
+        / max(sum(o.object_total for o in outcomes), 1),
         "shlp": float(np.mean([o.shlp for o in outcomes])),
         "shlp_decision": float(np.mean([r.decision_ok for r in rows])),
         "shlp_element": float(np.mean([r.element_ok for r in rows])),
@@ -103,9 +120,18 @@ def _majority(data: TrainingData) -> str:
     return OBJECT if data.object.y.mean() * 3 > 0.5 else GAP  # structured rows: three obstacles each
 
 
-def evaluate_split(data: TrainingData, demonstrations: Sequence[Demonstration], train: list[str], test: list[str],
-                   *, settings: LearnerSettings, keep: Callable[[str], bool] | None = None, setting: str = "",
-                   config: PlannerConfig | None = None, progress: bool = False) -> SplitResult:
+def evaluate_split(
+    data: TrainingData,
+    demonstrations: Sequence[Demonstration],
+    train: list[str],
+    test: list[str],
+    *,
+    settings: LearnerSettings,
+    keep: Callable[[str], bool] | None = None,
+    setting: str = "",
+    config: PlannerConfig | None = None,
+    progress: bool = False,
+) -> SplitResult:
     """Fit on the training trials, plan every ``test`` subject's demonstration, score against them.
 
     Args:
@@ -134,26 +160,41 @@ def calibration(models: DecisionModels, rows: LabelledSet, bins: int = 10) -> di
     p = models.row.predict_proba(rows.X)[:, 1]
     taken = rows.y > 0
     which = np.minimum((p * bins).astype(int), bins - 1)
-    gap = sum(abs(p[which == b].mean() - taken[which == b].mean()) * np.mean(which == b)
-              for b in range(bins) if np.any(which == b))
-    return {"ece": float(gap), "brier": float(np.mean((p - taken) ** 2)),
-            "in_distribution": float(np.mean(models.row.novelty(rows.X) <= 1.0))}
+    gap = sum(
+        abs(p[which == b].mean() - taken[which == b].mean()) * np.mean(which == b)
+        for b in range(bins)
+        if np.any(which == b)
+    )
+    return {
+        "ece": float(gap),
+        "brier": float(np.mean((p - taken) ** 2)),
+        "in_distribution": float(np.mean(models.row.novelty(rows.X) <= 1.0)),
+    }
 
 
-def score_plans(models: DecisionModels, demonstrations: Sequence[Demonstration], majority: str, *,
-                config: PlannerConfig | None = None,
-                progress: bool = False) -> tuple[list[TrialOutcome], dict[str, list[TrialOutcome]]]:
+def score_plans(
+    models: DecisionModels,
+    demonstrations: Sequence[Demonstration],
+    majority: str,
+    *,
+    config: PlannerConfig | None = None,
+    progress: bool = False,
+) -> tuple[list[TrialOutcome], dict[str, list[TrialOutcome]]]:
     """Plan every demonstration's scene with ``models`` (the person's own arm at the start) and
     with the baselines (``majority``: the majority decision), and score each against the person."""
     config = config or PlannerConfig(mode=models.mode_)
     faithful = is_faithful(models.mode_)
     outcomes, baselines = [], {name: [] for name in BASELINES}
-    for demo in tqdm(demonstrations, desc="planning test scenes", unit="scene", leave=False, disable=not progress):
+    for demo in tqdm(
+        demonstrations, desc="planning test scenes", unit="scene", leave=False, disable=not progress
+    ):
         lengths = (demo.link_lengths.upper_arm, demo.link_lengths.forearm)
         result = plan(demo.scene, models, config, start_arm=demo.keypoints[0].arm, link_lengths=lengths)
         outcomes.append(score_trial(demo, result, faithful=faithful))
         baselines["nearest_gap"].append(score_trial(demo, nearest_gap_plan(demo.scene), faithful=faithful))
-        baselines["majority"].append(score_trial(demo, majority_plan(demo.scene, majority), faithful=faithful))
+        baselines["majority"].append(
+            score_trial(demo, majority_plan(demo.scene, majority), faithful=faithful)
+        )
     return outcomes, baselines
 
 
@@ -161,14 +202,22 @@ def summarise(results: Sequence[SplitResult], planner: str = "hlp") -> dict[str,
     """Mean and standard deviation over splits of every metric of ``planner``, plus the planner's
     planning time figures."""
     per_split = [r.metrics(planner) for r in results]
-    summary = {m: {"mean": float(np.mean([s[m] for s in per_split])), "std": float(np.std([s[m] for s in per_split]))}
-               for m in METRICS}
+    summary = {
+        m: {
+            "mean": float(np.mean([s[m] for s in per_split])),
+            "std": float(np.std([s[m] for s in per_split])),
+        }
+        for m in METRICS
+    }
     for key in ("ece", "brier", "in_distribution"):
         values = [r.calibration[key] for r in results if key in r.calibration]
         if values and planner == "hlp":
             summary[f"row_{key}"] = {"mean": float(np.mean(values)), "std": float(np.std(values))}
     if planner == "hlp":  # the baselines' times are not measured
         times = np.array([o.planning_time_s for r in results for o in r.outcomes])
-        summary["planning_time_s"] = {"median": float(np.median(times)), "p95": float(np.percentile(times, 95)),
-                                      "p99": float(np.percentile(times, 99))}
+        summary["planning_time_s"] = {
+            "median": float(np.median(times)),
+            "p95": float(np.percentile(times, 95)),
+            "p99": float(np.percentile(times, 99)),
+        }
     return summary

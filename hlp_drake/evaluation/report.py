@@ -15,8 +15,15 @@ from hlp_drake.evaluation.protocol import PAPER_TABLE_I, PLANNERS, SETTINGS, Spl
 from hlp_drake.plotting import new_figure, save_png
 from hlp_drake.segmentation.demonstration import Demonstration
 
-COLUMNS = (("shlp", "sHLP"), ("shlp_plan", "sHLP plan"), ("shlp_decision", "I(D)"), ("shlp_element", "I(E)"),
-           ("shlp_element_plan", "I(E) plan"), ("gap_accuracy", "Cg"), ("object_accuracy", "Co"))
+COLUMNS = (
+    ("shlp", "sHLP"),
+    ("shlp_plan", "sHLP plan"),
+    ("shlp_decision", "I(D)"),
+    ("shlp_element", "I(E)"),
+    ("shlp_element_plan", "I(E) plan"),
+    ("gap_accuracy", "Cg"),
+    ("object_accuracy", "Co"),
+)
 NAMES = {"hlp": "planner", "nearest_gap": "nearest gap", "majority": "majority"}
 
 
@@ -24,19 +31,29 @@ def table(label: str, summaries: dict[str, dict], paper: bool) -> str:
     """The planners' figures (mean +- std over splits) under ``label``, the paper's beside if asked."""
     lines = [label, f"  {'':<12}" + "".join(f"{name:>15}" for _, name in COLUMNS)]
     for planner, summary in summaries.items():
-        lines.append(f"  {NAMES[planner]:<12}" + "".join(
-            f"{summary[key]['mean']:>8.3f} +-{summary[key]['std']:.3f}" for key, _ in COLUMNS))
+        lines.append(
+            f"  {NAMES[planner]:<12}"
+            + "".join(f"{summary[key]['mean']:>8.3f} +-{summary[key]['std']:.3f}" for key, _ in COLUMNS)
+        )
     if paper:
-        lines.append(f"  {'paper':<12}" + "".join(
-            f"{PAPER_TABLE_I[key]:>15.2f}" if key in PAPER_TABLE_I else f"{'-':>15}" for key, _ in COLUMNS))
+        lines.append(
+            f"  {'paper':<12}"
+            + "".join(
+                f"{PAPER_TABLE_I[key]:>15.2f}" if key in PAPER_TABLE_I else f"{'-':>15}" for key, _ in COLUMNS
+            )
+        )
     if "row_ece" in summaries["hlp"]:
         h = summaries["hlp"]
-        lines.append(f"  Cr on the held-out rows: calibration error {h['row_ece']['mean']:.3f}, Brier "
-                     f"{h['row_brier']['mean']:.3f}, within the demonstrations' range "
-                     f"{h['row_in_distribution']['mean']:.1%}")
+        lines.append(
+            f"  Cr on the held-out rows: calibration error {h['row_ece']['mean']:.3f}, Brier "
+            f"{h['row_brier']['mean']:.3f}, within the demonstrations' range "
+            f"{h['row_in_distribution']['mean']:.1%}"
+        )
     t = summaries["hlp"]["planning_time_s"]
-    lines.append(f"  planning time per scene: median {t['median'] * 1e3:.2f} ms, p95 {t['p95'] * 1e3:.2f} ms, "
-                 f"p99 {t['p99'] * 1e3:.2f} ms")
+    lines.append(
+        f"  planning time per scene: median {t['median'] * 1e3:.2f} ms, p95 {t['p95'] * 1e3:.2f} ms, "
+        f"p99 {t['p99'] * 1e3:.2f} ms"
+    )
     return "\n".join(lines)
 
 
@@ -44,8 +61,20 @@ def rows_csv(results: dict[str, list[SplitResult]]) -> str:
     """One row per split, planner, test trial and scored row."""
     out = io.StringIO()
     writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(["label", "split", "planner", "subject", "trial", "row", "human_decision", "human_element",
-                     "decision", "element"])
+    writer.writerow(
+        [
+            "label",
+            "split",
+            "planner",
+            "subject",
+            "trial",
+            "row",
+            "human_decision",
+            "human_element",
+            "decision",
+            "element",
+        ]
+    )
     for label, splits in results.items():
         for k, split in enumerate(splits, start=1):
             for planner in PLANNERS:
@@ -53,8 +82,20 @@ def rows_csv(results: dict[str, list[SplitResult]]) -> str:
                 for outcome in outcomes:
                     subject, trial = outcome.key.split("/T")
                     for r in outcome.rows:
-                        writer.writerow([label, k, planner, subject, int(trial), r.row, r.human_decision,
-                                         r.human_element, r.hlp_decision, r.hlp_element])
+                        writer.writerow(
+                            [
+                                label,
+                                k,
+                                planner,
+                                subject,
+                                int(trial),
+                                r.row,
+                                r.human_decision,
+                                r.human_element,
+                                r.hlp_decision,
+                                r.hlp_element,
+                            ]
+                        )
     return out.getvalue()
 
 
@@ -68,8 +109,16 @@ def _plot(path: str, summaries: dict[str, dict[str, dict]], title: str) -> None:
             x = np.arange(len(labels)) + (2 * p + m - len(PLANNERS) + 0.5) * width
             means = [summaries[label][planner][metric]["mean"] for label in labels]
             stds = [summaries[label][planner][metric]["std"] for label in labels]
-            axes.bar(x, means, width, yerr=stds, capsize=2, label=f"{NAMES[planner]}: {name}",
-                     color=f"C{p}", alpha=1.0 if m == 0 else 0.55)
+            axes.bar(
+                x,
+                means,
+                width,
+                yerr=stds,
+                capsize=2,
+                label=f"{NAMES[planner]}: {name}",
+                color=f"C{p}",
+                alpha=1.0 if m == 0 else 0.55,
+            )
     axes.set_xticks(np.arange(len(labels)), labels)
     axes.set_ylim(0.0, 1.0)
     axes.set_ylabel("agreement with the held-out people")
@@ -82,10 +131,20 @@ def _plot(path: str, summaries: dict[str, dict[str, dict]], title: str) -> None:
 def _plot_curve(path: str, summaries: dict[str, dict[str, dict]], title: str) -> None:
     figure, axes = new_figure(6.5, 4.5)
     sizes = [int(n) for n in summaries]
-    for metric, name in (("shlp", "sHLP"), ("shlp_decision", "I(D)"), ("gap_accuracy", "Cg"),
-                         ("object_accuracy", "Co")):
-        axes.errorbar(sizes, [summaries[str(n)]["hlp"][metric]["mean"] for n in sizes],
-                      yerr=[summaries[str(n)]["hlp"][metric]["std"] for n in sizes], marker="o", capsize=3, label=name)
+    for metric, name in (
+        ("shlp", "sHLP"),
+        ("shlp_decision", "I(D)"),
+        ("gap_accuracy", "Cg"),
+        ("object_accuracy", "Co"),
+    ):
+        axes.errorbar(
+            sizes,
+            [summaries[str(n)]["hlp"][metric]["mean"] for n in sizes],
+            yerr=[summaries[str(n)]["hlp"][metric]["std"] for n in sizes],
+            marker="o",
+            capsize=3,
+            label=name,
+        )
     axes.set_xlabel("training subjects")
     axes.set_ylabel("score on the held-out subjects")
     axes.set_ylim(0.0, 1.0)
@@ -95,26 +154,46 @@ def _plot_curve(path: str, summaries: dict[str, dict[str, dict]], title: str) ->
     save_png(figure, path)
 
 
-def write_report(args: Namespace, results: dict[str, list[SplitResult]], demonstrations: Sequence[Demonstration],
-                 seconds: float) -> int:
+def write_report(
+    args: Namespace,
+    results: dict[str, list[SplitResult]],
+    demonstrations: Sequence[Demonstration],
+    seconds: float,
+) -> int:
     """Print the tables and write the JSON (and CSV, PNG) ``args`` asks for; return 0."""
-    summaries = {label: {planner: summarise(splits, planner) for planner in PLANNERS}
-                 for label, splits in results.items()}
+    summaries = {
+        label: {planner: summarise(splits, planner) for planner in PLANNERS}
+        for label, splits in results.items()
+    }
     protocol = "models" if args.models else args.protocol
     what = f"models {args.models}" if args.models else f"{args.preset} learners"
-    print(f"{protocol} protocol, {args.mode} mode, {what}, {len(demonstrations)} demonstrations, {seconds:.0f} s")
+    print(
+        f"{protocol} protocol, {args.mode} mode, {what}, {len(demonstrations)} demonstrations, {seconds:.0f} s"
+    )
     for label, summary in summaries.items():
         heading = {"a": f"setting a: {SETTINGS['a']}", "b": f"setting b: {SETTINGS['b']}"}.get(label, label)
         count = len(results[label])
         if protocol == "num_subjects":
             heading = f"{label} training subjects"
-        print(table(f"{heading} ({count} split{'s' * (count > 1)}, mean +- std)", summary, protocol == "80_20"))
+        print(
+            table(f"{heading} ({count} split{'s' * (count > 1)}, mean +- std)", summary, protocol == "80_20")
+        )
     report = {
-        "protocol": protocol, "mode": args.mode, "preset": None if args.models else args.preset, "models": args.models,
-        "splits": args.splits, "folds": args.folds, "seed": args.seed, "demonstrations": len(demonstrations),
-        "seconds": seconds, "paper": PAPER_TABLE_I, "settings": SETTINGS, "results": summaries,
-        "splits_subjects": {label: [{"train": r.train, "test": r.test} for r in splits]
-                            for label, splits in results.items()},
+        "protocol": protocol,
+        "mode": args.mode,
+        "preset": None if args.models else args.preset,
+        "models": args.models,
+        "splits": args.splits,
+        "folds": args.folds,
+        "seed": args.seed,
+        "demonstrations": len(demonstrations),
+        "seconds": seconds,
+        "paper": PAPER_TABLE_I,
+        "settings": SETTINGS,
+        "results": summaries,
+        "splits_subjects": {
+            label: [{"train": r.train, "test": r.test} for r in splits] for label, splits in results.items()
+        },
     }
     write_text_atomic(args.json, json.dumps(report, indent=2) + "\n")
     if args.csv:

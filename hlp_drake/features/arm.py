@@ -12,8 +12,9 @@ from hlp_drake.taskspace import mirror_direction
 ARM_FEATURES = ("q1", "q2", "dx", "dy", "direction")
 
 
-def arm_features(arm: Sequence[float], displacement: Sequence[float], direction: str | None, *,
-                 mirror: bool = False) -> np.ndarray:
+def arm_features(
+    arm: Sequence[float], displacement: Sequence[float], direction: str | None, *, mirror: bool = False
+) -> np.ndarray:
     """(5,): current (q1, q2), the hand's displacement to the next keypoint / arm length, its class.
 
     Args:

@@ -27,8 +27,15 @@ def direction_index(name: str | None) -> int:
     return UNDEFINED_DIRECTION if name is None else DIRECTIONS.index(name)
 
 
-def direction_features(space: TaskSpace, name: str, *, hand: Sequence[float], mode: Mode,
-                       training: bool = False, hand_to_object: str | None = None) -> np.ndarray:
+def direction_features(
+    space: TaskSpace,
+    name: str,
+    *,
+    hand: Sequence[float],
+    mode: Mode,
+    training: bool = False,
+    hand_to_object: str | None = None,
+) -> np.ndarray:
     """Xd of obstacle ``name`` for a hand at ``hand``: (10,) = 8 free fractions, 2 class indices.
 
     Args:
@@ -73,8 +80,13 @@ class DirectionTable:
         else:
             self.origins = rect_centres(rects)
             target_origin = np.array(space.target.center)
-        self.to_target = np.array([direction_index(direction_of(*(target_origin - o), faithful=self.faithful))
-                                   for o in self.origins], dtype=int).reshape(-1)
+        self.to_target = np.array(
+            [
+                direction_index(direction_of(*(target_origin - o), faithful=self.faithful))
+                for o in self.origins
+            ],
+            dtype=int,
+        ).reshape(-1)
 
     def hand_direction(self, k: int, hand: Sequence[float]) -> str | None:
         """Direction class from a hand at ``hand`` to obstacle ``k``."""
@@ -84,4 +96,6 @@ class DirectionTable:
         """Xd of obstacles ``index`` approached from direction class indices ``hand_class``
         (broadcast together): (..., 10)."""
         index, hand_class = np.broadcast_arrays(index, hand_class)
-        return np.concatenate([self.free[index], hand_class[..., None], self.to_target[index][..., None]], axis=-1)
+        return np.concatenate(
+            [self.free[index], hand_class[..., None], self.to_target[index][..., None]], axis=-1
+        )

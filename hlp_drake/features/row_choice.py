@@ -71,7 +71,11 @@ def line_at(hand: np.ndarray, goal: np.ndarray, x: float) -> np.ndarray:
     hand = np.asarray(hand, float)
     span = goal[0] - hand[..., 0]
     flat = np.abs(span) < 1e-9
-    return np.where(flat, goal[1], hand[..., 1] + (x - hand[..., 0]) * (goal[1] - hand[..., 1]) / np.where(flat, 1.0, span))
+    return np.where(
+        flat,
+        goal[1],
+        hand[..., 1] + (x - hand[..., 0]) * (goal[1] - hand[..., 1]) / np.where(flat, 1.0, span),
+    )
 
 
 def _passage(y_min: np.ndarray, y_max: np.ndarray, line: np.ndarray, width: float) -> np.ndarray:
@@ -109,10 +113,19 @@ class _RowGeometry:
         gap_rows = np.flatnonzero(table.row == row)
         at_edge = np.array([table.left[k] is None or table.right[k] is None for k in gap_rows], dtype=float)
         members = np.array([space.obstacle_index[n] for n in r.members], dtype=int)
-        return cls(r.x, gap_rows, table.bounds[gap_rows], at_edge, members, space.obstacle_bounds[members],
-                   free[members].reshape(-1, 8))
+        return cls(
+            r.x,
+            gap_rows,
+            table.bounds[gap_rows],
+            at_edge,
+            members,
+            space.obstacle_bounds[members],
+            free[members].reshape(-1, 8),
+        )
 
-    def best(self, hands: np.ndarray, goal: np.ndarray, width: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def best(
+        self, hands: np.ndarray, goal: np.ndarray, width: float
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per hand (..., 2): (the smallest offset of a gap where the hand fits, that gap's width,
         the obstacles' overlap with the hand's corridor), m, at the row's depth."""
         line = line_at(hands, goal, self.x)[..., None]
@@ -134,8 +147,9 @@ def free_space(space: TaskSpace) -> np.ndarray:
     return free_fractions(block_array(space.obstacle_bounds, space.alpha), occluders).reshape(-1, 8)
 
 
-def _nearest(geometry: _RowGeometry, lines: np.ndarray, width: float,
-             limit: int | None) -> tuple[list[set[int]], list[set[int]]]:
+def _nearest(
+    geometry: _RowGeometry, lines: np.ndarray, width: float, limit: int | None
+) -> tuple[list[set[int]], list[set[int]]]:
     """Per hand (its line's lateral position at the row): the row's gaps and obstacles to describe,
     the ``limit`` of each kind laterally nearest the line (all if None)."""
     gaps, obstacles = len(geometry.gaps), len(geometry.obstacles)
@@ -144,8 +158,10 @@ def _nearest(geometry: _RowGeometry, lines: np.ndarray, width: float,
     gb, ob = geometry.gaps, geometry.obstacles
     gap_offset = np.abs(_passage(gb[:, 1], gb[:, 3], lines[:, None], width) - lines[:, None])
     obj_offset = np.abs((ob[:, 1] + ob[:, 3])[None] / 2.0 - lines[:, None])
-    return ([set(np.argsort(o, kind="stable")[:limit].tolist()) for o in gap_offset],
-            [set(np.argsort(o, kind="stable")[:limit].tolist()) for o in obj_offset])
+    return (
+        [set(np.argsort(o, kind="stable")[:limit].tolist()) for o in gap_offset],
+        [set(np.argsort(o, kind="stable")[:limit].tolist()) for o in obj_offset],
+    )
 
 
 class RowChoiceScene:
@@ -165,9 +181,13 @@ class RowChoiceScene:
         self.goal = np.asarray(space.target.center, float)
         start, centres = np.asarray(space.scene.start, float), space.obstacle_centres
         span = self.goal - start
-        offset = np.abs(span[0] * (centres[:, 1] - start[1]) - span[1] * (centres[:, 0] - start[0]))  # ~ distance
+        offset = np.abs(
+            span[0] * (centres[:, 1] - start[1]) - span[1] * (centres[:, 0] - start[0])
+        )  # ~ distance
         ids = np.sort(np.argsort(offset, kind="stable")[:route_obstacles])
-        self.routes = FreeRoutes(space.obstacle_bounds[ids], ids, space.scene.table.bounds, hand_width, self.goal)
+        self.routes = FreeRoutes(
+            space.obstacle_bounds[ids], ids, space.scene.table.bounds, hand_width, self.goal
+        )
         self._free = free_space(space)
         self._rows: dict[int, _RowGeometry] = {}
 
@@ -176,8 +196,15 @@ class RowChoiceScene:
             self._rows[index] = _RowGeometry.of(self.space, index, self._free)
         return self._rows[index]
 
-    def candidates(self, row: int, hands: np.ndarray, removed: Sequence[Collection[int]] | None = None, *,
-                   mirror: bool = False, limit: int | None = None) -> list[RowCandidates]:
+    def candidates(
+        self,
+        row: int,
+        hands: np.ndarray,
+        removed: Sequence[Collection[int]] | None = None,
+        *,
+        mirror: bool = False,
+        limit: int | None = None,
+    ) -> list[RowCandidates]:
         """The candidates of ``row`` and their features Xr, for each hand of ``hands`` heading for
         the target.
 
@@ -219,7 +246,9 @@ class RowChoiceScene:
         X[:, :, 3] = np.minimum(np.abs(lateral) / w, CAP)
         X[:, :, 4] = np.clip((-1.0 if mirror else 1.0) * lateral / w, -CAP, CAP)
         X[:, :, 5] = np.arctan2(np.abs(lateral), depth)
-        X[:, :n_gaps, 6] = np.minimum(np.maximum(np.abs(lateral[:, :n_gaps]) - best_offset[:, None], 0.0) / w, CAP)
+        X[:, :n_gaps, 6] = np.minimum(
+            np.maximum(np.abs(lateral[:, :n_gaps]) - best_offset[:, None], 0.0) / w, CAP
+        )
         X[:, :n_gaps, 7] = geometry.at_edge[gap_union]
         X[:, n_gaps:, 8] = np.minimum(_corridor_overlap(ob[:, 1], ob[:, 3], line[:, None], w) / w, CAP)
         X[:, :n_gaps, 9:11] = 1.0
@@ -231,7 +260,9 @@ class RowChoiceScene:
         X[:, :, 16] = np.minimum(best_width / w, CAP)[:, None]
         X[:, :, 17] = np.minimum(block / w, CAP)[:, None]
         X[:, :, 18] = min(len(geometry.members), CAP)
-        X[:, :, 19] = np.clip((geometry.x - hands[:, 0]) / np.maximum(goal[0] - hands[:, 0], w), -1.0, 2.0)[:, None]
+        X[:, :, 19] = np.clip((geometry.x - hands[:, 0]) / np.maximum(goal[0] - hands[:, 0], w), -1.0, 2.0)[
+            :, None
+        ]
         if row < len(self.space.rows):
             next_offset, _, next_block = self.row(row + 1).best(points, goal, w)
             X[:, :, 21], X[:, :, 22] = np.minimum(next_offset / w, CAP), np.minimum(next_block / w, CAP)
@@ -241,20 +272,38 @@ class RowChoiceScene:
         X[:, :, 26] = np.minimum((goal[0] - geometry.x) / w, CAP)
         self._route_features(X, hands, points, members, n_gaps, removed)
 
-        gaps = np.concatenate([self.space.gap_table.index[geometry.gap_rows[gap_union]], np.zeros(n_obj, dtype=int)])
+        gaps = np.concatenate(
+            [self.space.gap_table.index[geometry.gap_rows[gap_union]], np.zeros(n_obj, dtype=int)]
+        )
         obstacles = np.concatenate([np.full(n_gaps, -1), members]).astype(int)
         kinds = ("gap",) * n_gaps + ("object",) * n_obj
         at = {g: k for k, g in enumerate(gap_union)}
         at_obj = {o: n_gaps + k for k, o in enumerate(obj_union)}
         result = []
         for b in range(len(hands)):
-            keep = np.array([at[g] for g in sorted(gap_keep[b])] + [at_obj[o] for o in sorted(obj_keep[b])], dtype=int)
-            result.append(RowCandidates(row, tuple(kinds[k] for k in keep), gaps[keep], obstacles[keep],
-                                        points[b, keep], X[b, keep]))
+            keep = np.array(
+                [at[g] for g in sorted(gap_keep[b])] + [at_obj[o] for o in sorted(obj_keep[b])], dtype=int
+            )
+            result.append(
+                RowCandidates(
+                    row,
+                    tuple(kinds[k] for k in keep),
+                    gaps[keep],
+                    obstacles[keep],
+                    points[b, keep],
+                    X[b, keep],
+                )
+            )
         return result
 
-    def _approach_collision(self, hands: np.ndarray, points: np.ndarray, members: np.ndarray, n_gaps: int,
-                            removed: list[frozenset[int]]) -> np.ndarray:
+    def _approach_collision(
+        self,
+        hands: np.ndarray,
+        points: np.ndarray,
+        members: np.ndarray,
+        n_gaps: int,
+        removed: list[frozenset[int]],
+    ) -> np.ndarray:
         """(B, n) per hand and candidate: the length of the hand's straight way from the hand to the
         candidate inside the obstacles grown by half the hand's width, in hand widths (not counting
         the candidate's own obstacle, nor the ones moved away)."""
@@ -267,15 +316,24 @@ class RowChoiceScene:
         inside[:, np.arange(n_gaps, n), members] = 0.0
         return inside.sum(axis=2) / w
 
-    def _route_features(self, X: np.ndarray, hands: np.ndarray, points: np.ndarray, members: np.ndarray,
-                        n_gaps: int, removed: list[frozenset[int]]) -> None:
+    def _route_features(
+        self,
+        X: np.ndarray,
+        hands: np.ndarray,
+        points: np.ndarray,
+        members: np.ndarray,
+        n_gaps: int,
+        removed: list[frozenset[int]],
+    ) -> None:
         """Fill columns 12, 13 and 20 of ``X`` (B, n, k): a gap's shortest route through it / the
         shortest route; an obstacle's shortening of the shortest route if it were moved, in hand
         widths (for the obstacles across the straight way from the hand to the target; 0 for the
         others); the shortest route / the straight distance (ROUTE_CAP where there is no route)."""
         routes, w, B, G = self.routes, self.width, len(hands), n_gaps
         gap_points = points[:, :G].reshape(-1, 2)
-        sight, pair_hits = routes.sight(np.vstack([hands, gap_points]), pairs=(np.repeat(hands, G, axis=0), gap_points))
+        sight, pair_hits = routes.sight(
+            np.vstack([hands, gap_points]), pairs=(np.repeat(hands, G, axis=0), gap_points)
+        )
         straight = np.maximum(np.hypot(*(self.goal - hands).T), w)
         route_index = {int(k): i for i, k in enumerate(routes.ids)}
         for gone in set(removed):
@@ -285,8 +343,10 @@ class RowChoiceScene:
             X[group, :, 20] = np.minimum(shortest / straight[group], ROUTE_CAP)[:, None]
             if G:
                 pairs = (group[:, None] * G + np.arange(G)).reshape(-1)
-                via = (routes.between(sight, np.repeat(group, G), B + pairs, pair_hits[pairs], gone)
-                       + routes.to_goal(sight, B + pairs, gone)).reshape(len(group), G)
+                via = (
+                    routes.between(sight, np.repeat(group, G), B + pairs, pair_hits[pairs], gone)
+                    + routes.to_goal(sight, B + pairs, gone)
+                ).reshape(len(group), G)
                 X[group, :G, 12] = np.minimum(via / shortest[:, None], ROUTE_CAP)
             for k, obstacle in enumerate(members):  # moved away: the route from the hands it stands before
                 r = route_index.get(int(obstacle))

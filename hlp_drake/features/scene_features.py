@@ -14,12 +14,15 @@ OBJECT_FEATURES = (*GAP_FEATURES, "free_space", "target_overlap")
 def _relative(centres: np.ndarray, start: np.ndarray, target: np.ndarray, diagonal: float) -> np.ndarray:
     """Columns 1, 2, 4, 5 of Xg/Xo: distances (normalised) and angles from the start and the target."""
     from_start, from_target = centres - start, centres - target
-    return np.stack([
-        np.linalg.norm(from_start, axis=1) / diagonal,
-        np.linalg.norm(from_target, axis=1) / diagonal,
-        paper_angle(from_start),
-        paper_angle(from_target),
-    ], axis=1)
+    return np.stack(
+        [
+            np.linalg.norm(from_start, axis=1) / diagonal,
+            np.linalg.norm(from_target, axis=1) / diagonal,
+            paper_angle(from_start),
+            paper_angle(from_target),
+        ],
+        axis=1,
+    )
 
 
 def gap_features(space: TaskSpace, index: np.ndarray | None = None) -> np.ndarray:

@@ -31,8 +31,9 @@ def path_occluders(space: TaskSpace, *, faithful: bool) -> np.ndarray:
     return np.vstack([space.obstacle_bounds, rect_array(walls)])
 
 
-def segment_feature_matrix(space: TaskSpace, near: list[Node], far: list[Node], *, mode: Mode,
-                           training: bool = False) -> np.ndarray:
+def segment_feature_matrix(
+    space: TaskSpace, near: list[Node], far: list[Node], *, mode: Mode, training: bool = False
+) -> np.ndarray:
     """Xc of every pair (a in ``near``, b in ``far``), a-major: (len(near) * len(far), 4).
 
     1 lateral span |b_y - a_y| / N; 2 the segment's lateral-per-depth slope minus the start-target
@@ -50,14 +51,28 @@ def node_pairs(space: TaskSpace, near: list[Node], far: list[Node]) -> tuple[np.
     """The arguments ``pa, pb, own_a, own_b`` of ``pair_features`` for every pair (a in ``near``,
     b in ``far``), a-major."""
     a, b = (np.array([n.center for n in nodes], float).reshape(-1, 2) for nodes in (near, far))
-    own_a, own_b = (np.array([-1 if n.obstacle is None else space.obstacle_index[n.obstacle] for n in nodes], dtype=int)
-                    for nodes in (near, far))
-    return (np.repeat(a, len(far), axis=0), np.tile(b, (len(near), 1)), np.repeat(own_a, len(far)),
-            np.tile(own_b, len(near)))
+    own_a, own_b = (
+        np.array([-1 if n.obstacle is None else space.obstacle_index[n.obstacle] for n in nodes], dtype=int)
+        for nodes in (near, far)
+    )
+    return (
+        np.repeat(a, len(far), axis=0),
+        np.tile(b, (len(near), 1)),
+        np.repeat(own_a, len(far)),
+        np.tile(own_b, len(near)),
+    )
 
 
-def pair_features(space: TaskSpace, pa: np.ndarray, pb: np.ndarray, own_a: np.ndarray, own_b: np.ndarray, *,
-                  mode: Mode, training: bool = False) -> np.ndarray:
+def pair_features(
+    space: TaskSpace,
+    pa: np.ndarray,
+    pb: np.ndarray,
+    own_a: np.ndarray,
+    own_b: np.ndarray,
+    *,
+    mode: Mode,
+    training: bool = False,
+) -> np.ndarray:
     """Xc of the segments pa[i] -> pb[i] (see ``segment_feature_matrix``): (n, 4).
 
     Args:
@@ -90,7 +105,9 @@ def pair_features(space: TaskSpace, pa: np.ndarray, pb: np.ndarray, own_a: np.nd
     collision = np.where(own, 0.0, coverage).sum(axis=1) / (~own).sum(axis=1)
     lateral_a, lateral_b, lateral_t = -pa[:, 1], -pb[:, 1], -target[1]
     low, high = np.minimum(lateral_a, lateral_b), np.maximum(lateral_a, lateral_b)
-    overlap = np.maximum(np.minimum(high, lateral_t + TARGET_BAND) - np.maximum(low, lateral_t - TARGET_BAND), 0.0)
+    overlap = np.maximum(
+        np.minimum(high, lateral_t + TARGET_BAND) - np.maximum(low, lateral_t - TARGET_BAND), 0.0
+    )
     return np.column_stack([span, slope, collision, overlap / norm])
 
 

@@ -33,8 +33,14 @@ class LabelledSet:
         return len(self.y)
 
     def rows(self, mask: np.ndarray) -> LabelledSet:
-        return LabelledSet(self.columns, self.X[mask], self.y[mask], self.subjects[mask], self.keys[mask],
-                           self.original[mask])
+        return LabelledSet(
+            self.columns,
+            self.X[mask],
+            self.y[mask],
+            self.subjects[mask],
+            self.keys[mask],
+            self.original[mask],
+        )
 
     def subset(self, subjects: Iterable[str]) -> LabelledSet:
         """The rows of the given subjects."""
@@ -67,9 +73,15 @@ class TrainingData:
 
     def where(self, keep) -> TrainingData:
         """The rows of the trials (keys) ``keep(key)`` accepts."""
-        return TrainingData(self.mode, *(
-            getattr(self, n).rows(np.array([bool(keep(k)) for k in getattr(self, n).keys], dtype=bool).reshape(-1))
-            for n in SETS))
+        return TrainingData(
+            self.mode,
+            *(
+                getattr(self, n).rows(
+                    np.array([bool(keep(k)) for k in getattr(self, n).keys], dtype=bool).reshape(-1)
+                )
+                for n in SETS
+            ),
+        )
 
 
 class _Builder:
@@ -101,8 +113,9 @@ def _chosen(node: Node, decision) -> bool:
     return decision.decision == OBJECT and node.obstacle == decision.obstacle
 
 
-def _segment_labels(space: TaskSpace, demo: Demonstration, row: int, near: list[Node], far: list[Node],
-                    *, faithful: bool) -> np.ndarray:
+def _segment_labels(
+    space: TaskSpace, demo: Demonstration, row: int, near: list[Node], far: list[Node], *, faithful: bool
+) -> np.ndarray:
     """(len(near), len(far)) 0/1 matrix with a 1 at the pair of nodes the demonstrator used."""
     labels = np.zeros((len(near), len(far)))
     d_near, d_far = demo.decisions[row - 1], demo.decisions[row]
@@ -144,8 +157,12 @@ def object_labels(demo: Demonstration, space: TaskSpace) -> list[float]:
     return [float(n in moved) for n in space.obstacle_names]
 
 
-def row_choice_rows(demo: Demonstration, space: TaskSpace, *, hand_width: float = HUMAN_HAND_WIDTH,
-                    ) -> list[tuple[np.ndarray, np.ndarray]]:
+def row_choice_rows(
+    demo: Demonstration,
+    space: TaskSpace,
+    *,
+    hand_width: float = HUMAN_HAND_WIDTH,
+) -> list[tuple[np.ndarray, np.ndarray]]:
     """Per row the person crossed: the row's candidates' Xr and 0/1 labels (1: the person's).
 
     The hand goes from row to row as the planner's does: from the start to the passage point of
@@ -159,17 +176,22 @@ def row_choice_rows(demo: Demonstration, space: TaskSpace, *, hand_width: float 
     for decision in demo.decisions:
         if decision.decision == NONE:
             continue
-        candidates, = features.candidates(decision.row, hand, [removed], mirror=demo.left_handed)
+        (candidates,) = features.candidates(decision.row, hand, [removed], mirror=demo.left_handed)
         names = space.obstacle_names
-        chosen = [k for k in range(len(candidates)) if candidates.kinds[k] == decision.decision
-                  and candidates.element(k, names) == decision.element]
+        chosen = [
+            k
+            for k in range(len(candidates))
+            if candidates.kinds[k] == decision.decision and candidates.element(k, names) == decision.element
+        ]
         if len(chosen) != 1:
             continue  # the person's obstacle was moved already (a second move in a row is not learnt)
         k = chosen[0]
         rows.append((candidates.X, (np.arange(len(candidates)) == k).astype(float)))
         if decision.decision == OBJECT:
             obstacle = int(candidates.obstacles[k])
-            region = relocated_array(space.obstacle_bounds[[obstacle]], space.alpha)[0, DIRECTIONS.index(decision.direction)]
+            region = relocated_array(space.obstacle_bounds[[obstacle]], space.alpha)[
+                0, DIRECTIONS.index(decision.direction)
+            ]
             hand = np.array([(region[0] + region[2]) / 2.0, (region[1] + region[3]) / 2.0])
             removed.add(obstacle)
         else:
@@ -220,8 +242,14 @@ def training_data(demonstrations: Iterable[Demonstration], *, mode: Mode | None 
             if keypoint.kind != "approach":
                 continue
             decision = demo.decisions[keypoint.row - 1]
-            features = direction_features(space, decision.obstacle, hand=demo.keypoints[k - 1].position, mode=mode,
-                                          training=True, hand_to_object=keypoint.direction)
+            features = direction_features(
+                space,
+                decision.obstacle,
+                hand=demo.keypoints[k - 1].position,
+                mode=mode,
+                training=True,
+                hand_to_object=keypoint.direction,
+            )
             direction.add(demo.key, features, [direction_index(decision.direction)])
         for row in range(1, len(space.rows)):
             if NONE in (demo.decisions[row - 1].decision, demo.decisions[row].decision):
@@ -230,11 +258,25 @@ def training_data(demonstrations: Iterable[Demonstration], *, mode: Mode | None 
             labels = _segment_labels(space, demo, row, near, far, faithful=faithful)
             features = segment_feature_matrix(space, near, far, mode=mode, training=True)
             segment.add(demo.key, features, labels.reshape(-1))
-        people.add(demo.key, np.array([demo.link_lengths.upper_arm, demo.link_lengths.forearm]), [demo.keypoints[0].arm])
+        people.add(
+            demo.key,
+            np.array([demo.link_lengths.upper_arm, demo.link_lengths.forearm]),
+            [demo.keypoints[0].arm],
+        )
         scale = demo.link_lengths.total if faithful else 1.0  # bug B4: divided by the arm length twice
         mirror = demo.left_handed and not faithful
         for before, after in zip(demo.keypoints, demo.keypoints[1:]):
             displacement = np.asarray(after.displacement) / scale
-            arm.add(demo.key, arm_features(before.arm, displacement, after.direction, mirror=mirror), [after.arm])
-    return TrainingData(mode or "fixed", gap.build(), obj.build(), direction.build(), segment.build(), arm.build(),
-                        people.build(), row_set.build())
+            arm.add(
+                demo.key, arm_features(before.arm, displacement, after.direction, mirror=mirror), [after.arm]
+            )
+    return TrainingData(
+        mode or "fixed",
+        gap.build(),
+        obj.build(),
+        direction.build(),
+        segment.build(),
+        arm.build(),
+        people.build(),
+        row_set.build(),
+    )

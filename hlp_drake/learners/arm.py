@@ -30,7 +30,9 @@ class ArmRegressor(RegressorMixin, BaseEstimator):
     displacements and one-hot classes alike). Saved as plain arrays; prediction is the GP mean.
     """
 
-    def __init__(self, max_samples: int = 1500, categorical: tuple[int, ...] = (), random_state: int = 0) -> None:
+    def __init__(
+        self, max_samples: int = 1500, categorical: tuple[int, ...] = (), random_state: int = 0
+    ) -> None:
         self.max_samples = max_samples
         self.categorical = categorical
         self.random_state = random_state
@@ -60,7 +62,9 @@ class ArmRegressor(RegressorMixin, BaseEstimator):
         self.alpha_, self.length_scale_, self.amplitude_ = [], [], []
         for k in range(y.shape[1]):
             kernel = ConstantKernel(1.0) * RBF(length_scale=1.0) + WhiteKernel(0.1)
-            gp = GaussianProcessRegressor(kernel, random_state=self.random_state).fit(self.train_, targets[:, k])
+            gp = GaussianProcessRegressor(kernel, random_state=self.random_state).fit(
+                self.train_, targets[:, k]
+            )
             self.alpha_.append(gp.alpha_.ravel())
             self.length_scale_.append(gp.kernel_.k1.k2.length_scale)
             self.amplitude_.append(gp.kernel_.k1.k1.constant_value)
@@ -76,8 +80,13 @@ class ArmRegressor(RegressorMixin, BaseEstimator):
         q = self._predict(self._standardised(X))
         return q[:, 0] if self._flat else q
 
-    def rollout(self, start: np.ndarray, parent: list[int], moves: np.ndarray,
-                limits: tuple[float, float] = (-np.inf, np.inf)) -> np.ndarray:
+    def rollout(
+        self,
+        start: np.ndarray,
+        parent: list[int],
+        moves: np.ndarray,
+        limits: tuple[float, float] = (-np.inf, np.inf),
+    ) -> np.ndarray:
         """The angles at every node of a tree of hand moves, each predicted from its parent's.
 
         Args:
@@ -107,14 +116,26 @@ class ArmRegressor(RegressorMixin, BaseEstimator):
 
     def _predict(self, Z: np.ndarray) -> np.ndarray:
         kernels = gaussian_kernel(Z, self._weights, tuple(0.5 / self.length_scale_**2))
-        return np.column_stack([self.amplitude_[k] * (K @ self.alpha_[k]) * self.y_std_[k] + self.y_mean_[k]
-                                for k, K in enumerate(kernels)])
+        return np.column_stack(
+            [
+                self.amplitude_[k] * (K @ self.alpha_[k]) * self.y_std_[k] + self.y_mean_[k]
+                for k, K in enumerate(kernels)
+            ]
+        )
 
     def get_state(self) -> dict[str, np.ndarray]:
         check_is_fitted(self)
-        return {"mean": self.mean_, "scale": self.scale_, "train": self.train_, "alpha": self.alpha_,
-                "length_scale": self.length_scale_, "amplitude": self.amplitude_, "y_mean": self.y_mean_,
-                "y_std": self.y_std_, "outputs": np.array(0 if self._flat else self.n_outputs_)}
+        return {
+            "mean": self.mean_,
+            "scale": self.scale_,
+            "train": self.train_,
+            "alpha": self.alpha_,
+            "length_scale": self.length_scale_,
+            "amplitude": self.amplitude_,
+            "y_mean": self.y_mean_,
+            "y_std": self.y_std_,
+            "outputs": np.array(0 if self._flat else self.n_outputs_),
+        }
 
     def set_state(self, state: dict[str, np.ndarray]) -> ArmRegressor:
         for name in ("mean", "scale", "train", "alpha", "length_scale", "amplitude", "y_mean", "y_std"):

@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 
-def oversample(X: np.ndarray, y: np.ndarray, rng: np.random.Generator,
-               max_per_class: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+def oversample(
+    X: np.ndarray, y: np.ndarray, rng: np.random.Generator, max_per_class: int | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Bring every class to the size of the largest (whole copies plus a random remainder).
 
     Args:

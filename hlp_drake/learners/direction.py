@@ -34,7 +34,9 @@ class DirectionClassifier(ClassifierMixin, BaseEstimator):
         check_classification_targets(y)
         check_categorical(self.categorical, X.shape[1])
         classes, codes = np.unique(y, return_inverse=True)
-        Xb, yb = oversample(expand_directions(X, self.categorical), codes, np.random.default_rng(self.random_state))
+        Xb, yb = oversample(
+            expand_directions(X, self.categorical), codes, np.random.default_rng(self.random_state)
+        )
         svc = SVC(C=self.C, kernel="linear", decision_function_shape="ovo").fit(Xb, yb)
         self.classes_ = classes[svc.classes_]
         self.coef_ = svc.coef_

@@ -13,7 +13,7 @@ def expand_directions(X: np.ndarray, columns: tuple[int, ...]) -> np.ndarray:
     X = np.asarray(X, dtype=float)
     keep = [c for c in range(X.shape[1]) if c not in columns]
     out = np.zeros((len(X), len(keep) + N_DIRECTIONS * len(columns)))
-    out[:, :len(keep)] = X[:, keep]
+    out[:, : len(keep)] = X[:, keep]
     for k, c in enumerate(columns):
         index = X[:, c].astype(int)
         valid = np.flatnonzero((index >= 0) & (index < N_DIRECTIONS))

@@ -10,8 +10,9 @@ def binary_classes(estimator, y: np.ndarray) -> np.ndarray:
     """The two classes of ``y``; a one-line ValueError for one class or more than two."""
     classes = np.unique(y)
     if len(classes) > 2:
-        raise ValueError(f"Only binary classification is supported. {type(estimator).__name__} got "
-                         f"{len(classes)} classes")
+        raise ValueError(
+            f"Only binary classification is supported. {type(estimator).__name__} got {len(classes)} classes"
+        )
     if len(classes) < 2:
         raise ValueError(f"{type(estimator).__name__} needs samples of two classes, got 1 class")
     return classes
@@ -36,8 +37,10 @@ def prediction_input(estimator, X) -> np.ndarray:
     X = np.asarray(X, dtype=float)
     name, expected = type(estimator).__name__, estimator.n_features_in_
     if X.ndim != 2:
-        raise ValueError(f"expected a 2-D array of shape (n, {expected}), got shape {X.shape}; "
-                         "Reshape your data with X.reshape(1, -1) for a single sample")
+        raise ValueError(
+            f"expected a 2-D array of shape (n, {expected}), got shape {X.shape}; "
+            "Reshape your data with X.reshape(1, -1) for a single sample"
+        )
     if X.shape[1] != expected:
         raise ValueError(f"X has {X.shape[1]} features, but {name} is expecting {expected} features as input")
     if not np.all(np.isfinite(X)):

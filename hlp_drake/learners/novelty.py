@@ -24,8 +24,9 @@ def _kth_distance(Z: np.ndarray, weights: np.ndarray, k: int, exclude_self: bool
     return np.sqrt(np.partition(sq, k, axis=1)[:, k])
 
 
-def fit_novelty(X: np.ndarray, rng: np.random.Generator, *, samples: int, neighbours: int,
-                quantile: float) -> dict[str, np.ndarray]:
+def fit_novelty(
+    X: np.ndarray, rng: np.random.Generator, *, samples: int, neighbours: int, quantile: float
+) -> dict[str, np.ndarray]:
     """The arrays of a novelty model of the rows of ``X``."""
     mean = X.mean(axis=0)
     scale = np.where(X.std(axis=0) > 0, X.std(axis=0), 1.0)
@@ -36,9 +37,16 @@ def fit_novelty(X: np.ndarray, rng: np.random.Generator, *, samples: int, neighb
     if len(probe) >= samples // 2 and len(probe) > 0:
         distances = _kth_distance(probe, weights, neighbours)
     else:
-        distances = _kth_distance(kept, weights, neighbours, exclude_self=True) if len(kept) > 1 else np.zeros(1)
-    return {"mean": mean, "scale": scale, "points": kept, "neighbours": np.array(neighbours),
-            "threshold": np.array(max(float(np.quantile(distances, quantile)), 1e-9))}
+        distances = (
+            _kth_distance(kept, weights, neighbours, exclude_self=True) if len(kept) > 1 else np.zeros(1)
+        )
+    return {
+        "mean": mean,
+        "scale": scale,
+        "points": kept,
+        "neighbours": np.array(neighbours),
+        "threshold": np.array(max(float(np.quantile(distances, quantile)), 1e-9)),
+    }
 
 
 def novelty_score(state: dict[str, np.ndarray], weights: np.ndarray, X: np.ndarray) -> np.ndarray:

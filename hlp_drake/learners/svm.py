@@ -29,8 +29,14 @@ class RbfSvmClassifier(ClassifierMixin, BaseEstimator):
     ``decision_function`` is reproduced exactly from a saved file.
     """
 
-    def __init__(self, C: float = 1.0, kernel_scale: float = 0.25, max_per_class: int | None = None,
-                 balance: bool = True, random_state: int = 0) -> None:
+    def __init__(
+        self,
+        C: float = 1.0,
+        kernel_scale: float = 0.25,
+        max_per_class: int | None = None,
+        balance: bool = True,
+        random_state: int = 0,
+    ) -> None:
         self.C = C
         self.kernel_scale = kernel_scale
         self.max_per_class = max_per_class
@@ -47,7 +53,11 @@ class RbfSvmClassifier(ClassifierMixin, BaseEstimator):
         check_classification_targets(y)
         self.classes_ = binary_classes(self, y)
         rng = np.random.default_rng(self.random_state)
-        rows = oversample(np.arange(len(y)), y, rng, self.max_per_class)[0] if self.balance else np.arange(len(y))
+        rows = (
+            oversample(np.arange(len(y)), y, rng, self.max_per_class)[0]
+            if self.balance
+            else np.arange(len(y))
+        )
         Xb, yb = X[rows], y[rows]
         self.mean_ = Xb.mean(axis=0)
         self.scale_ = np.where(Xb.std(axis=0) > 0, Xb.std(axis=0), 1.0)
@@ -65,7 +75,7 @@ class RbfSvmClassifier(ClassifierMixin, BaseEstimator):
     def decision_function(self, X: np.ndarray) -> np.ndarray:
         """Signed distance-like score; > 0 means the positive class (``classes_[1]``)."""
         X = prediction_input(self, X)
-        kernel, = gaussian_kernel((X - self.mean_) / self.scale_, self._weights, (self.gamma_,))
+        (kernel,) = gaussian_kernel((X - self.mean_) / self.scale_, self._weights, (self.gamma_,))
         return kernel @ self.dual_coef_ + self.intercept_
 
     def predict(self, X: np.ndarray) -> np.ndarray:
@@ -75,9 +85,15 @@ class RbfSvmClassifier(ClassifierMixin, BaseEstimator):
     def get_state(self) -> dict[str, np.ndarray]:
         """The fitted arrays (for safe saving)."""
         check_is_fitted(self)
-        return {"classes": self.classes_, "mean": self.mean_, "scale": self.scale_,
-                "gamma": np.array(self.gamma_), "support_vectors": self.support_vectors_,
-                "dual_coef": self.dual_coef_, "intercept": np.array(self.intercept_)}
+        return {
+            "classes": self.classes_,
+            "mean": self.mean_,
+            "scale": self.scale_,
+            "gamma": np.array(self.gamma_),
+            "support_vectors": self.support_vectors_,
+            "dual_coef": self.dual_coef_,
+            "intercept": np.array(self.intercept_),
+        }
 
     def set_state(self, state: dict[str, np.ndarray]) -> RbfSvmClassifier:
         self.classes_, self.mean_, self.scale_ = state["classes"], state["mean"], state["scale"]

@@ -18,9 +18,16 @@ def boosted_tree_arrays(model: GradientBoostingClassifier, X: np.ndarray) -> dic
     term (read off ``model.decision_function`` on ``X``)."""
     trees = [estimator.tree_ for estimator in model.estimators_[:, 0]]
     nodes = max(t.node_count for t in trees)
-    arrays = {name: np.zeros((len(trees), nodes), dtype=dtype) for name, dtype in
-              (("feature", np.int32), ("threshold", np.float64), ("left", np.int32), ("right", np.int32),
-               ("value", np.float64))}
+    arrays = {
+        name: np.zeros((len(trees), nodes), dtype=dtype)
+        for name, dtype in (
+            ("feature", np.int32),
+            ("threshold", np.float64),
+            ("left", np.int32),
+            ("right", np.int32),
+            ("value", np.float64),
+        )
+    }
     for k, t in enumerate(trees):
         n = t.node_count
         arrays["feature"][k, :n] = np.maximum(t.feature, 0)
@@ -32,8 +39,9 @@ def boosted_tree_arrays(model: GradientBoostingClassifier, X: np.ndarray) -> dic
     arrays["depth"] = np.array(max(e.get_depth() for e in model.estimators_[:, 0]))
     sample = X[:1]
     arrays["offset"] = np.array(0.0)
-    arrays["offset"] = np.array(float(model.decision_function(sample)[0])
-                                - float(BoostedTrees(arrays).decision_function(sample)[0]))
+    arrays["offset"] = np.array(
+        float(model.decision_function(sample)[0]) - float(BoostedTrees(arrays).decision_function(sample)[0])
+    )
     return arrays
 
 

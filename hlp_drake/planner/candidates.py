@@ -26,8 +26,9 @@ def line_offsets(centres: np.ndarray, start: np.ndarray, target: np.ndarray) -> 
     return np.abs(y - (start[1] + t * (target[1] - start[1])))
 
 
-def nearest_per_row(rows: np.ndarray, centres: np.ndarray, start: np.ndarray, target: np.ndarray,
-                    limit: int) -> np.ndarray:
+def nearest_per_row(
+    rows: np.ndarray, centres: np.ndarray, start: np.ndarray, target: np.ndarray, limit: int
+) -> np.ndarray:
     """Sorted indices of the items (row index, (x, y) centre) kept: per row the ``limit`` laterally
     nearest the line from the start to the target, measured at the item's depth (ties: the first)."""
     offset = line_offsets(centres, start, target)
@@ -69,8 +70,13 @@ def _accepted(scores: list[float], evidence: list[bool], offsets: list[float], c
     return ranked[:1]
 
 
-def row_candidates(space: TaskSpace, models: DecisionModels, gap_scores: np.ndarray, object_scores: np.ndarray,
-                   config: PlannerConfig) -> list[list[Node]]:
+def row_candidates(
+    space: TaskSpace,
+    models: DecisionModels,
+    gap_scores: np.ndarray,
+    object_scores: np.ndarray,
+    config: PlannerConfig,
+) -> list[list[Node]]:
     """Per row the accepted classified gaps (left to right; at least ``min_gap_width`` wide), then
     the accepted classified obstacles (scene order); of each kind the best one if none is accepted
     (the one nearest the start-target line if no score of the row carries evidence, ``informed``)."""
@@ -90,32 +96,53 @@ def row_candidates(space: TaskSpace, models: DecisionModels, gap_scores: np.ndar
     centres, names = table.centers.tolist(), space.obstacle_names
     candidates = []
     for row, row_gaps, row_objects in zip(space.rows, gaps, objects):
-        keep_gaps = [row_gaps[i] for i in _accepted(gap_scores[row_gaps].tolist(), gap_evidence[row_gaps].tolist(),
-                                                     gap_offsets[row_gaps].tolist(), config.max_gaps_per_row)]
-        keep_objects = [row_objects[i] for i in _accepted(
-            object_scores[row_objects].tolist(), object_evidence[row_objects].tolist(),
-            object_offsets[row_objects].tolist(), config.max_objects_per_row)]
+        keep_gaps = [
+            row_gaps[i]
+            for i in _accepted(
+                gap_scores[row_gaps].tolist(),
+                gap_evidence[row_gaps].tolist(),
+                gap_offsets[row_gaps].tolist(),
+                config.max_gaps_per_row,
+            )
+        ]
+        keep_objects = [
+            row_objects[i]
+            for i in _accepted(
+                object_scores[row_objects].tolist(),
+                object_evidence[row_objects].tolist(),
+                object_offsets[row_objects].tolist(),
+                config.max_objects_per_row,
+            )
+        ]
         candidates.append(
             [Node(row.index, "gap", tuple(centres[k]), gap=int(table.index[k])) for k in keep_gaps]
-            + [Node(row.index, "object", space.rects[names[k]].center, obstacle=names[k]) for k in keep_objects])
+            + [
+                Node(row.index, "object", space.rects[names[k]].center, obstacle=names[k])
+                for k in keep_objects
+            ]
+        )
     return candidates
 
 
-def segment_scores(space: TaskSpace, models: DecisionModels, candidates: list[list[Node]],
-                   config: PlannerConfig) -> list[np.ndarray]:
+def segment_scores(
+    space: TaskSpace, models: DecisionModels, candidates: list[list[Node]], config: PlannerConfig
+) -> list[np.ndarray]:
     """Cc scores of every pair of candidates of consecutive rows: per row pair (near, far), all in
     one feature and one classifier call."""
     if len(candidates) < 2:
         return []
-    pairs = [np.concatenate(part) for part in zip(*(node_pairs(space, a, b) for a, b in pairwise(candidates)))]
+    pairs = [
+        np.concatenate(part) for part in zip(*(node_pairs(space, a, b) for a, b in pairwise(candidates)))
+    ]
     scores = models.segment.decision_function(pair_features(space, *pairs, mode=config.mode))
     sizes = [(len(a), len(b)) for a, b in pairwise(candidates)]
     split = np.cumsum([n * m for n, m in sizes])[:-1]
     return [block.reshape(shape) for block, shape in zip(np.split(scores, split), sizes)]
 
 
-def enumerate_paths(sizes: list[int], scores: list[np.ndarray], max_paths: int,
-                    evidence: list[np.ndarray] | None = None) -> list[tuple[tuple[int, ...], float]]:
+def enumerate_paths(
+    sizes: list[int], scores: list[np.ndarray], max_paths: int, evidence: list[np.ndarray] | None = None
+) -> list[tuple[tuple[int, ...], float]]:
     """Candidate positions (one per row) along accepted row-to-row segments and their summed
     score, best first (at most ``max_paths``).
 
@@ -124,7 +151,9 @@ def enumerate_paths(sizes: list[int], scores: list[np.ndarray], max_paths: int,
     its best-scoring segment, so there is always a path. Where ``evidence`` (per block, which
     scores carry evidence, ``informed``) says no score between two rows does, every pair is.
     """
-    paths: list[tuple[tuple[int, ...], float]] = [((i,), 0.0) for i in range(sizes[0])] if sizes else [((), 0.0)]
+    paths: list[tuple[tuple[int, ...], float]] = (
+        [((i,), 0.0) for i in range(sizes[0])] if sizes else [((), 0.0)]
+    )
     for b, block in enumerate(scores):
         ok = block > 0
         if evidence is not None and not evidence[b].any():
@@ -132,10 +161,15 @@ def enumerate_paths(sizes: list[int], scores: list[np.ndarray], max_paths: int,
         elif not ok.any():
             ok = np.zeros_like(ok)
             ok.flat[np.argsort(-block, axis=None)[:2]] = True
-        following = [np.flatnonzero(row).tolist() or [int(np.argmax(values))] for row, values in zip(ok, block)]
+        following = [
+            np.flatnonzero(row).tolist() or [int(np.argmax(values))] for row, values in zip(ok, block)
+        ]
         values = block.tolist()
-        extended = [(nodes + (j,), score + values[nodes[-1]][j])
-                    for nodes, score in paths for j in following[nodes[-1]]]
+        extended = [
+            (nodes + (j,), score + values[nodes[-1]][j])
+            for nodes, score in paths
+            for j in following[nodes[-1]]
+        ]
         extended.sort(key=lambda p: -p[1])
         paths = extended[:max_paths]
     return paths

@@ -36,8 +36,15 @@ def _inflate(rects: np.ndarray, margin: float) -> np.ndarray:
     return rects + np.array([-margin, -margin, margin, margin])
 
 
-def sweep_collision(before: np.ndarray, after: np.ndarray, occluders: np.ndarray, mask: np.ndarray,
-                    *, band: float, faithful: bool) -> np.ndarray:
+def sweep_collision(
+    before: np.ndarray,
+    after: np.ndarray,
+    occluders: np.ndarray,
+    mask: np.ndarray,
+    *,
+    band: float,
+    faithful: bool,
+) -> np.ndarray:
     """Collision of the three links moving from ``before`` to ``after`` joints, per motion.
 
     Args:
@@ -76,9 +83,11 @@ def sweep_collision(before: np.ndarray, after: np.ndarray, occluders: np.ndarray
         phi = np.minimum(paper_angle(da), paper_angle(db))
         offsets = np.column_stack([np.sin(phi), -np.cos(phi)])  # the original's (cos, sin) in its frame
         reach = np.maximum(np.linalg.norm(da, axis=1), np.linalg.norm(db, axis=1))
-        cover = np.stack([
-            band_coverage_sampled(a0[i], b0[i], offsets[i], band, band + reach[i], occluders)[0]
-            for i in range(n)
-        ])
+        cover = np.stack(
+            [
+                band_coverage_sampled(a0[i], b0[i], offsets[i], band, band + reach[i], occluders)[0]
+                for i in range(n)
+            ]
+        )
         total += np.where(mask, cover, 0.0).sum(axis=1) / counted
     return total

@@ -39,9 +39,14 @@ class PlanKeypoint:
 
     def to_dict(self) -> dict[str, Any]:
         return {
-            "action": self.action, "x": self.position[0], "y": self.position[1], "row": self.row,
-            "element": self.element, "direction": self.direction,
-            "arm": None if self.arm is None else list(self.arm), "height": self.height,
+            "action": self.action,
+            "x": self.position[0],
+            "y": self.position[1],
+            "row": self.row,
+            "element": self.element,
+            "direction": self.direction,
+            "arm": None if self.arm is None else list(self.arm),
+            "height": self.height,
         }
 
 
@@ -96,7 +101,8 @@ class HighLevelPlan:
             "keypoints": [k.to_dict() for k in self.keypoints],
             "expected_collision": self.expected_collision,
             "alternatives": [
-                {"elements": list(c.elements), "expected_collision": c.expected_collision} for c in self.alternatives
+                {"elements": list(c.elements), "expected_collision": c.expected_collision}
+                for c in self.alternatives
             ],
             "planning_time_s": self.planning_time_s,
         }

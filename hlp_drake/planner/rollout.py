@@ -23,8 +23,13 @@ from hlp_drake.taskspace import DIRECTIONS, Node, TaskSpace, direction_of
 from hlp_drake.taskspace.relocation import relocated_array
 
 
-def path_keypoints(space: TaskSpace, models: DecisionModels, candidates: list[list[Node]],
-                   paths: list[tuple[int, ...]], mode: Mode) -> list[list[PlanKeypoint]]:
+def path_keypoints(
+    space: TaskSpace,
+    models: DecisionModels,
+    candidates: list[list[Node]],
+    paths: list[tuple[int, ...]],
+    mode: Mode,
+) -> list[list[PlanKeypoint]]:
     """Each path's keypoints: start, per row its gap or its obstacle's move and release (the
     direction by Cd from the hand's previous keypoint), target.
 
@@ -37,12 +42,17 @@ def path_keypoints(space: TaskSpace, models: DecisionModels, candidates: list[li
     if names:
         table = DirectionTable(space, names, mode=mode)
         hands = np.arange(-1, len(DIRECTIONS))  # every approach class, undefined (-1) first
-        X = table.features(np.arange(len(names))[:, None], hands[None, :]).reshape(-1, len(DIRECTION_FEATURES))
+        X = table.features(np.arange(len(names))[:, None], hands[None, :]).reshape(
+            -1, len(DIRECTION_FEATURES)
+        )
         labels = models.direction.predict(X).reshape(len(names), len(hands)).tolist()
         index = {name: k for k, name in enumerate(names)}
-        regions = relocated_array(space.obstacle_bounds[[space.obstacle_index[n] for n in names]], space.alpha)
-        releases = np.stack([(regions[..., 0] + regions[..., 2]) / 2.0,
-                             (regions[..., 1] + regions[..., 3]) / 2.0], axis=-1).tolist()
+        regions = relocated_array(
+            space.obstacle_bounds[[space.obstacle_index[n] for n in names]], space.alpha
+        )
+        releases = np.stack(
+            [(regions[..., 0] + regions[..., 2]) / 2.0, (regions[..., 1] + regions[..., 3]) / 2.0], axis=-1
+        ).tolist()
 
     @cache
     def gap(node: Node) -> PlanKeypoint:
@@ -53,8 +63,10 @@ def path_keypoints(space: TaskSpace, models: DecisionModels, candidates: list[li
         k = index[node.obstacle]
         direction = DIRECTIONS[int(labels[k][direction_index(table.hand_direction(k, hand)) + 1])]
         release = tuple(releases[k][DIRECTIONS.index(direction)])
-        return (PlanKeypoint("move", node.center, node.row, node.obstacle, direction),
-                PlanKeypoint("release", release, node.row, node.obstacle, direction))
+        return (
+            PlanKeypoint("move", node.center, node.row, node.obstacle, direction),
+            PlanKeypoint("release", release, node.row, node.obstacle, direction),
+        )
 
     result = []
     for path in paths:
@@ -108,19 +120,30 @@ class PrefixTree:
         return np.array([k.position for k in self.keypoints], dtype=float).reshape(-1, 2)
 
 
-def arm_configurations(models: DecisionModels, tree: PrefixTree, q0: np.ndarray, arm_total: float,
-                       faithful: bool) -> np.ndarray:
+def arm_configurations(
+    models: DecisionModels, tree: PrefixTree, q0: np.ndarray, arm_total: float, faithful: bool
+) -> np.ndarray:
     """(nodes, 2) the arm (q1, q2) at each node's keypoint by Ra, from ``q0`` at the start."""
     hands = tree.hands
-    step_class = cache(lambda a, b: direction_index(direction_of(b[0] - a[0], b[1] - a[1], faithful=faithful)))
-    classes = [0] + [step_class(tree.keypoints[p].position, k.position)
-                     for p, k in zip(tree.parent[1:], tree.keypoints[1:])]
+    step_class = cache(
+        lambda a, b: direction_index(direction_of(b[0] - a[0], b[1] - a[1], faithful=faithful))
+    )
+    classes = [0] + [
+        step_class(tree.keypoints[p].position, k.position)
+        for p, k in zip(tree.parent[1:], tree.keypoints[1:])
+    ]
     steps = (hands - hands[np.maximum(tree.parent, 0)]) / arm_total
     return models.arm.rollout(q0, tree.parent, np.column_stack([steps, classes]), limits=(0.0, np.pi))
 
 
-def expected_collisions(space: TaskSpace, tree: PrefixTree, arms: np.ndarray, links: tuple[float, float],
-                        band: float, faithful: bool) -> list[float]:
+def expected_collisions(
+    space: TaskSpace,
+    tree: PrefixTree,
+    arms: np.ndarray,
+    links: tuple[float, float],
+    band: float,
+    faithful: bool,
+) -> list[float]:
     """Each path's expected arm collision: the summed sweeps of its motions; an obstacle it moves
     no longer counts from the motion reaching it on."""
     if len(tree.paths) == 1 and faithful:
@@ -134,8 +157,9 @@ def expected_collisions(space: TaskSpace, tree: PrefixTree, arms: np.ndarray, li
         moved = (space.obstacle_index[keypoint.element],) if keypoint.action == "move" else ()
         gone.append(gone[tree.parent[node]] + moved)
         mask[node, list(gone[node])] = False
-    motion = sweep_collision(joints[tree.parent[1:]], joints[1:], occluders, mask[1:], band=band,
-                             faithful=faithful).tolist()
+    motion = sweep_collision(
+        joints[tree.parent[1:]], joints[1:], occluders, mask[1:], band=band, faithful=faithful
+    ).tolist()
     costs = []
     for nodes in tree.paths:
         cost = 0.0

@@ -70,22 +70,37 @@ def _fallback(candidates: RowCandidates) -> np.ndarray:
 class _Expander:
     """Grows partial plans by one row: Cr on the row's candidates, Cd for each obstacle moved."""
 
-    def __init__(self, space: TaskSpace, models: DecisionModels, config: PlannerConfig, hand_width: float,
-                 mirror: bool) -> None:
-        self.space, self.models, self.config, self.width, self.mirror = space, models, config, hand_width, mirror
+    def __init__(
+        self, space: TaskSpace, models: DecisionModels, config: PlannerConfig, hand_width: float, mirror: bool
+    ) -> None:
+        self.space, self.models, self.config, self.width, self.mirror = (
+            space,
+            models,
+            config,
+            hand_width,
+            mirror,
+        )
         self.features = RowChoiceScene(space, hand_width)
         self.names = space.obstacle_names
         self.directions = DirectionTable(space, self.names, mode=config.mode)
         regions = relocated_array(space.obstacle_bounds, space.alpha)  # (n, 8, 4)
-        self.releases = np.stack([(regions[..., 0] + regions[..., 2]) / 2.0,
-                                  (regions[..., 1] + regions[..., 3]) / 2.0], axis=-1)
+        self.releases = np.stack(
+            [(regions[..., 0] + regions[..., 2]) / 2.0, (regions[..., 1] + regions[..., 3]) / 2.0], axis=-1
+        )
 
-    def candidates(self, beam: list[_Partial], row: Row) -> list[tuple[RowCandidates, np.ndarray, np.ndarray]]:
+    def candidates(
+        self, beam: list[_Partial], row: Row
+    ) -> list[tuple[RowCandidates, np.ndarray, np.ndarray]]:
         """Per partial plan: the row's candidates from its hand, their probabilities (summing to 1)
         and their novelty (Cr asked once for the whole beam); where no candidate lies within the
         demonstrations' range (novelty <= 1), the one-line rule's choice."""
-        per_plan = self.features.candidates(row.index, np.array([p.hand for p in beam]), [p.removed for p in beam],
-                                            mirror=self.mirror, limit=self.config.classify_per_row)
+        per_plan = self.features.candidates(
+            row.index,
+            np.array([p.hand for p in beam]),
+            [p.removed for p in beam],
+            mirror=self.mirror,
+            limit=self.config.classify_per_row,
+        )
         X = np.vstack([c.X for c in per_plan])
         probability = self.models.row.predict_proba(X)[:, 1] if len(X) else np.zeros(0)
         novelty = self.models.row.novelty(X) if len(X) else np.zeros(0)
@@ -101,9 +116,14 @@ class _Expander:
         """Cd's direction for each obstacle approached from its hand (one prediction for all)."""
         if not obstacles:
             return []
-        classes = [direction_index(self.directions.hand_direction(k, hand)) for k, hand in zip(obstacles, hands)]
+        classes = [
+            direction_index(self.directions.hand_direction(k, hand)) for k, hand in zip(obstacles, hands)
+        ]
         X = self.directions.features(np.asarray(obstacles, int), np.asarray(classes, int))
-        return [DIRECTIONS[int(label)] for label in self.models.direction.predict(X.reshape(-1, len(DIRECTION_FEATURES)))]
+        return [
+            DIRECTIONS[int(label)]
+            for label in self.models.direction.predict(X.reshape(-1, len(DIRECTION_FEATURES)))
+        ]
 
     def grow(self, beam: list[_Partial], row: Row) -> list[_Partial]:
         """Every partial plan of ``beam`` grown by its likely choices at ``row``."""
@@ -112,7 +132,9 @@ class _Expander:
             if len(candidates) == 0:
                 chosen.append((partial, candidates, p, evidence, None))
                 continue
-            keep = [k for k in np.argsort(-p, kind="stable") if p[k] >= self.config.min_share] or [int(np.argmax(p))]
+            keep = [k for k in np.argsort(-p, kind="stable") if p[k] >= self.config.min_share] or [
+                int(np.argmax(p))
+            ]
             chosen += [(partial, candidates, p, evidence, int(k)) for k in keep]
         moved = [c for c in chosen if c[4] is not None and c[1].kinds[c[4]] == "object"]
         directions = self.moves([c[0].hand for c in moved], [int(c[1].obstacles[c[4]]) for c in moved])
@@ -122,8 +144,9 @@ class _Expander:
             partial, candidates, p, evidence, k = choice
             scores = (*partial.scores, (row.index, candidates, p, evidence))
             if k is None:
-                children.append(_Partial(partial.keypoints, partial.hand, partial.removed, partial.log_likelihood,
-                                         scores))
+                children.append(
+                    _Partial(partial.keypoints, partial.hand, partial.removed, partial.log_likelihood, scores)
+                )
                 continue
             log_likelihood = partial.log_likelihood + math.log(max(float(p[k]), 1e-300))
             point = tuple(float(v) for v in candidates.points[k])
@@ -134,13 +157,20 @@ class _Expander:
                 continue
             obstacle, direction = int(candidates.obstacles[k]), direction_of_move[id(choice)]
             release = tuple(float(v) for v in self.releases[obstacle, DIRECTIONS.index(direction)])
-            keypoints = (*partial.keypoints, PlanKeypoint("move", point, row.index, element, direction),
-                         PlanKeypoint("release", release, row.index, element, direction))
-            children.append(_Partial(keypoints, release, partial.removed | {obstacle}, log_likelihood, scores))
+            keypoints = (
+                *partial.keypoints,
+                PlanKeypoint("move", point, row.index, element, direction),
+                PlanKeypoint("release", release, row.index, element, direction),
+            )
+            children.append(
+                _Partial(keypoints, release, partial.removed | {obstacle}, log_likelihood, scores)
+            )
         return children
 
 
-def segment_collisions(space: TaskSpace, keypoints: tuple[PlanKeypoint, ...], hand_width: float) -> list[dict]:
+def segment_collisions(
+    space: TaskSpace, keypoints: tuple[PlanKeypoint, ...], hand_width: float
+) -> list[dict]:
     """The hand's straight ways between consecutive keypoints that pass through an obstacle, each as
     ``{"segment": i, "obstacle": name, "depth": m}``: the length of the way inside the obstacle
     grown by half the hand's width, the obstacles where they stand at that moment (a moved one at
@@ -167,14 +197,25 @@ def segment_collisions(space: TaskSpace, keypoints: tuple[PlanKeypoint, ...], ha
     j = np.arange(segments)[:, None]
     counted = (j >= spans[:, 0]) & (j < spans[:, 1]) & ~own[:, owners]
     ends = np.array([k.position for k in keypoints], dtype=float)
-    grown = np.array(rects).reshape(-1, 4) + np.array([-hand_width, -hand_width, hand_width, hand_width]) / 2.0
+    grown = (
+        np.array(rects).reshape(-1, 4) + np.array([-hand_width, -hand_width, hand_width, hand_width]) / 2.0
+    )
     inside = segment_inside(ends[:-1], ends[1:], grown) * counted
-    return [{"segment": int(i), "obstacle": names[owners[r]], "depth": float(inside[i, r])}
-            for i, r in zip(*np.nonzero(inside > 1e-9))]
+    return [
+        {"segment": int(i), "obstacle": names[owners[r]], "depth": float(inside[i, r])}
+        for i, r in zip(*np.nonzero(inside > 1e-9))
+    ]
 
 
-def plan_rows(space: TaskSpace, models: DecisionModels, config: PlannerConfig, q0: np.ndarray,
-              links: tuple[float, float], hand_width: float, started: float) -> HighLevelPlan:
+def plan_rows(
+    space: TaskSpace,
+    models: DecisionModels,
+    config: PlannerConfig,
+    q0: np.ndarray,
+    links: tuple[float, float],
+    hand_width: float,
+    started: float,
+) -> HighLevelPlan:
     """The row-by-row plan of a valid scene's task space (see the module docstring)."""
     scene = space.scene
     expander = _Expander(space, models, config, hand_width, mirror=False)
@@ -189,17 +230,22 @@ def plan_rows(space: TaskSpace, models: DecisionModels, config: PlannerConfig, q
     arms = arm_configurations(models, tree, q0, links[0] + links[1], False)
     costs = expected_collisions(space, tree, arms, links, config.arm_band, False)
     collisions = [segment_collisions(space, tuple(k), hand_width) for k in keypoints]
-    score = [beam[i].log_likelihood - config.collision_weight * sum(c["depth"] for c in collisions[i]) / hand_width
-             for i in range(len(beam))]
+    score = [
+        beam[i].log_likelihood - config.collision_weight * sum(c["depth"] for c in collisions[i]) / hand_width
+        for i in range(len(beam))
+    ]
     order = sorted(range(len(beam)), key=lambda i: (-score[i], costs[i]))
     best = order[0]
     chosen = tuple(
         PlanKeypoint(k.action, k.position, k.row, k.element, k.direction, (float(q[0]), float(q[1])))
-        for k, q in zip(keypoints[best], arms[[0, *tree.paths[best]]].tolist()))
+        for k, q in zip(keypoints[best], arms[[0, *tree.paths[best]]].tolist())
+    )
     alternatives = tuple(PlanCandidate(tuple(keypoints[i]), costs[i]) for i in order[1:])
     details = _details(space, beam[best], [beam[i].log_likelihood for i in order])
     details["segment_collisions"] = collisions[best]
-    return HighLevelPlan(scene.name, chosen, costs[best], alternatives, time.perf_counter() - started, None, details)
+    return HighLevelPlan(
+        scene.name, chosen, costs[best], alternatives, time.perf_counter() - started, None, details
+    )
 
 
 def _details(space: TaskSpace, partial: _Partial, log_likelihoods: list[float]) -> dict:
@@ -219,5 +265,11 @@ def _details(space: TaskSpace, partial: _Partial, log_likelihoods: list[float]) 
                 gap_scores[f"{row}:{element}"] = float(p[k]) - 0.5
             else:
                 object_scores[element] = float(p[k]) - 0.5
-    return {"gap_scores": gap_scores, "object_scores": object_scores, "candidates": candidates,
-            "evidence": evidence, "novelty": novelty, "log_likelihoods": log_likelihoods}
+    return {
+        "gap_scores": gap_scores,
+        "object_scores": object_scores,
+        "candidates": candidates,
+        "evidence": evidence,
+        "novelty": novelty,
+        "log_likelihoods": log_likelihoods,
+    }

@@ -40,16 +40,23 @@ def _reason_kind(reason: str) -> str:
     return re.sub(r"\d+", "N", reason)
 
 
-def demonstration_records(dataset: Dataset, subjects: Iterable[str] | None = None,
-                          categories: Iterable[str] = (STRUCTURED,)) -> list[TrialRecord]:
+def demonstration_records(
+    dataset: Dataset, subjects: Iterable[str] | None = None, categories: Iterable[str] = (STRUCTURED,)
+) -> list[TrialRecord]:
     """The trials the method learns from: the successful trials of ``categories`` (default: the
     structured trials T010-T099)."""
     categories = tuple(categories)
     return [r for r in dataset.select(success=True, subjects=subjects) if r.category in categories]
 
 
-def segment_dataset(dataset: Dataset, *, mode: Mode = DEFAULT_MODE, records: list[TrialRecord] | None = None,
-                    categories: Iterable[str] = (STRUCTURED,), progress: bool = False) -> SegmentationResult:
+def segment_dataset(
+    dataset: Dataset,
+    *,
+    mode: Mode = DEFAULT_MODE,
+    records: list[TrialRecord] | None = None,
+    categories: Iterable[str] = (STRUCTURED,),
+    progress: bool = False,
+) -> SegmentationResult:
     """Segment ``records`` (default: all successful trials of ``categories``) of ``dataset``.
 
     Trials of those categories the dataset loader already left out (unreadable or invalid files)
@@ -88,5 +95,7 @@ def log_agreement(dataset: Dataset, result: SegmentationResult) -> float:
             if d.decision == NONE:
                 continue
             total += 1
-            agree += (d.decision == OBJECT) == (d.row in first) and (d.row not in first or first[d.row] == d.obstacle)
+            agree += (d.decision == OBJECT) == (d.row in first) and (
+                d.row not in first or first[d.row] == d.obstacle
+            )
     return agree / max(total, 1)

@@ -13,8 +13,9 @@ MOVE_KINDS = ("PickedUp", "Pushed")
 LIMBS = ("Hand", "HandToWrist", "WristToElbow")  # the acting body parts in the interaction log
 
 
-def motion_period(positions: np.ndarray, *, faithful: bool,
-                  tolerance: float = MOTION_TOLERANCE) -> tuple[int, int] | None:
+def motion_period(
+    positions: np.ndarray, *, faithful: bool, tolerance: float = MOTION_TOLERANCE
+) -> tuple[int, int] | None:
     """(first, last) frame of an object's motion, or None if it never moved.
 
     A frame pair counts as motion when the object moved more than ``tolerance`` between them. The
@@ -30,8 +31,9 @@ def motion_period(positions: np.ndarray, *, faithful: bool,
     return max(int(moving[0]) - 1, 0), int(moving[-1]) + 1
 
 
-def first_moved_per_row(interactions: Iterable[Interaction], row_of: Mapping[str, int], *,
-                        faithful: bool) -> dict[int, str]:
+def first_moved_per_row(
+    interactions: Iterable[Interaction], row_of: Mapping[str, int], *, faithful: bool
+) -> dict[int, str]:
     """The obstacle each row's decision is about: the first one picked up or pushed in that row.
 
     The original takes every PickedUp/Pushed row except those acting on the Target, including

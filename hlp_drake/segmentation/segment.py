@@ -63,8 +63,10 @@ def _checked_tracks(trial: Trial, names: list[str]) -> dict[str, np.ndarray]:
 def _inside(points: np.ndarray, rect: Rect) -> np.ndarray:
     """Strictly inside (the original's test for gap passage)."""
     return (
-        (points[:, 0] > rect.x_min) & (points[:, 0] < rect.x_max)
-        & (points[:, 1] > rect.y_min) & (points[:, 1] < rect.y_max)
+        (points[:, 0] > rect.x_min)
+        & (points[:, 0] < rect.x_max)
+        & (points[:, 1] > rect.y_min)
+        & (points[:, 1] < rect.y_max)
     )
 
 
@@ -89,8 +91,9 @@ def _crossing(go: np.ndarray, row: Row, gaps: list[Gap]) -> tuple[int, int] | No
     raise Rejected(f"the hand crossed row {row.index} over an obstacle (y {y:+.3f} m) and moved none there")
 
 
-def _moving_direction(space: TaskSpace, name: str, initial: np.ndarray, final: np.ndarray,
-                      *, faithful: bool) -> str:
+def _moving_direction(
+    space: TaskSpace, name: str, initial: np.ndarray, final: np.ndarray, *, faithful: bool
+) -> str:
     """Direction class of a moved obstacle (reference 3.7; bug B9 in faithful mode)."""
     if faithful:
         # Largest overlap of the obstacle, placed at its pose at the end of the whole trial, with
@@ -106,7 +109,9 @@ def _moving_direction(space: TaskSpace, name: str, initial: np.ndarray, final: n
     return label
 
 
-def segment_trial(trial: Trial, *, mode: Mode = DEFAULT_MODE, space: TaskSpace | None = None) -> Demonstration:
+def segment_trial(
+    trial: Trial, *, mode: Mode = DEFAULT_MODE, space: TaskSpace | None = None
+) -> Demonstration:
     """Segment one successful demonstration.
 
     Args:
@@ -134,10 +139,14 @@ def segment_trial(trial: Trial, *, mode: Mode = DEFAULT_MODE, space: TaskSpace |
     gap_flags = tuple(tuple(bool(_inside(go, gap.rect).any()) for gap in gaps) for gaps in space.gaps)
 
     # 3.5 motion periods; 3.8 rejection rules, in the original's order.
-    periods = {name: motion_period(tracks[name], faithful=faithful) for name in [*moved.values(), target_name]}
+    periods = {
+        name: motion_period(tracks[name], faithful=faithful) for name in [*moved.values(), target_name]
+    }
     moved_count = sum(p is not None for p in periods.values())
     if len(moved) >= 2 and moved_count < len(moved) + 1:
-        raise Rejected(f"{len(moved)} rows with a moved obstacle but only {moved_count} objects moved (incl. target)")
+        raise Rejected(
+            f"{len(moved)} rows with a moved obstacle but only {moved_count} objects moved (incl. target)"
+        )
     if periods[target_name] is None:
         raise Rejected("the target never moved")
     if moved and moved_count < 2:
@@ -158,11 +167,20 @@ def segment_trial(trial: Trial, *, mode: Mode = DEFAULT_MODE, space: TaskSpace |
             origin = 0 if row.index == 1 else previous
             if origin > approach:
                 origin = max(approach - SEGMENT_START_FALLBACK, 0)
-            entries += [_Entry("approach", row.index, approach, origin), _Entry("release", row.index, release, approach)]
+            entries += [
+                _Entry("approach", row.index, approach, origin),
+                _Entry("release", row.index, release, approach),
+            ]
             initial = np.array(space.rects[name].center)
             final = tracks[name][-1] if faithful else tracks[name][release]
-            decisions.append(RowDecision(row.index, OBJECT, obstacle=name,
-                                         direction=_moving_direction(space, name, initial, final, faithful=faithful)))
+            decisions.append(
+                RowDecision(
+                    row.index,
+                    OBJECT,
+                    obstacle=name,
+                    direction=_moving_direction(space, name, initial, final, faithful=faithful),
+                )
+            )
             previous = release
             continue
         gaps = space.gaps[row.index - 1]
@@ -212,8 +230,15 @@ def segment_trial(trial: Trial, *, mode: Mode = DEFAULT_MODE, space: TaskSpace |
             displacement = (float(step[0]), float(step[1]))
         q = arm_angles(shoulder[frame], elbow[frame], hand[frame], medial)
         keypoints.append(
-            Keypoint(entry.kind, entry.row, frame, (float(hand[frame, 0]), float(hand[frame, 1])), direction,
-                     (float(q[0]), float(q[1])), displacement)
+            Keypoint(
+                entry.kind,
+                entry.row,
+                frame,
+                (float(hand[frame, 0]), float(hand[frame, 1])),
+                direction,
+                (float(q[0]), float(q[1])),
+                displacement,
+            )
         )
     return Demonstration(
         key=trial.key,

@@ -20,8 +20,9 @@ SAMPLED_LINES = 11  # area_scan_resolution 10 -> 11 lines
 SAMPLES_PER_LINE = 50
 
 
-def band_polygon(p0: Sequence[float], p1: Sequence[float], offset: Sequence[float],
-                 s_minus: float, s_plus: float) -> Polygon:
+def band_polygon(
+    p0: Sequence[float], p1: Sequence[float], offset: Sequence[float], s_minus: float, s_plus: float
+) -> Polygon:
     """The parallelogram swept by segment p0->p1 shifted by t * offset for t in [-s_minus, s_plus]."""
     a, b, u = np.asarray(p0, float), np.asarray(p1, float), np.asarray(offset, float)
     corners = [a - s_minus * u, b - s_minus * u, b + s_plus * u, a + s_plus * u]
@@ -43,8 +44,9 @@ def _relu_mean(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.where(lo >= 0.0, 0.5 * (a + b), np.where(hi > 0.0, crossing, 0.0))
 
 
-def _relation(x: np.ndarray, y: np.ndarray, qx: np.ndarray, qy: np.ndarray,
-              box: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _relation(
+    x: np.ndarray, y: np.ndarray, qx: np.ndarray, qy: np.ndarray, box: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Whether each convex polygon (edges (x, y) -> (qx, qy), each (k, K)) is apart from its box
     (k, 4) (on the outer side of one of its own edges, touching included: they share no area),
     and whether it contains it."""
@@ -73,8 +75,9 @@ def _paired_overlap(poly: np.ndarray, box: np.ndarray) -> np.ndarray:
     dx = qx - x
     slope = (qy - y) / np.where(dx != 0.0, dx, 1.0)
     # The edge's y at u and at v, each above the box's bottom and above its top: (k, K, 2, 2).
-    above = (y[..., None] + (np.stack([u, v], axis=-1) - x[..., None]) * slope[..., None])[..., None] \
-        - box[:, None, None, [1, 3]]
+    above = (y[..., None] + (np.stack([u, v], axis=-1) - x[..., None]) * slope[..., None])[..., None] - box[
+        :, None, None, [1, 3]
+    ]
     mean = _relu_mean(above[..., 0, :], above[..., 1, :])
     inside = mean[..., 0] - mean[..., 1]
     apart, contains = _relation(x, y, qx, qy, box)
@@ -84,8 +87,12 @@ def _paired_overlap(poly: np.ndarray, box: np.ndarray) -> np.ndarray:
 
 def _touching(lo: np.ndarray, hi: np.ndarray, rects: np.ndarray) -> np.ndarray:
     """Whether boxes [lo, hi] (..., 2) and rectangles (..., 4) overlap (broadcast)."""
-    return ((lo[..., 0] < rects[..., 2]) & (hi[..., 0] > rects[..., 0])
-            & (lo[..., 1] < rects[..., 3]) & (hi[..., 1] > rects[..., 1]))
+    return (
+        (lo[..., 0] < rects[..., 2])
+        & (hi[..., 0] > rects[..., 0])
+        & (lo[..., 1] < rects[..., 3])
+        & (hi[..., 1] > rects[..., 1])
+    )
 
 
 def convex_rect_overlap(polygons: np.ndarray, rects: np.ndarray) -> np.ndarray:
@@ -108,8 +115,9 @@ def convex_rect_overlap(polygons: np.ndarray, rects: np.ndarray) -> np.ndarray:
     return areas
 
 
-def band_coverage(p0: np.ndarray, p1: np.ndarray, offsets: np.ndarray, s_minus: float, s_plus: float,
-                  rects: np.ndarray) -> np.ndarray:
+def band_coverage(
+    p0: np.ndarray, p1: np.ndarray, offsets: np.ndarray, s_minus: float, s_plus: float, rects: np.ndarray
+) -> np.ndarray:
     """Exact covered fraction of each rectangle by each band: (n, m).
 
     Args:
@@ -125,8 +133,9 @@ def band_coverage(p0: np.ndarray, p1: np.ndarray, offsets: np.ndarray, s_minus: 
     return covered / ((r[:, 2] - r[:, 0]) * (r[:, 3] - r[:, 1]))[None, :]
 
 
-def band_coverage_sampled(p0: np.ndarray, p1: np.ndarray, offsets: np.ndarray, s_minus: float, s_plus: float,
-                          rects: np.ndarray) -> np.ndarray:
+def band_coverage_sampled(
+    p0: np.ndarray, p1: np.ndarray, offsets: np.ndarray, s_minus: float, s_plus: float, rects: np.ndarray
+) -> np.ndarray:
     """The original's sampled estimate of ``band_coverage`` (reference 4.6): (n, m).
 
     11 parallel copies of each segment, 50 samples each; per rectangle the bounding box of the
@@ -140,8 +149,12 @@ def band_coverage_sampled(p0: np.ndarray, p1: np.ndarray, offsets: np.ndarray, s
     base = a[:, None, :] + along[None, :, None] * (b - a)[:, None, :]  # (n, S, 2)
     points = (base[:, None, :, :] + shifts[None, :, None, None] * u[:, None, None, :]).reshape(len(a), -1, 2)
     x, y = points[:, None, :, 0], points[:, None, :, 1]  # (n, 1, P)
-    inside = (x >= r[None, :, 0, None]) & (x <= r[None, :, 2, None]) & (y >= r[None, :, 1, None]) & (
-        y <= r[None, :, 3, None])  # (n, m, P)
+    inside = (
+        (x >= r[None, :, 0, None])
+        & (x <= r[None, :, 2, None])
+        & (y >= r[None, :, 1, None])
+        & (y <= r[None, :, 3, None])
+    )  # (n, m, P)
     any_inside = inside.any(axis=2)
     x_hi = np.where(inside, x, -np.inf).max(axis=2)
     x_lo = np.where(inside, x, np.inf).min(axis=2)
@@ -151,8 +164,14 @@ def band_coverage_sampled(p0: np.ndarray, p1: np.ndarray, offsets: np.ndarray, s
     return area / ((r[:, 2] - r[:, 0]) * (r[:, 3] - r[:, 1]))[None, :]
 
 
-def band_collision(p0: Sequence[float], p1: Sequence[float], occluders: Sequence[Rect], *,
-                   half_width: float, offset: Sequence[float] | None = None) -> float:
+def band_collision(
+    p0: Sequence[float],
+    p1: Sequence[float],
+    occluders: Sequence[Rect],
+    *,
+    half_width: float,
+    offset: Sequence[float] | None = None,
+) -> float:
     """Exact mean covered fraction of ``occluders`` by the band of ``half_width`` around p0->p1.
 
     Args:
@@ -164,8 +183,15 @@ def band_collision(p0: Sequence[float], p1: Sequence[float], occluders: Sequence
     return float(band_coverage(p0, p1, u, half_width, half_width, rect_array(occluders)).mean())
 
 
-def band_collision_sampled(p0: Sequence[float], p1: Sequence[float], occluders: Sequence[Rect], *,
-                           offset: Sequence[float], s_minus: float, s_plus: float) -> float:
+def band_collision_sampled(
+    p0: Sequence[float],
+    p1: Sequence[float],
+    occluders: Sequence[Rect],
+    *,
+    offset: Sequence[float],
+    s_minus: float,
+    s_plus: float,
+) -> float:
     """The original code's sampled estimate (reference 4.6); all occluders count in the mean."""
     if not occluders:
         return 0.0

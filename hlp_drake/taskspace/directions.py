@@ -11,8 +11,14 @@ import math
 DIRECTIONS = ("FF", "BB", "LL", "RR", "FR", "FL", "BR", "BL")
 # Unit step (dx, dy) of each direction in the world frame.
 DIRECTION_VECTORS = {
-    "FF": (1, 0), "BB": (-1, 0), "LL": (0, 1), "RR": (0, -1),
-    "FR": (1, -1), "FL": (1, 1), "BR": (-1, -1), "BL": (-1, 1),
+    "FF": (1, 0),
+    "BB": (-1, 0),
+    "LL": (0, 1),
+    "RR": (0, -1),
+    "FR": (1, -1),
+    "FL": (1, 1),
+    "BR": (-1, -1),
+    "BL": (-1, 1),
 }
 _BY_SIGNS = {v: k for k, v in DIRECTION_VECTORS.items()}
 # Counter-clockwise from +x (FF) in 45 degree steps: FF, FL, LL, BL, BB, BR, RR, FR.

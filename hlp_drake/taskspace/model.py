@@ -164,8 +164,14 @@ class TaskSpace:
         wall_thickness: thickness of the virtual walls outside the table edges.
     """
 
-    def __init__(self, scene: Scene, *, alpha: float = ALPHA, row_tolerance: float | None = None,
-                 wall_thickness: float = WALL_THICKNESS) -> None:
+    def __init__(
+        self,
+        scene: Scene,
+        *,
+        alpha: float = ALPHA,
+        row_tolerance: float | None = None,
+        wall_thickness: float = WALL_THICKNESS,
+    ) -> None:
         self.scene = scene
         self.alpha = alpha
         bounds = {o.name: footprint_bounds(o) for o in scene.objects}
@@ -224,8 +230,13 @@ class TaskSpace:
                     bounds.append((r.x_min, y_lo, r.x_max, y_hi))
                     left.append(name_left)
                     right.append(name_right)
-        return GapTable(np.array(row, dtype=int), np.array(index, dtype=int),
-                        np.array(bounds, dtype=float).reshape(-1, 4), tuple(left), tuple(right))
+        return GapTable(
+            np.array(row, dtype=int),
+            np.array(index, dtype=int),
+            np.array(bounds, dtype=float).reshape(-1, 4),
+            tuple(left),
+            tuple(right),
+        )
 
     @cached_property
     def gaps(self) -> list[list[Gap]]:
@@ -241,7 +252,9 @@ class TaskSpace:
         """Row ``row``'s candidates: its gaps left to right, then its obstacles in scene order."""
         members = set(self.rows[row - 1].members)
         gaps = [Node(row, "gap", gap.center, gap=gap.index) for gap in self.gaps[row - 1]]
-        objects = [Node(row, "object", self.rects[n].center, obstacle=n) for n in self.obstacle_names if n in members]
+        objects = [
+            Node(row, "object", self.rects[n].center, obstacle=n) for n in self.obstacle_names if n in members
+        ]
         return gaps + objects
 
     def connecting_space(self, row: int) -> Rect:

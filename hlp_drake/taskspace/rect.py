@@ -41,4 +41,9 @@ class Rect:
     def contains(self, points: np.ndarray) -> np.ndarray:
         """Boolean mask of the (N, 2) points inside or on the boundary."""
         p = np.asarray(points, dtype=float)
-        return (p[:, 0] >= self.x_min) & (p[:, 0] <= self.x_max) & (p[:, 1] >= self.y_min) & (p[:, 1] <= self.y_max)
+        return (
+            (p[:, 0] >= self.x_min)
+            & (p[:, 0] <= self.x_max)
+            & (p[:, 1] >= self.y_min)
+            & (p[:, 1] <= self.y_max)
+        )

@@ -16,7 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-CORNER_OFFSET = 1e-5  # hand widths: corners sit just outside their grown rectangle, so they see along its sides
+CORNER_OFFSET = (
+    1e-5  # hand widths: corners sit just outside their grown rectangle, so they see along its sides
+)
 
 
 def _clip(p0: np.ndarray, p1: np.ndarray, rects: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -53,17 +55,23 @@ def segment_hits(p0: np.ndarray, p1: np.ndarray, rects: np.ndarray) -> np.ndarra
     hits = (low[:, 0, None] < r[None, :, 2]) & (high[:, 0, None] > r[None, :, 0])
     hits &= (low[:, 1, None] < r[None, :, 3]) & (high[:, 1, None] > r[None, :, 1])
     centre, half = (r[:, :2] + r[:, 2:]) / 2.0, (r[:, 2:] - r[:, :2]) / 2.0
-    across = d[:, 0, None] * (centre[None, :, 1] - a[:, 1, None]) - d[:, 1, None] * (centre[None, :, 0] - a[:, 0, None])
+    across = d[:, 0, None] * (centre[None, :, 1] - a[:, 1, None]) - d[:, 1, None] * (
+        centre[None, :, 0] - a[:, 0, None]
+    )
     spread = np.abs(d[:, 0, None]) * half[None, :, 1] + np.abs(d[:, 1, None]) * half[None, :, 0]
     length = np.hypot(d[:, 0], d[:, 1])[:, None]
-    hits &= (np.abs(across) < spread - 1e-9 * length * (half[None, :, 0] + half[None, :, 1])) | (length == 0.0)
+    hits &= (np.abs(across) < spread - 1e-9 * length * (half[None, :, 0] + half[None, :, 1])) | (
+        length == 0.0
+    )
     return hits
 
 
 def segment_inside(p0: np.ndarray, p1: np.ndarray, rects: np.ndarray) -> np.ndarray:
     """(n, m): the length of segment p0[i] -> p1[i] inside rectangle j."""
     low, high = _clip(p0, p1, rects)
-    length = np.linalg.norm(np.asarray(p1, float).reshape(-1, 2) - np.asarray(p0, float).reshape(-1, 2), axis=1)
+    length = np.linalg.norm(
+        np.asarray(p1, float).reshape(-1, 2) - np.asarray(p0, float).reshape(-1, 2), axis=1
+    )
     return np.maximum(high - low, 0.0) * length[:, None]
 
 
@@ -104,23 +112,42 @@ class FreeRoutes:
         goal: (2,) where every route ends.
     """
 
-    def __init__(self, rects: np.ndarray, ids: np.ndarray, table_bounds: tuple[float, float, float, float],
-                 hand_width: float, goal: np.ndarray) -> None:
+    def __init__(
+        self,
+        rects: np.ndarray,
+        ids: np.ndarray,
+        table_bounds: tuple[float, float, float, float],
+        hand_width: float,
+        goal: np.ndarray,
+    ) -> None:
         half = hand_width / 2.0
         self.grown = np.asarray(rects, float).reshape(-1, 4) + np.array([-half, -half, half, half])
         self.ids = np.asarray(ids, dtype=int).reshape(-1)
         self.goal = np.asarray(goal, float)
         g, e = self.grown, CORNER_OFFSET * hand_width
-        corners = np.concatenate([
-            np.column_stack([g[:, 0] - e, g[:, 1] - e]), np.column_stack([g[:, 0] - e, g[:, 3] + e]),
-            np.column_stack([g[:, 2] + e, g[:, 1] - e]), np.column_stack([g[:, 2] + e, g[:, 3] + e])])
+        corners = np.concatenate(
+            [
+                np.column_stack([g[:, 0] - e, g[:, 1] - e]),
+                np.column_stack([g[:, 0] - e, g[:, 3] + e]),
+                np.column_stack([g[:, 2] + e, g[:, 1] - e]),
+                np.column_stack([g[:, 2] + e, g[:, 3] + e]),
+            ]
+        )
         owner = np.tile(np.arange(len(g)), 4)
         x0, y0, x1, y1 = table_bounds
-        keep = ((corners[:, 0] >= x0) & (corners[:, 0] <= x1 - half)
-                & (corners[:, 1] >= y0 + half) & (corners[:, 1] <= y1 - half))
+        keep = (
+            (corners[:, 0] >= x0)
+            & (corners[:, 0] <= x1 - half)
+            & (corners[:, 1] >= y0 + half)
+            & (corners[:, 1] <= y1 - half)
+        )
         if len(g):
-            inside = ((corners[:, None, 0] > g[None, :, 0]) & (corners[:, None, 0] < g[None, :, 2])
-                      & (corners[:, None, 1] > g[None, :, 1]) & (corners[:, None, 1] < g[None, :, 3]))
+            inside = (
+                (corners[:, None, 0] > g[None, :, 0])
+                & (corners[:, None, 0] < g[None, :, 2])
+                & (corners[:, None, 1] > g[None, :, 1])
+                & (corners[:, None, 1] < g[None, :, 3])
+            )
             keep &= ~inside.any(axis=1)
         self.corners, self.owner = corners[keep], owner[keep]
         n = len(self.corners)
@@ -163,7 +190,7 @@ class FreeRoutes:
         seen = hits[: len(points) * (c + 1)].reshape(len(points), c + 1, m)
         length = np.linalg.norm(points[:, None] - ends[None], axis=2)
         sight = Sight(points, seen[:, :c], length[:, :c], seen[:, c], length[:, c])
-        return sight if pairs is None else (sight, hits[len(points) * (c + 1):])
+        return sight if pairs is None else (sight, hits[len(points) * (c + 1) :])
 
     def to_goal(self, sight: Sight, rows: np.ndarray, removed: frozenset[int]) -> np.ndarray:
         """Route lengths from the points ``rows`` of ``sight`` to the goal (inf: no route)."""
@@ -174,7 +201,9 @@ class FreeRoutes:
         reach = self._reach(sight, rows, kept)
         return np.minimum(direct, np.min(reach + to_goal[None], axis=1))
 
-    def to_goal_without(self, sight: Sight, rows: np.ndarray, removed: frozenset[int], obstacle: int) -> np.ndarray:
+    def to_goal_without(
+        self, sight: Sight, rows: np.ndarray, removed: frozenset[int], obstacle: int
+    ) -> np.ndarray:
         """As ``to_goal`` with the obstacle of id ``obstacle`` taken away too, without a new corner
         graph: the shortest route then crosses the obstacle's (convex) place at most once, along a
         straight way that it alone blocked, between the point or a corner the route reaches with
@@ -186,6 +215,7 @@ class FreeRoutes:
             return base
         others = kept.copy()
         others[r] = False
+
         def crossing(hits: np.ndarray) -> np.ndarray:  # blocked by the obstacle and by no other
             return hits[..., r] & ~hits[..., others].any(axis=-1)
 
@@ -199,11 +229,18 @@ class FreeRoutes:
         edge = np.where(crossing(self._edge_hits), self._edge_length, np.inf)
         last = np.where(crossing(self._corners_to_goal.goal_hits), self._corners_to_goal.goal_length, np.inf)
         via_edge = np.min(from_point[:, :, None] + edge[None] + to_goal[None, None, :], axis=(1, 2))
-        return np.minimum.reduce([best, np.min(through + to_goal[None], axis=1), np.min(from_point + last[None], axis=1),
-                                  via_edge])
+        return np.minimum.reduce(
+            [best, np.min(through + to_goal[None], axis=1), np.min(from_point + last[None], axis=1), via_edge]
+        )
 
-    def between(self, sight: Sight, sources: np.ndarray, targets: np.ndarray, direct_hits: np.ndarray,
-                removed: frozenset[int]) -> np.ndarray:
+    def between(
+        self,
+        sight: Sight,
+        sources: np.ndarray,
+        targets: np.ndarray,
+        direct_hits: np.ndarray,
+        removed: frozenset[int],
+    ) -> np.ndarray:
         """Route lengths from the points ``sources`` to the points ``targets`` of ``sight``, pair
         by pair; ``direct_hits`` (pairs, m): which grown obstacles each straight way passes through."""
         kept, distances, _ = self.tables(removed)
@@ -213,7 +250,7 @@ class FreeRoutes:
             return direct
         reach = self._reach(sight, np.concatenate([sources, targets]), kept)
         from_source = np.min(reach[: len(sources), :, None] + distances[None], axis=1)  # (pairs, c)
-        return np.minimum(direct, np.min(from_source + reach[len(sources):], axis=1))
+        return np.minimum(direct, np.min(from_source + reach[len(sources) :], axis=1))
 
     def _reach(self, sight: Sight, rows: np.ndarray, kept: np.ndarray) -> np.ndarray:
         return np.where(sight.corner_hits[rows][:, :, kept].any(axis=2), np.inf, sight.corner_length[rows])

@@ -83,7 +83,9 @@ def damaged_models(draw) -> tuple[bytes, bytes]:
         with warnings.catch_warnings():  # nan or inf into an integer: whatever the cast gives
             warnings.simplefilter("ignore", RuntimeWarning)
             if values.ndim:
-                values.flat[draw(st.integers(0, values.size - 1))] = draw(_VALUES)
+                values.flat[draw(st.integers(0, values.size - 1))] = np.asarray(draw(_VALUES)).astype(
+                    values.dtype
+                )
             else:
                 values = np.asarray(draw(_VALUES)).astype(values.dtype)
         arrays[name] = values

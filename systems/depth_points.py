@@ -16,7 +16,8 @@ import numpy as np
 import sklearn
 from pydrake.math import RigidTransform
 from pydrake.systems.sensors import CameraInfo
-from sklearn.linear_model import LinearRegression, RANSACRegressor
+from sklearn.base import BaseEstimator, RegressorMixin
+from sklearn.linear_model import RANSACRegressor
 
 MAX_TILT = np.tan(np.radians(10.0))
 """A table plane tilts less than 10 degrees from horizontal (the world's z is up)."""
@@ -149,6 +150,26 @@ def view_points(views: list[CameraView]) -> tuple[Points, int]:
     return Points(*(np.concatenate(column) for column in zip(*parts))), missing
 
 
+class _Plane(RegressorMixin, BaseEstimator):
+    """z = a x + b y + c by least squares: ``RANSACRegressor``'s base estimator for planes, without
+    ``LinearRegression``'s input checks on every 3-point trial (RANSAC checks its input once; this
+    is 6x faster on a frame's sample)."""
+
+    def fit(self, X: np.ndarray, y: np.ndarray) -> _Plane:
+        A = np.column_stack([X, np.ones(len(X))])
+        (a, b, c), *_ = np.linalg.lstsq(A, y, rcond=None)
+        self.coef_, self.intercept_ = np.array([a, b]), float(c)
+        return self
+
+    def predict(self, X: np.ndarray) -> np.ndarray:
+        return X @ self.coef_ + self.intercept_
+
+    def score(self, X: np.ndarray, y: np.ndarray) -> float:
+        """R squared, as ``LinearRegression``'s (RANSAC's tie-break between equal inlier counts)."""
+        total = float(np.sum((y - np.mean(y)) ** 2))
+        return 1.0 - float(np.sum((y - self.predict(X)) ** 2)) / total if total > 0 else 0.0
+
+
 @dataclass(frozen=True)
 class TablePlane:
     """The fitted table: the plane z = a x + b y + c and its points' extent.
@@ -201,7 +222,7 @@ def fit_table(
     chosen = rng.choice(n, size=min(sample, n), replace=False)
     xy, z = points.xyz[chosen, :2], points.xyz[chosen, 2]
     ransac = RANSACRegressor(
-        LinearRegression(), residual_threshold=tolerance, max_trials=100, random_state=seed
+        _Plane(), min_samples=3, residual_threshold=tolerance, max_trials=100, random_state=seed
     )
     try:
         with sklearn.config_context(assume_finite=True, skip_parameter_validation=True):

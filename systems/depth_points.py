@@ -134,18 +134,20 @@ def view_points(views: list[CameraView]) -> tuple[Points, int]:
     parts, missing = [], 0
     for k, view in enumerate(views):
         info, depth = view.info, view.depth
-        ok = valid_depth(depth)
+        ok = valid_depth(depth).ravel()
         missing += int(ok.size - ok.sum())
-        row, col = np.nonzero(ok)
-        z = depth[row, col].astype(float)
+        pixel = np.flatnonzero(ok)
+        row, col = np.divmod(pixel.astype(np.int32), np.int32(depth.shape[1]))
+        z = depth.ravel()[ok].astype(float)
         rays = _rays(
             info.width(), info.height(), info.focal_x(), info.focal_y(), info.center_x(), info.center_y()
-        )
+        ).reshape(-1, 3)[ok]
         X = view.X_WC
-        xyz = (rays[row, col] * z[:, None]) @ X.rotation().matrix().T + X.translation()
-        parts.append((xyz, np.full(len(z), k), row, col, z, view.labels[row, col].astype(int)))
+        xyz = (rays * z[:, None]) @ X.rotation().matrix().T + X.translation()
+        camera = np.full(len(z), k, dtype=np.int16)
+        parts.append((xyz, camera, row, col, z, view.labels.ravel()[ok].astype(np.int32)))
     if not parts:
-        empty = np.zeros(0, int)
+        empty = np.zeros(0, np.int32)
         return Points(np.zeros((0, 3)), empty, empty, empty, np.zeros(0), empty), missing
     return Points(*(np.concatenate(column) for column in zip(*parts))), missing
 

@@ -10,7 +10,7 @@ sample, refined by least squares on all points) and its extent.
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 import sklearn
@@ -187,6 +187,7 @@ class TablePlane:
         inliers: how many points lie on it.
         pixel: the width of a pixel seen on it (the median over its points), m.
         unseen_edges: the edges (``EDGES``) the cameras did not see past (the table may go on there).
+        heights: per view of the fit, ``height_image`` of it (kept for the frame's other steps).
     """
 
     coefficients: tuple[float, float, float]
@@ -194,6 +195,7 @@ class TablePlane:
     inliers: int
     pixel: float
     unseen_edges: tuple[str, ...] = ()
+    heights: tuple[np.ndarray, ...] = field(default=(), compare=False, repr=False)
 
     def height_above(self, xyz: np.ndarray) -> np.ndarray:
         """Per point (n, 3), its height above the plane, m."""
@@ -271,10 +273,9 @@ def fit_table(
         A = np.column_stack([sx[near], sy[near], np.ones(int(near.sum()))])
         (a, b, c), *_ = np.linalg.lstsq(A, sz[near], rcond=None)
     plane = TablePlane((float(a), float(b), float(c)), (0.0, 0.0, 0.0, 0.0), 0, 0.0)
-    on = []
-    for view, mask in zip(views, masks):
-        with np.errstate(invalid="ignore"):
-            on.append(mask & (np.abs(plane.height_image(view)) <= tolerance))
+    heights = tuple(plane.height_image(view) for view in views)
+    with np.errstate(invalid="ignore"):
+        on = [mask & (np.abs(h) <= tolerance) for mask, h in zip(masks, heights)]
     count = sum(int(o.sum()) for o in on)
     if count < max(MIN_TABLE_POINTS, MIN_TABLE_SHARE * n):
         return "no table plane found (no plane holds enough of the points)"
@@ -285,7 +286,9 @@ def fit_table(
     focal = np.array([v.info.focal_x() for v in views])
     pixel = float(np.median(sampled.depth / focal[sampled.camera]))
     bounds = (*(xy.min(axis=0) - pixel / 2.0), *(xy.max(axis=0) + pixel / 2.0))
-    table = replace(plane, bounds=tuple(float(v) for v in bounds), inliers=count, pixel=pixel)
+    table = replace(
+        plane, bounds=tuple(float(v) for v in bounds), inliers=count, pixel=pixel, heights=heights
+    )
     return replace(table, unseen_edges=unseen_edges(table, views, margin))
 
 

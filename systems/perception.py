@@ -198,8 +198,8 @@ def _perceive(
     if isinstance(table, str):
         return failed(table)
     x0, y0, x1, y1 = table.bounds
+    heights = table.heights
     with np.errstate(invalid="ignore"):
-        heights = [table.height_image(v) for v in views]
         high = pixel_points(views, [k & (h >= config.min_height) for k, h in zip(keep, heights)])
     x, y = high.xyz[:, 0], high.xyz[:, 1]
     object_points = high.subset((x >= x0) & (x <= x1) & (y >= y0) & (y <= y1))

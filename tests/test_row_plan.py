@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from hlp_drake.evaluation import nearest_gap_plan
+from hlp_drake.features.row_choice import RowChoiceScene
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.planner import PlanKeypoint, plan
-from hlp_drake.features.row_choice import RowChoiceScene
 from hlp_drake.planner.row_plan import FALLBACK_SCALE, _fallback, planned_rows, segment_collisions
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene, SceneObject, Table

@@ -15,6 +15,7 @@ from dataclasses import replace
 import pytest
 import yaml
 from fuzz_support import PROFILES, STATS, check_error, junk, mutate, numbers, run, scene_file
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from hlp_drake.errors import SceneError
@@ -24,7 +25,13 @@ from hlp_drake.planner.plan import HighLevelPlan
 from hlp_drake.scene.generators import KINDS, generate_scene
 from hlp_drake.scene.io import load_scene, scene_to_dict
 from hlp_drake.scene.model import SHAPES, Scene, SceneObject, Table
-from hlp_drake.scene.validation import scene_problems
+from hlp_drake.scene.validation import (
+    SIZE_RANGE,
+    YAW_LIMIT,
+    _object_problems,
+    _plainly_sound,
+    scene_problems,
+)
 
 
 @functools.cache
@@ -168,3 +175,37 @@ def _check_layout(scene: Scene) -> None:
 @pytest.mark.parametrize("profile", PROFILES)
 def test_plan_answers_every_moved_layout(profile):
     run(profile, (100, 3000), _moved_layouts(), _check_layout)
+
+
+_edge_floats = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from([SIZE_RANGE[0], SIZE_RANGE[1], YAW_LIMIT, -YAW_LIMIT, 0.0, -0.0, 1e-9]),
+    st.floats(SIZE_RANGE[0] * 0.99, SIZE_RANGE[1] * 1.01),
+)
+_objects = st.builds(
+    SceneObject,
+    name=st.one_of(st.text(max_size=3), st.text(min_size=99, max_size=102), junk),
+    shape=st.one_of(st.sampled_from(SHAPES), junk),
+    x=st.one_of(_edge_floats, junk),
+    y=_edge_floats,
+    size=st.one_of(
+        st.tuples(_edge_floats, _edge_floats, _edge_floats),
+        st.floats(0.01, 0.5).map(lambda d: (d, d * (1 + 1e-7), 0.1)),  # a cylinder's nearly equal diameters
+        junk,
+    ),
+    yaw=_edge_floats,
+)
+
+
+@given(st.lists(_objects, max_size=6))
+@settings(max_examples=400, deadline=None)
+def test_objects_checked_in_bulk_are_the_ones_found_sound_one_by_one(objects):
+    """The bulk check of plain objects agrees with the one-by-one check on every object it passes
+    (and a plain object of floats the one-by-one check finds sound is passed in bulk)."""
+    bulk = _plainly_sound(objects)
+    for k, obj in enumerate(objects):
+        alone = _object_problems(obj, "obstacle", k)
+        if bulk[k]:
+            assert alone == []
+        elif alone == [] and all(type(v) is float for v in (obj.x, obj.y, obj.yaw)):
+            assert type(obj.size) is not tuple or not all(type(v) is float for v in obj.size)

@@ -102,6 +102,42 @@ def _object_problems(obj: object, role: str, index: int) -> list[str]:
     return [f"{_label(obj, role)}: {problem}" for problem in problems]
 
 
+def _plainly_sound(objects: Sequence[object]) -> np.ndarray:
+    """(n,) which objects ``_object_problems`` would find nothing wrong with, for the common case
+    checked in bulk (a SceneObject of plain floats, a known shape and a short printable name); the
+    others (false here) go through ``_object_problems`` for their messages."""
+    plain = [
+        type(o) is SceneObject
+        and type(o.name) is str
+        and 0 < len(o.name) <= MAX_NAME
+        and o.name.isprintable()
+        and type(o.shape) is str
+        and o.shape in SHAPES
+        and type(o.x) is float
+        and type(o.y) is float
+        and type(o.yaw) is float
+        and type(o.size) is tuple
+        and len(o.size) == 3
+        and all(type(v) is float for v in o.size)
+        for o in objects
+    ]
+    sound = np.array(plain, dtype=bool)
+    if not sound.any():
+        return sound
+    chosen = [o for o, p in zip(objects, plain) if p]
+    values = np.array([(o.x, o.y, o.yaw, *o.size) for o in chosen], dtype=float)
+    size = values[:, 3:]
+    cylinder = np.array([o.shape == "cylinder" for o in chosen], dtype=bool)
+    ok = np.isfinite(values).all(axis=1) & (np.abs(values[:, 2]) <= YAW_LIMIT)
+    ok &= ((size >= SIZE_RANGE[0]) & (size <= SIZE_RANGE[1])).all(axis=1)
+    diameters_equal = np.abs(size[:, 0] - size[:, 1]) <= np.maximum(
+        1e-6 * np.maximum(np.abs(size[:, 0]), np.abs(size[:, 1])), 1e-9
+    )  # math.isclose(rel_tol=1e-6, abs_tol=1e-9)
+    ok &= ~cylinder | diameters_equal
+    sound[np.flatnonzero(sound)] = ok
+    return sound
+
+
 def _off_table(obj: SceneObject, role: str, bounds: Sequence[float], table: Table) -> str:
     """What sides of the table the footprint ``bounds`` pokes past."""
     x_min, y_min, x_max, y_max = bounds
@@ -174,8 +210,9 @@ def scene_problems(scene: Scene) -> list[str]:
 
     seen: set[str] = set()
     sound: list[tuple[SceneObject, str]] = []
+    plainly_sound = _plainly_sound([obj for obj, _ in roles]).tolist()
     for index, (obj, role) in enumerate(roles):
-        own = _object_problems(obj, role, index)
+        own = [] if plainly_sound[index] else _object_problems(obj, role, index)
         if isinstance(obj, SceneObject) and isinstance(obj.name, str) and obj.name:
             if obj.name in seen:
                 problems.append(f"two objects are named {obj.name!r}")

@@ -26,10 +26,15 @@ REINSTALL = (
 """The hint of a damaged or missing model package."""
 
 
-def drake_reason(error: Exception) -> str:
-    """The first line of a Drake error, short (its parse errors run over many lines)."""
+def drake_reason(error: Exception, named: Path | None = None) -> str:
+    """The first line of a Drake error, short (its parse errors run over many lines); the file
+    ``named`` already names in the message is called by its name only (a deep install path would
+    otherwise push the hint off the one-line message)."""
     lines = [line.strip() for line in str(error).splitlines() if line.strip()]
-    return short(lines[0] if lines else type(error).__name__, 160)
+    first = lines[0] if lines else type(error).__name__
+    if named is not None:
+        first = first.replace(str(named), named.name)
+    return short(first, 160)
 
 
 def configure_parser(parser: Parser) -> Parser:
@@ -45,7 +50,7 @@ def configure_parser(parser: Parser) -> Parser:
             package_map.AddPackageXml(str(xml))
         except RuntimeError as error:
             raise InstallError(
-                f"{xml}: the model package is missing or damaged ({drake_reason(error)}); {REINSTALL}"
+                f"{xml}: the model package is missing or damaged ({drake_reason(error, xml)}); {REINSTALL}"
             ) from None
     return parser
 

@@ -21,6 +21,7 @@ the fingertip pads, +z along the approach direction, +y along the left finger's 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
@@ -129,8 +130,11 @@ def add_robot(
     try:
         (instance,) = parser.AddModels(url=ROBOT_URL)
     except RuntimeError as error:  # a damaged installation: one line and a hint, exit 2 on the command line
+        robot_file = (
+            Path(parser.package_map().GetPath(MODELS_PACKAGE)) / ROBOT_URL.split(f"{MODELS_PACKAGE}/", 1)[1]
+        )
         raise InstallError(
-            f"{ROBOT_URL}: the robot model cannot be parsed ({drake_reason(error)}); {REINSTALL}"
+            f"{ROBOT_URL}: the robot model cannot be parsed ({drake_reason(error, robot_file)}); {REINSTALL}"
         ) from None
     finally:
         parser.SetAutoRenaming(auto_renaming)

@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+import shutil
+import threading
+
 import numpy as np
 import pytest
 from conftest import run_module
 from synthetic_dataset import hand_positions, write_archive, write_dataset
 
 from hlp_drake.dataset import Dataset
+from hlp_drake.dataset.cache import build_cache, cache_lock
 from hlp_drake.errors import DatasetError
 
 
@@ -68,6 +72,28 @@ def test_second_load_comes_from_the_cache_and_edits_invalidate_it(folder, tmp_pa
     again = load(folder, tmp_path)
     assert again.cache_status == "built"
     assert again.trial("sub_01/T010").interactions[-1].kind == "Pushed"
+
+
+def test_a_second_process_waits_for_the_cache_being_built_and_reads_it(folder, tmp_path):
+    first = load(folder, tmp_path)
+    shutil.rmtree(first.cache_path)
+    statuses = []
+    waiting = threading.Thread(target=lambda: statuses.append(load(folder, tmp_path).cache_status))
+    with cache_lock(first.cache_path):  # a process building the cache holds this lock
+        waiting.start()
+        waiting.join(timeout=0.5)
+        assert waiting.is_alive() and not first.cache_path.exists()  # it waits instead of parsing too
+        build_cache(first.source, first.cache_path, progress=False)
+    waiting.join(timeout=60)
+    assert statuses == ["warm"]
+
+
+def test_a_cache_another_process_wrote_meanwhile_is_kept(folder, tmp_path):
+    ds = load(folder, tmp_path)
+    before = (ds.cache_path / "tracks.npy").stat().st_ino
+    build_cache(ds.source, ds.cache_path, progress=False)  # a reader may have it open: never replaced
+    assert (ds.cache_path / "tracks.npy").stat().st_ino == before
+    assert load(folder, tmp_path).cache_status == "warm"
 
 
 def test_damaged_cache_is_rebuilt(folder, tmp_path):

@@ -7,7 +7,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from hlp_drake.features.row_choice import ROW_CHOICE_FEATURES, RowChoiceScene
+from hlp_drake.features.row_choice import ROUTE_OBSTACLES, ROW_CHOICE_FEATURES, RowChoiceScene
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene, SceneObject, Table
 from hlp_drake.taskspace import TaskSpace
@@ -135,3 +135,19 @@ def test_one_call_for_several_hands_equals_one_call_each():
         assert alone.kinds == batch.kinds
         np.testing.assert_allclose(alone.X, batch.X)
         np.testing.assert_allclose(alone.points, batch.points)
+
+
+def test_the_route_graph_holds_the_obstacles_nearest_the_reach_on_any_table():
+    """Its size does not grow with the object count: on a crowded table it holds the
+    ``ROUTE_OBSTACLES`` obstacles nearest the start-target line, on a VR-sized one all of them."""
+    crowded = generate_scene("gen2", 3, 25)
+    space = TaskSpace(crowded)
+    routes = RowChoiceScene(space, 0.08).routes
+    start, goal = np.array(crowded.start), np.array(space.target.center)
+    span = (goal - start) / np.linalg.norm(goal - start)
+    d = space.obstacle_centres - start
+    offset = np.abs(span[0] * d[:, 1] - span[1] * d[:, 0])
+    assert len(routes.ids) == ROUTE_OBSTACLES < len(crowded.obstacles)
+    assert offset[routes.ids].max() <= np.sort(offset)[ROUTE_OBSTACLES - 1] + 1e-12
+    vr_sized = generate_scene("gen2", 3, 6)  # six obstacles, as in every VR scene
+    assert len(RowChoiceScene(TaskSpace(vr_sized), 0.08).routes.ids) == len(vr_sized.obstacles) == 6

@@ -7,6 +7,7 @@ The cache is keyed by the source's fingerprint and ``CACHE_VERSION`` and written
 
 from __future__ import annotations
 
+import fcntl
 import hashlib
 import json
 import os
@@ -15,6 +16,8 @@ import shutil
 import sys
 import tempfile
 from collections import defaultdict
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -254,6 +257,24 @@ def _kept_tracks(blocks: list[np.ndarray], trials: list[dict[str, Any]]) -> np.n
     return np.concatenate(kept) if kept else np.empty((0, 7))
 
 
+@contextmanager
+def cache_lock(directory: Path) -> Iterator[None]:
+    """Hold an exclusive lock on ``directory``'s cache while it is checked and built (a second
+    process waits, then finds it built); no lock where the folder cannot take one."""
+    try:
+        directory.parent.mkdir(parents=True, exist_ok=True)
+        handle = open(directory.parent / f".{directory.name}.lock", "a+b")  # noqa: SIM115
+    except OSError:
+        yield
+        return
+    with handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX)
+        except OSError:
+            pass
+        yield
+
+
 def build_cache(source: Source, directory: Path, *, progress: bool = True) -> None:
     """Parse the whole source once and write the cache into ``directory`` (atomically)."""
     collector = _Collector(source)
@@ -285,7 +306,13 @@ def build_cache(source: Source, directory: Path, *, progress: bool = True) -> No
         (staging / "index.json").write_bytes(text)
         (staging / INDEX_DIGEST).write_text(hashlib.sha256(text).hexdigest(), encoding="utf-8")
         if directory.exists():
-            shutil.rmtree(directory)
+            try:
+                load_cache(directory)
+                return  # another process wrote it meanwhile: keep theirs, which they may be reading
+            except ValueError:
+                stale = Path(tempfile.mkdtemp(prefix=f".{directory.name}.stale.", dir=directory.parent))
+                os.rename(directory, stale / "cache")
+                shutil.rmtree(stale, ignore_errors=True)
         os.rename(staging, directory)
     except OSError:
         if not (directory / "index.json").exists():

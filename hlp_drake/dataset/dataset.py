@@ -10,7 +10,14 @@ from typing import Any
 
 import numpy as np
 
-from hlp_drake.dataset.cache import CACHE_VERSION, INDEX_DIGEST, build_cache, default_cache_root, load_cache
+from hlp_drake.dataset.cache import (
+    CACHE_VERSION,
+    INDEX_DIGEST,
+    build_cache,
+    cache_lock,
+    default_cache_root,
+    load_cache,
+)
 from hlp_drake.dataset.convert import TableFrame, scene_from_layouts
 from hlp_drake.dataset.parse import check_track
 from hlp_drake.dataset.records import TRACKERS, Interaction, Trial, TrialRecord, trial_key
@@ -53,15 +60,22 @@ class Dataset:
         try:
             index, tracks = load_cache(self.cache_path)
             self.cache_status = "warm"
-        except ValueError as error:
-            if self.cache_path.exists():
-                print(f"rebuilding the dataset cache at {self.cache_path} ({error})", file=sys.stderr)
-            build_cache(self.source, self.cache_path, progress=progress)
-            try:
-                index, tracks = load_cache(self.cache_path)
-            except ValueError as again:
-                raise DatasetError(f"{self.cache_path}: cannot write a usable cache: {again}") from None
-            self.cache_status = "built"
+        except ValueError:
+            with cache_lock(self.cache_path):  # processes loading at once parse the source once
+                try:
+                    index, tracks = load_cache(self.cache_path)
+                    self.cache_status = "warm"
+                except ValueError as error:
+                    if self.cache_path.exists():
+                        print(f"rebuilding the dataset cache at {self.cache_path} ({error})", file=sys.stderr)
+                    build_cache(self.source, self.cache_path, progress=progress)
+                    try:
+                        index, tracks = load_cache(self.cache_path)
+                    except ValueError as again:
+                        raise DatasetError(
+                            f"{self.cache_path}: cannot write a usable cache: {again}"
+                        ) from None
+                    self.cache_status = "built"
         self._tracks = tracks
         self._entries: dict[str, dict[str, Any]] = {
             trial_key(e["subject"], e["trial"]): e for e in index["trials"]

@@ -164,6 +164,11 @@ def _nearest(
     )
 
 
+ROUTE_OBSTACLES = 6
+"""Obstacles in the route graph: every VR scene (structured and unstructured) has six; with 16 a
+50-object plan took 1.8x a 6-object one, with 6 the same (``benchmarks/planning_time.py``)."""
+
+
 class RowChoiceScene:
     """The row-choice features of one scene for a hand of one width (``candidates``), with what
     every row and every hand position share computed once: the rows' geometry and the route graph.
@@ -172,11 +177,14 @@ class RowChoiceScene:
         space: the scene's task space.
         hand_width: the hand's (gripper's) width, m; lengths are measured in it.
         route_obstacles: the route graph holds at most this many obstacles, those nearest the
-            straight line from the start to the target (so its cost does not grow with a crowded
-            table's far corners).
+            straight line from the start to the target, so its cost is the same on any table
+            (``ROUTE_OBSTACLES``: as many as every VR scene has, so the features the models
+            learnt from are the ones they are asked about).
     """
 
-    def __init__(self, space: TaskSpace, hand_width: float, *, route_obstacles: int = 16) -> None:
+    def __init__(
+        self, space: TaskSpace, hand_width: float, *, route_obstacles: int = ROUTE_OBSTACLES
+    ) -> None:
         self.space, self.width = space, hand_width
         self.goal = np.asarray(space.target.center, float)
         start, centres = np.asarray(space.scene.start, float), space.obstacle_centres

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
+from test_closed_loop import forward  # the base moving along x
 
 from hlp_drake.run_scene import DEFAULT_SCENE
 from hlp_drake.scene.io import load_scene
@@ -24,14 +25,6 @@ from hlp_drake.systems.world_settings import EXECUTION_SETTLE_S
 @pytest.fixture(scope="module")
 def scenario():
     return Scenario(scene=load_scene(DEFAULT_SCENE))
-
-
-def forward(start: np.ndarray, distance: float, duration: float) -> ControlSequence:
-    """The robot's base moving ``distance`` along x from ``start`` in ``duration`` s (4 steps)."""
-    times = np.linspace(0.0, duration, 5)
-    knots = np.tile(start, (5, 1))
-    knots[:, 0] += np.linspace(0.0, distance, 5)
-    return ControlSequence(times, knots)
 
 
 def test_a_rollout_on_the_execution_model_ends_exactly_where_the_execution_does(scenario):

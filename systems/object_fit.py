@@ -23,10 +23,11 @@ from hlp_drake.systems.depth_points import CameraView, Points, valid_depth
 
 NEARER = 0.005
 """A neighbour pixel this much nearer the camera (m) hides what lies beyond: an occlusion boundary."""
-YAW_STEPS = 90
-"""Yaws tried over a quarter turn (1 degree apart) ..."""
-FINE_STEPS = 20
-"""... and on each side of the best of them (0.05 degrees apart)."""
+YAW_STEPS = (30, 12, 10)
+"""The yaw search: 30 yaws over a quarter turn (3 degrees apart), then 12 on each side of the best
+(0.25 degrees apart), then 10 on each side of that (0.025 degrees apart)."""
+COARSE_EDGE = 64
+"""The coarsest yaws are scored on at most this many of the silhouette's points (evenly spaced)."""
 NEIGHBOURS = ((0, 1), (0, -1), (1, 0), (-1, 0))
 TOP_BAND = 0.005
 """An object's top: its points within this (m) below the 99th percentile of their heights."""
@@ -86,39 +87,38 @@ def boundaries(
     """Each group of ``points`` with its silhouette, occlusion and border pixels (4-neighbours in
     its camera's image: another group's pixel or the robot nearer by ``NEARER`` occludes; a pixel
     without a depth tells nothing; anything else ends the object)."""
-    owner = [np.full(v.depth.shape, -1) for v in views]
+    group = np.full(len(points), -1, dtype=np.int32)
     for g, members in enumerate(groups):
-        for k in range(len(views)):
-            mine = members[points.camera[members] == k]
-            owner[k][points.row[mine], points.col[mine]] = g
-    clusters = []
-    for g, members in enumerate(groups):
-        sub = points.subset(members)
-        silhouette = np.zeros(len(sub), bool)
-        occluded = np.zeros(len(sub), bool)
-        at_border = np.zeros(len(sub), bool)
-        for k, view in enumerate(views):
-            here = sub.camera == k
-            if not here.any():
-                continue
-            h, w = view.depth.shape
-            row, col = sub.row[here], sub.col[here]
-            own = view.depth[row, col]
-            at_border[here] = (row < border) | (col < border) | (row >= h - border) | (col >= w - border)
-            sil, occ = np.zeros(len(row), bool), np.zeros(len(row), bool)
-            for dr, dc in NEIGHBOURS:
-                r, c = row + dr, col + dc
-                inside = (r >= 0) & (r < h) & (c >= 0) & (c < w)
-                r, c = np.clip(r, 0, h - 1), np.clip(c, 0, w - 1)
-                other = owner[k][r, c] != g
-                depth = view.depth[r, c]
-                known = valid_depth(depth) | np.isposinf(depth)
-                nearer = (depth < own - NEARER) | (depth == 0)
-                occ |= inside & other & nearer
-                sil |= inside & other & known & ~nearer
-            silhouette[here], occluded[here] = sil & ~occ, occ
-        clusters.append(Cluster(sub, silhouette, occluded, at_border))
-    return clusters
+        group[members] = g
+    silhouette = np.zeros(len(points), bool)
+    occluded = np.zeros(len(points), bool)
+    at_border = np.zeros(len(points), bool)
+    for k, view in enumerate(views):
+        here = np.flatnonzero((points.camera == k) & (group >= 0))
+        if not len(here):
+            continue
+        h, w = view.depth.shape
+        row, col, mine = points.row[here], points.col[here], group[here]
+        owner = np.full((h, w), -1, dtype=np.int32)
+        owner[row, col] = mine
+        own = view.depth[row, col]
+        at_border[here] = (row < border) | (col < border) | (row >= h - border) | (col >= w - border)
+        sil, occ = np.zeros(len(here), bool), np.zeros(len(here), bool)
+        for dr, dc in NEIGHBOURS:
+            r, c = row + dr, col + dc
+            inside = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+            r, c = np.clip(r, 0, h - 1), np.clip(c, 0, w - 1)
+            other = owner[r, c] != mine
+            depth = view.depth[r, c]
+            known = valid_depth(depth) | np.isposinf(depth)
+            nearer = (depth < own - NEARER) | (depth == 0)
+            occ |= inside & other & nearer
+            sil |= inside & other & known & ~nearer
+        silhouette[here], occluded[here] = sil & ~occ, occ
+    return [
+        Cluster(points.subset(members), silhouette[members], occluded[members], at_border[members])
+        for members in groups
+    ]
 
 
 def _circle(xy: np.ndarray) -> tuple[float, float, float, float]:
@@ -150,22 +150,26 @@ def _rectangles(yaws: np.ndarray, hull: np.ndarray, edge: np.ndarray) -> tuple[n
 
 def _rectangle(xy: np.ndarray, edge: np.ndarray) -> tuple[float, np.ndarray, float]:
     """(yaw, bounds in the frame turned by it, rms residual) of the rectangle whose sides
-    ``edge`` lies on best: yaws 1 degree apart, then 0.05 degrees apart around the best."""
+    ``edge`` lies on best, searched coarse to fine (``YAW_STEPS``)."""
     hull = xy[ConvexHull(xy).vertices] if len(xy) >= 3 else xy
-    step = (np.pi / 2) / YAW_STEPS
-    coarse = np.arange(YAW_STEPS) * step
-    best = coarse[int(np.argmin(_rectangles(coarse, hull, edge)[0]))]
-    fine = best + np.linspace(-step, step, 2 * FINE_STEPS + 1)
-    residuals, bounds = _rectangles(fine, hull, edge)
-    k = int(np.argmin(residuals))
-    return float(fine[k]), bounds[k], float(residuals[k])
+    first, *finer = YAW_STEPS
+    step = (np.pi / 2) / first
+    yaws = np.arange(first) * step
+    sparse = edge[np.linspace(0, len(edge) - 1, min(len(edge), COARSE_EDGE)).astype(int)]
+    best = yaws[int(np.argmin(_rectangles(yaws, hull, sparse)[0]))]
+    for steps in finer:
+        yaws = best + np.linspace(-step, step, 2 * steps + 1)
+        residuals, bounds = _rectangles(yaws, hull, edge)
+        k = int(np.argmin(residuals))
+        best, step = yaws[k], step / steps
+    return float(best), bounds[k], float(residuals[k])
 
 
 def _top(heights: np.ndarray) -> tuple[float, np.ndarray]:
     """(height, per point whether it is on the top) of an object from its points' heights above
     the table: its top is the points within ``TOP_BAND`` below the 99th percentile, its height their
     median."""
-    on_top = heights >= np.percentile(heights, 99) - TOP_BAND
+    on_top = heights >= np.percentile(heights, 99, method="linear") - TOP_BAND
     return float(np.median(heights[on_top])), on_top
 
 

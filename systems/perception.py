@@ -17,6 +17,7 @@ every planner refuses; it never raises inside the diagram.
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
@@ -28,7 +29,14 @@ from hlp_drake.scene.geometry import footprint_bounds
 from hlp_drake.scene.model import Scene, SceneObject, Table
 from hlp_drake.scene.validation import scene_problems
 from hlp_drake.systems.cameras import ROBOT_LABEL, TARGET_LABEL
-from hlp_drake.systems.depth_points import CameraView, TablePlane, fit_table, view_points
+from hlp_drake.systems.depth_points import (
+    CameraView,
+    TablePlane,
+    fit_table,
+    pixel_points,
+    valid_depth,
+    view_points,
+)
 from hlp_drake.systems.object_fit import Cluster, boundaries, cluster_points, fit_object
 
 if TYPE_CHECKING:
@@ -76,8 +84,9 @@ class Perception:
             too far: nothing there), ``nan_pixels`` of them NaN (no return: dropout).
         noise_points: points above the table in no object's cluster.
         perception_s: the time this took, s (the rendering not included).
-        cloud: the world points (n, 3) with their class per point in ``cloud_class`` (0 table,
-            1 object, 2 above the table but in no object, 3 anything else), for display.
+        views: the frames perceived.
+        class_images: per view (h, w), each pixel's class for display: 0 table, 1 object, 2 above
+            the table but in no object, 3 anything else (``cloud`` and ``cloud_class``).
     """
 
     scene: Scene | None
@@ -89,8 +98,26 @@ class Perception:
     nan_pixels: int = 0
     noise_points: int = 0
     perception_s: float = 0.0
-    cloud: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)), compare=False, repr=False)
-    cloud_class: np.ndarray = field(default_factory=lambda: np.zeros(0, int), compare=False, repr=False)
+    views: tuple[CameraView, ...] = field(default=(), compare=False, repr=False)
+    class_images: tuple[np.ndarray, ...] = field(default=(), compare=False, repr=False)
+
+    @functools.cached_property
+    def _cloud(self) -> tuple[np.ndarray, np.ndarray]:
+        points, _ = view_points(list(self.views))
+        if not self.class_images:
+            return points.xyz, np.full(len(points), 3)
+        images = np.stack(self.class_images) if len(self.class_images) > 1 else self.class_images[0][None]
+        return points.xyz, images[points.camera, points.row, points.col].astype(int)
+
+    @property
+    def cloud(self) -> np.ndarray:
+        """Every pixel with a depth as a world point (n, 3), made when first asked (for display)."""
+        return self._cloud[0]
+
+    @property
+    def cloud_class(self) -> np.ndarray:
+        """The class of each of ``cloud``'s points (``class_images``)."""
+        return self._cloud[1]
 
     @property
     def ok(self) -> bool:
@@ -147,21 +174,22 @@ def perceive(views: list[CameraView], config: PerceptionConfig, template: Scene)
 def _perceive(
     views: list[CameraView], config: PerceptionConfig, template: Scene, started: float
 ) -> Perception:
-    points, no_depth = view_points(views)
+    valid = [valid_depth(v.depth) for v in views]
     base = {
         "pixels": sum(v.depth.size for v in views),
-        "no_depth_pixels": no_depth,
+        "no_depth_pixels": sum(int(m.size - m.sum()) for m in valid),
         "nan_pixels": sum(int(np.isnan(v.depth).sum()) for v in views),
+        "views": tuple(views),
     }
 
     def failed(reason: str, **more: Any) -> Perception:
         elapsed = time.perf_counter() - started
         return Perception(unperceived_scene(template), reason, perception_s=elapsed, **base, **more)
 
-    scene_points = points.subset(points.label != ROBOT_LABEL)
+    keep = [m & (v.labels != ROBOT_LABEL) for m, v in zip(valid, views)]
     table = fit_table(
-        scene_points,
         views,
+        keep,
         tolerance=config.table_tolerance,
         sample=config.ransac_points,
         seed=config.seed,
@@ -170,20 +198,28 @@ def _perceive(
     if isinstance(table, str):
         return failed(table)
     x0, y0, x1, y1 = table.bounds
-    heights = table.height_above(scene_points.xyz)
-    x, y = scene_points.xyz[:, 0], scene_points.xyz[:, 1]
-    above = (x >= x0) & (x <= x1) & (y >= y0) & (y <= y1) & (heights >= config.min_height)
-    object_points = scene_points.subset(above)
+    heights = table.heights
+    with np.errstate(invalid="ignore"):
+        high = pixel_points(views, [k & (h >= config.min_height) for k, h in zip(keep, heights)])
+    x, y = high.xyz[:, 0], high.xyz[:, 1]
+    object_points = high.subset((x >= x0) & (x <= x1) & (y >= y0) & (y <= y1))
     radius = max(config.cluster_radius, 1.5 * table.pixel)
     groups = cluster_points(object_points, radius=radius, min_points=config.min_points)
     clusters = boundaries(views, object_points, groups, config.border_margin)
-    classes = np.full(len(points), 3)  # the display's classes (``Perception.cloud_class``)
-    kept = np.flatnonzero(points.label != ROBOT_LABEL)
-    classes[kept[np.abs(heights) <= config.table_tolerance]] = 0
-    classes[kept[above]] = 2
-    classes[kept[np.flatnonzero(above)[np.concatenate(groups)]] if groups else []] = 1
-    noise = int(above.sum()) - sum(len(g) for g in groups)
-    display = {"cloud": points.xyz, "cloud_class": classes, "noise_points": noise, "table": table}
+    classes = []  # the display's classes per pixel (``Perception.cloud_class``)
+    clustered = np.zeros(len(object_points), bool)
+    clustered[np.concatenate(groups) if groups else []] = True
+    for k, (mask, h) in enumerate(zip(keep, heights)):
+        image = np.full(mask.shape, 3, dtype=np.int8)
+        with np.errstate(invalid="ignore"):
+            image[mask & (np.abs(h) <= config.table_tolerance)] = 0
+        mine = object_points.camera == k
+        image[object_points.row[mine], object_points.col[mine]] = 2
+        mine &= clustered
+        image[object_points.row[mine], object_points.col[mine]] = 1
+        classes.append(image)
+    noise = len(object_points) - int(clustered.sum())
+    display = {"class_images": tuple(classes), "noise_points": noise, "table": table}
     for cluster in clusters:
         if _cut_off(cluster):
             cx, cy = cluster.points.xyz[:, :2].mean(axis=0)

@@ -12,7 +12,8 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.sensors import ImageDepth32F, ImageLabel16I
 
 from hlp_drake.scene.model import Scene, SceneObject, Table
-from hlp_drake.systems.cameras import TABLE_LABEL, TARGET_LABEL, DepthNoise, camera_pose
+from hlp_drake.systems.cameras import ROBOT_LABEL, TABLE_LABEL, TARGET_LABEL, DepthNoise, camera_pose
+from hlp_drake.systems.depth_points import view_points
 from hlp_drake.systems.perception_config import CameraSettings, PerceptionConfig
 from hlp_drake.systems.perception_errors import perception_record
 from hlp_drake.systems.scenario import Scenario, load_scenario
@@ -90,6 +91,19 @@ def test_scene_perception_finds_every_object_with_its_pose_size_and_shape(frame)
     assert abs(scene.table.length - SCENE.table.length) < 0.01
     assert scene.start == SCENE.start
     assert perception.perception_s > 0 and perception.pixels == CAMERA.width * CAMERA.height
+
+
+def test_the_tables_height_images_are_the_heights_of_the_pixels_points_and_classify_the_cloud(frame):
+    perception, _ = perceive_fixed(frame["depth_image"], frame["label_image"], frame["camera_pose"])
+    table, (view,) = perception.table, perception.views
+    points, _ = view_points([view])
+    heights = table.heights[0][points.row, points.col]
+    assert np.allclose(heights, table.height_above(points.xyz), atol=1e-9)
+    assert len(perception.cloud) == len(points) and perception.cloud_class.shape == (len(points),)
+    on_table = np.abs(heights) <= SCENARIO.perception.table_tolerance
+    assert np.all(perception.cloud_class[on_table & (points.label != ROBOT_LABEL)] == 0)
+    assert np.all(perception.cloud_class[heights >= SCENARIO.perception.min_height] != 0)
+    assert (perception.cloud_class == 1).sum() == sum(o.points for o in perception.objects)
 
 
 def test_scene_perception_reads_through_missing_depth_and_tells_of_nan_pixels(frame):

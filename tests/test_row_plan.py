@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 
 from hlp_drake.evaluation import nearest_gap_plan
+from hlp_drake.features.row_choice import RowChoiceScene
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.planner import PlanKeypoint, plan
-from hlp_drake.planner.row_plan import planned_rows, segment_collisions
+from hlp_drake.planner.row_plan import FALLBACK_SCALE, _fallback, planned_rows, segment_collisions
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene, SceneObject, Table
 from hlp_drake.taskspace import TaskSpace
@@ -80,6 +81,26 @@ def test_a_case_outside_the_demonstrations_falls_back_to_the_nearest_gap(models)
     assert [(k.action, k.element) for k in first_row] == [
         (k.action, k.element) for k in rule.keypoints if k.row == 1
     ]
+
+
+def test_the_one_line_rule_follows_the_nearest_gap_and_keeps_the_about_as_near_ones():
+    # The line from the start to the target meets the box 0.2 mm off its middle: the two gaps
+    # beside it are about equally near, the nearer gets the larger share, the obstacle none.
+    scene = Scene(
+        name="tie",
+        table=Table(length=0.8, width=0.9, height=0.75),
+        start=(0.0, 0.0),
+        target=SceneObject("Target", "cylinder", 0.6, 0.0, (0.066, 0.066, 0.12)),
+        obstacles=(SceneObject("box", "box", 0.3, 0.0002, (0.06, 0.10, 0.10)),),
+    )
+    width = 0.05
+    candidates = RowChoiceScene(TaskSpace(scene), width).candidates(1, np.array([scene.start]))[0]
+    p = _fallback(candidates)
+    assert candidates.kinds == ("gap", "gap", "object")
+    assert p.sum() == pytest.approx(1.0) and p[2] == 0.0
+    assert p[1] > p[0] > 0.45  # gap 2 (right, -y) is 0.4 mm nearer
+    offsets = candidates.X[:2, 3]
+    assert p[0] / p[1] == pytest.approx(np.exp(-(offsets[0] - offsets[1]) / FALLBACK_SCALE))
 
 
 def test_ways_through_obstacles_are_reported():

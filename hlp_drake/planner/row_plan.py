@@ -58,13 +58,20 @@ def planned_rows(space: TaskSpace, hand_width: float) -> list[Row]:
     return [row for row in space.rows if scene.start[0] < row.x < reach]
 
 
+FALLBACK_SCALE = 0.5
+"""The one-line rule's shares fall by e for every this many hand widths a candidate lies further
+from the hand's line than the nearest (``_fallback``)."""
+
+
 def _fallback(candidates: RowCandidates) -> np.ndarray:
     """The one-line rule's choice as probabilities: the gap nearest the hand's line (else the
-    obstacle nearest it)."""
-    offset = candidates.X[:, 3] + 1e3 * candidates.X[:, 0]  # gaps first
-    p = np.zeros(len(candidates))
-    p[int(np.argmin(offset))] = 1.0
-    return p
+    obstacle nearest it), with the gaps about as near as alternatives: shares falling by e per
+    ``FALLBACK_SCALE`` hand widths of lateral offset beyond the nearest. Two gaps equally near
+    (the line meeting an obstacle in its middle) are then both followed and the plan's ranking
+    chooses, where a hard nearest-gap rule would flip between them with sub-millimetre changes."""
+    offset = candidates.X[:, 3] + 1e3 * candidates.X[:, 0]  # lateral offset in hand widths; gaps first
+    p = np.exp(-(offset - offset.min()) / FALLBACK_SCALE)
+    return p / p.sum()
 
 
 class _Expander:

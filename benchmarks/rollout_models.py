@@ -16,7 +16,8 @@
 
 The models (``MODELS``): the full model at 5 ms (the issue's reference), the reduced model (objects
 nothing comes near asleep) at 5 and 10 ms, the full model at 10 ms, each contact trim alone on the
-reduced 10 ms model, and the default (``Scenario().optimiser``). Writes ``DIR/rollout_models.json``
+reduced 10 ms model, the default trims at 20 ms (with and without sampled output ports), and the
+default (``Scenario().optimiser``). Writes ``DIR/rollout_models.json``
 and ``DIR/rollout_models.png``.
 """
 
@@ -53,6 +54,8 @@ MODELS = {
     "{top_spheres: true, rim_spheres: 8, robot_self_contact: false, sampled_output_ports: true}}",
     "reduced_10ms_unsampled": "{rollout_time_step: 0.01, reduced_model: true, rollout_trims: "
     "{top_spheres: true, rim_spheres: 8, robot_self_contact: true, sampled_output_ports: false}}",
+    "trimmed_20ms": "{rollout_time_step: 0.02}",
+    "trimmed_20ms_sampled": "{rollout_time_step: 0.02, rollout_trims: {sampled_output_ports: true}}",
     "default": "{}",
 }
 

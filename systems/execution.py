@@ -7,7 +7,8 @@ IK and optimiser then work on the perceived scene while the world simulates the 
 what drives the robot: open loop a trajectory source, closed loop (``scenario.closed_loop.enabled``)
 a ``RecedingHorizonController`` re-optimising on the measured state. It evaluates the plan, the
 keyframes and the optimisation at the start, plays the optimised trajectory, checks the reach, then
-closes the gripper and lifts. With ``scenario.uncertainty.enabled`` the world differs from what the
+closes the gripper and lifts (open loop in the optimiser's own world, the reach is the optimiser's
+verification of it on the execution model: the execution starts from where that ended). With ``scenario.uncertainty.enabled`` the world differs from what the
 planners believe (``model_error``): without cameras the planning diagram then plans on the
 scenario's scene, not the plant's. A ``RunListener`` hears of every stage as it happens.
 """
@@ -40,7 +41,7 @@ from hlp_drake.systems.planning_diagram import make_planning_diagram
 from hlp_drake.systems.receding_horizon import RecedingHorizonController
 from hlp_drake.systems.robot import TCP_FRAME
 from hlp_drake.systems.robot_command import ClosedLoopCommand, OpenLoopCommand
-from hlp_drake.systems.rollout_cost import pregrasp_check, reach_problem
+from hlp_drake.systems.rollout_cost import FinalState, pregrasp_check, reach_problem
 from hlp_drake.systems.rollout_pool import RolloutPool
 from hlp_drake.systems.rollout_world import simulation_failure
 from hlp_drake.systems.scene_models import fallen_objects, object_body, object_planar_poses
@@ -93,7 +94,9 @@ class RunListener:
 
 @dataclass
 class ExecutionResult:
-    """Outcome of planning and executing one scene."""
+    """Outcome of planning and executing one scene (``reach_reused``: the execution started where
+    the optimised sequence's verification on the execution model ended, rather than simulating the
+    reach again; see ``verified_reach``)."""
 
     planner: str
     scene: Scene
@@ -114,6 +117,7 @@ class ExecutionResult:
     perception: dict[str, Any] | None = None
     execution: str = "open"
     closed_loop: dict[str, Any] = field(default_factory=dict)
+    reach_reused: bool = False
 
     @property
     def rollout_passed_execution_failed(self) -> bool:
@@ -141,6 +145,7 @@ class ExecutionResult:
             **({} if self.perception is None else {"perception": self.perception}),
             "execution": self.execution,
             "closed_loop": self.closed_loop,
+            "reach_reused": self.reach_reused,
             "rollout_passed_execution_failed": self.rollout_passed_execution_failed,
         }
 
@@ -272,8 +277,12 @@ def plan_and_execute(
         draw_plan(meshcat, result.robot_plan, path="robot_plan", **heights)
         if perception is not None:
             draw_perception(meshcat, perception)
+    reached = None
+    if execution == "open" and error is None and meshcat is None and result.failure_reason is None:
+        reached = verified_reach(optimisation, scenario)
+    result.reach_reused = reached is not None
     if execution == "open" or result.failure_reason is None:  # closed loop: only an optimised sequence
-        _execute(result, simulator, command, scenario, meshcat, listener)
+        _execute(result, simulator, command, scenario, meshcat, listener, reached)
     if execution == "closed" and result.failure_reason is None:
         result.closed_loop = controller.record(simulator.get_context()).to_dict()
     executed = time.perf_counter()
@@ -285,6 +294,15 @@ def plan_and_execute(
     return result
 
 
+def verified_reach(optimisation: StoResult, scenario: Scenario) -> FinalState | None:
+    """Where the optimised sequence's verification on the execution model ended, if that was in
+    ``scenario``'s own world from the scene's start (None otherwise, e.g. planned on a perceived
+    scene): the execution model is deterministic, so the execution's reach would end there too."""
+    outcome = optimisation.outcome
+    final = None if outcome is None or outcome.verification is None else outcome.verification.final
+    return final if final is not None and final.scenario_key == scenario.key else None
+
+
 def _execute(
     result: ExecutionResult,
     simulator: Simulator,
@@ -292,8 +310,10 @@ def _execute(
     scenario: Scenario,
     meshcat: Meshcat | None,
     listener: RunListener,
+    reached: FinalState | None = None,
 ) -> None:
-    """Simulate the commanded reach in the world, check it, then grasp and lift; fills ``result``."""
+    """Simulate the commanded reach in the world (or start where ``reached`` says it ends), check
+    it, then grasp and lift; fills ``result``."""
     scene = result.scene
     world = simulator.get_system().GetSubsystemByName("world")
     plant, robot = world_plant(world)
@@ -309,10 +329,19 @@ def _execute(
         meshcat.StartRecording(frames_per_second=RECORDING_FPS)
     try:
         end = command.end(root)
-        while simulator.get_context().get_time() < end:  # closed loop: a re-plan may move the end
-            simulator.AdvanceTo(end)
-            end = command.end(root)
-        simulator.AdvanceTo(end + SETTLE_S)
+        if reached is not None and reached.time == end + SETTLE_S:  # the verification was this reach
+            root.SetTime(reached.time)
+            state = plant.GetMyMutableContextFromRoot(root)
+            for name, x in reached.states.items():
+                plant.SetPositionsAndVelocities(state, plant.GetModelInstanceByName(name), x)
+            simulator.Initialize()
+            listener.simulated(reached.time)
+        else:
+            result.reach_reused = False
+            while simulator.get_context().get_time() < end:  # closed loop: a re-plan may move the end
+                simulator.AdvanceTo(end)
+                end = command.end(root)
+            simulator.AdvanceTo(end + SETTLE_S)
         after = object_planar_poses(plant, plant_context, names)
         result.objects_moved = [
             n

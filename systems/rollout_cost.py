@@ -65,6 +65,19 @@ class Prediction:
 
 
 @dataclass(frozen=True)
+class FinalState:
+    """Where a rollout on the execution model ended: the plant's model instances' positions and
+    velocities (by name, ``RolloutWorld.states()``' form) at simulated time ``time``, in the world
+    of the scenario with key ``scenario_key``. Its execution model is deterministic, so an execution
+    of the same sequence from the same start in that world ends there too and may start from here.
+    """
+
+    scenario_key: str
+    time: float
+    states: dict[str, np.ndarray]
+
+
+@dataclass(frozen=True)
 class RolloutOutcome:
     """A rollout's cost and final state.
 
@@ -81,6 +94,7 @@ class RolloutOutcome:
         prediction: the samples' object centres and tcp positions.
         verification: the same sequence's outcome on the execution model, when it was verified there
             and passed (its prediction is then the execution's own).
+        final: the end state, for a rollout on the execution model only (None on the rollout model).
     """
 
     cost: float
@@ -95,6 +109,7 @@ class RolloutOutcome:
     switches: int = 0
     prediction: Prediction | None = None
     verification: RolloutOutcome | None = None
+    final: FinalState | None = None
 
 
 def _half_extent(size: tuple[float, float, float]) -> float:

@@ -40,8 +40,28 @@ ANGULAR_REST = 0.05
 """An object turning slower than this (rad/s) may count as at rest."""
 
 
+class _ClosePairs:
+    """``world.close_pairs`` at one sample, queried once at ``reach`` and filtered for any threshold
+    up to it (a larger one queries again): the wake and the sleep checks share one query."""
+
+    def __init__(self, world: RolloutWorld, reach: float) -> None:
+        self._world, self._reach, self._pairs = world, reach, None
+
+    def within(self, threshold: float) -> list[tuple[int, int, float]]:
+        if threshold > self._reach:
+            return self._world.close_pairs(threshold)
+        if self._pairs is None:
+            self._pairs = self._world.close_pairs(self._reach)
+        return [pair for pair in self._pairs if pair[2] <= threshold]
+
+
 def _near_asleep(
-    world: RolloutWorld, poses: BodyPoses, previous: BodyPoses, start: BodyPoses, asleep: frozenset[str]
+    world: RolloutWorld,
+    pairs: _ClosePairs,
+    poses: BodyPoses,
+    previous: BodyPoses,
+    start: BodyPoses,
+    asleep: frozenset[str],
 ) -> frozenset[str]:
     """The sleeping objects within the margin (see the module's docstring) of the robot or of an
     awake object that has moved since ``start`` (the poses now)."""
@@ -54,7 +74,7 @@ def _near_asleep(
     step = float(np.max(world.motion_bounds(poses, previous)[moved], initial=0.0))
     watchers = {name for name, m in zip(names, moved[world.num_robot_bodies :]) if m}
     near = set()
-    for a, b, _ in world.close_pairs(world.scenario.optimiser.weld_margin + step):
+    for a, b, _ in pairs.within(world.scenario.optimiser.weld_margin + step):
         for sleeper, other in ((a, b), (b, a)):
             name, other_name = world.object_name(sleeper), world.object_name(other)
             if name in asleep and (other in world.robot_bodies or other_name in watchers):
@@ -64,6 +84,7 @@ def _near_asleep(
 
 def _sleepers(
     world: RolloutWorld,
+    pairs: _ClosePairs,
     poses: BodyPoses,
     previous: BodyPoses,
     asleep: frozenset[str],
@@ -82,7 +103,7 @@ def _sleepers(
     if not chosen:
         return frozenset()
     touching: dict[str, set[str]] = {n: set() for n in chosen}
-    for a, b, distance in world.close_pairs(sto.weld_clearance):
+    for a, b, distance in pairs.within(sto.weld_clearance):
         for body, other in ((a, b), (b, a)):
             name, other_name = world.object_name(body), world.object_name(other)
             if name not in touching:
@@ -140,7 +161,8 @@ def sample_rollout(
             if problem is not None:
                 break
         poses = world.watched_poses()
-        near = _near_asleep(world, poses, previous, first, asleep) if asleep else frozenset()
+        pairs = _ClosePairs(world, sto.weld_clearance)
+        near = _near_asleep(world, pairs, poses, previous, first, asleep) if asleep else frozenset()
         if near:  # back to the previous sample (or the start) with those objects awake
             asleep, switches = asleep - near, switches + 1
             world.begin(sequence, time=saved[0], states=saved[1], asleep=asleep)
@@ -153,7 +175,7 @@ def sample_rollout(
         due = schedule.due(t) - woken
         woken |= due
         sleepers = (
-            _sleepers(world, poses, previous, asleep, schedule.approaching(t), sto)
+            _sleepers(world, pairs, poses, previous, asleep, schedule.approaching(t), sto)
             if schedule.sleeping
             else frozenset()
         )

@@ -6,7 +6,9 @@ for verifying), with a C++ ``TrajectorySource`` driving the robot; the initial c
 rollout swaps the source's trajectory, resets the context (or sets a given start state) and
 simulates, Python only reading the state (``Reading``) every ``optimiser.sample_period``. Objects
 may be put to sleep (their floating joints locked in the context: they neither move nor cost the
-contact solver a degree of freedom) and woken again, at any pose (see ``rollout_sampler``).
+contact solver a degree of freedom) and woken again, at any pose (see ``rollout_sampler``). On the
+execution model a rollout from the scene's start keeps its end state (``RolloutOutcome.final``): the
+execution of a verified sequence starts from there rather than simulating the reach again.
 """
 
 from __future__ import annotations
@@ -26,7 +28,13 @@ from pydrake.systems.framework import DiagramBuilder
 
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.robot import TCP_FRAME
-from hlp_drake.systems.rollout_cost import Prediction, RolloutOutcome, RolloutSamples, rollout_cost
+from hlp_drake.systems.rollout_cost import (
+    FinalState,
+    Prediction,
+    RolloutOutcome,
+    RolloutSamples,
+    rollout_cost,
+)
 from hlp_drake.systems.rollout_sampler import sample_rollout
 from hlp_drake.systems.scene_models import TABLE_NAME, object_body, over_table_mask
 from hlp_drake.systems.sleep_schedule import AWAKE
@@ -122,6 +130,7 @@ class RolloutWorld:
     """
 
     def __init__(self, scenario: Scenario, *, execution: bool = False) -> None:
+        self.execution, self.key = execution, scenario.key
         if execution:
             scenario = verification_scenario(scenario)
         scene = scenario.scene
@@ -355,14 +364,19 @@ class RolloutWorld:
 def timed_rollout(
     sequence: ControlSequence, simulate, costing: RolloutWorld, start: RolloutStart | None = None
 ) -> RolloutOutcome:
-    """``simulate(sequence, start)`` costed by ``costing``, with the sleeping record and the wall time."""
+    """``simulate(sequence, start)`` costed by ``costing``, with the sleeping record and the wall time
+    (and, on the execution model from the scene's start, the end state)."""
     started = time.perf_counter()
     samples = simulate(sequence, start)
     prediction = Prediction(samples.times, samples.positions, samples.tcp)
+    final = None
+    if costing.execution and start is None:
+        final = FinalState(costing.key, costing.time(), costing.states())
     outcome = replace(
         costing.cost(samples, sequence),
         asleep=samples.asleep,
         switches=samples.switches,
         prediction=prediction,
+        final=final,
     )
     return replace(outcome, wall_s=time.perf_counter() - started)

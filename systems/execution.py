@@ -5,7 +5,8 @@ own time step), the scene source feeding the planning diagram (``SceneFromPlant`
 body poses, or with ``perception.source: camera`` ``ScenePerception`` on its cameras: the planner,
 IK and optimiser then work on the perceived scene while the world simulates the true one), and
 what drives the robot: open loop a trajectory source, closed loop (``scenario.closed_loop.enabled``)
-a ``RecedingHorizonController`` re-optimising on the measured state. It evaluates the plan, the
+a ``RecedingHorizonController`` re-optimising on the measured state and the scene source's scene
+(re-perceived at every re-plan with cameras). It evaluates the plan, the
 keyframes and the optimisation at the start, plays the optimised trajectory, checks the reach, then
 closes the gripper and lifts (open loop in the optimiser's own world, the reach is the optimiser's
 verification of it on the execution model: the execution starts from where that ended). With ``scenario.uncertainty.enabled`` the world differs from what the
@@ -193,17 +194,20 @@ def plan_and_execute(
     planning = builder.AddNamedSystem("planning", make_planning_diagram(scenario, pool=pool, models=models))
     if camera:  # the planners see what the cameras see of the (true) world
         source = add_scene_perception(builder, world, scenario)
-        builder.Connect(source.get_scene_output_port(), planning.GetInputPort(SCENE_PORT))
-    elif error is None:  # the planners see the plant's scene
+    else:  # the plant's poses (of the believed objects, under model error)
         source = builder.AddNamedSystem("scene_from_plant", SceneFromPlant(plant, scene))
         builder.Connect(world.GetOutputPort("body_poses"), source.get_body_poses_input_port())
+    if camera or error is None:  # else the planners plan on the believed scene (fixed below)
         builder.Connect(source.get_scene_output_port(), planning.GetInputPort(SCENE_PORT))
-    if execution == "closed":
+    if execution == "closed":  # it observes the scene through the same source at every re-plan
         replanner = ObservedScenePlanner(scenario, models=models)  # when objects have moved far
         controller = builder.AddNamedSystem(
             "controller", RecedingHorizonController(scenario, plant, pool, initialiser=replanner)
         )
         builder.Connect(world.GetOutputPort("state"), controller.GetInputPort("state"))
+        builder.Connect(source.get_scene_output_port(), controller.GetInputPort(SCENE_PORT))
+        if camera:
+            builder.Connect(source.get_perception_output_port(), controller.GetInputPort("perception"))
         builder.Connect(planning.GetOutputPort("optimisation"), controller.GetInputPort("initial"))
         connect_robot_command(
             builder, world, controller.GetOutputPort("desired_trajectory_state"), name="controller"

@@ -1,7 +1,13 @@
 """``RecedingHorizonController``: closed-loop execution, the STO re-run on the measured state.
 
 Input ports:
-    ``state``: the plant's whole state (the world's ``state`` output: the robot and the free objects).
+    ``state``: the plant's whole state (the world's ``state`` output): the robot's state, and with
+        ``perception.source: plant`` the free objects' too.
+    ``scene`` (abstract ``Scene``): the observed scene, from the diagram's scene source (``SceneFromPlant``
+        on the plant's poses, or ``ScenePerception`` on the cameras: then the objects are known only
+        from it), read at the start and at every re-plan.
+    ``perception`` (abstract ``Perception``, optional): the scene source's frame, for why a scene
+        without a target was observed (``ScenePerception``'s ``perception`` output).
     ``initial`` (abstract ``StoResult``, e.g. the planning diagram's ``optimisation``): the open-loop
         optimisation, read once when the simulation is initialised.
 
@@ -10,16 +16,19 @@ Output port:
         velocities once the sequence has ended); ``connect_robot_command`` feeds it to the world.
 
 Every ``closed_loop.replan_period`` s of simulated time while its sequence lasts (a periodic
-unrestricted update: the simulation waits for it), the controller reads the measured state, cuts its
-commanded sequence there (the warm start: its remainder, starting where the robot is commanded now)
-and runs ``optimise`` from the measured state (``RolloutStart``) with the budget of
+unrestricted update: the simulation waits for it), the controller reads the measured state and the
+observed scene, cuts its commanded sequence there (the warm start: its remainder, starting where the
+robot is commanded now) and runs ``optimise`` from the measured state (``RolloutStart``; objects
+not measured start at rest where the observed scene has them) with the budget of
 ``closed_loop.iterations`` and ``closed_loop.rollouts``; the result's sequence is commanded from then
 on (the optimiser's acceptance is monotone: the remainder unless a candidate is cheaper or passes;
 re-optimisations do not verify on the execution model: the execution itself goes on from there).
-When an object is farther than ``closed_loop.replan_distance`` from where the current sequence's
-rollout put it, and an ``initialiser`` is given, its sequence for the measured states (e.g. the
-planner's on the observed scene) is optimised instead, the remainder its alternative. The commanded
-sequence and the counts live in the context's abstract state (``ControllerRecord``).
+When an observed object is farther than ``closed_loop.replan_distance`` from where the current
+sequence's rollout put it (objects matched by name), and an ``initialiser`` is given, its sequence
+for the observed scene from the robot's measured state (e.g. the planner's) is optimised instead,
+the remainder its alternative. An observed scene without a target (a failed frame) is not used: the
+last good one is kept and the reason counted. The commanded sequence, the scene its rollout
+predicted and the counts live in the context's abstract state (``ControllerRecord``).
 """
 
 from __future__ import annotations
@@ -32,11 +41,14 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import Context, LeafSystem, State
 
+from hlp_drake.scene.model import Scene
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser import EMPTY_RESULT, Budget, StoResult, optimise
+from hlp_drake.systems.perception import Perception
 from hlp_drake.systems.robot import ROBOT_MODEL_NAME
 from hlp_drake.systems.rollout_cost import Prediction
 from hlp_drake.systems.rollout_world import RolloutStart
+from hlp_drake.systems.scene_source import declare_scene_input_port, scene_input, with_scene
 
 if TYPE_CHECKING:
     from pydrake.multibody.plant import MultibodyPlant
@@ -46,12 +58,15 @@ if TYPE_CHECKING:
 
 MIN_REMAINDER = 1.0e-3
 """A sequence with less than this left (s) is not re-optimised."""
+Initialiser = Callable[[Scene, np.ndarray], "ControlSequence | None"]
+"""A fresh initial sequence for an observed scene from the robot's measured state (11 + 11)."""
 
 
 @dataclass(frozen=True)
 class ControllerRecord:
     """The controller's state: the commanded ``sequence`` (started at simulated time ``t0``), the
-    prediction of its last rollout and what the re-optimisations did."""
+    prediction of its last rollout and the ``scene`` that rollout was on, the last good observed
+    scene, and what the re-optimisations and observations did."""
 
     sequence: ControlSequence | None = None
     t0: float = 0.0
@@ -61,6 +76,11 @@ class ControllerRecord:
     initialised: int = 0
     changed: int = 0
     reason: str | None = None
+    scene: Scene | None = None
+    observed: Scene | None = None
+    observations: int = 0
+    observation_failures: int = 0
+    observation_reason: str | None = None
 
     def to_dict(self) -> dict:
         return {
@@ -69,6 +89,9 @@ class ControllerRecord:
             "initialised": self.initialised,
             "changed": self.changed,
             "reason": self.reason,
+            "observations": self.observations,
+            "observation_failures": self.observation_failures,
+            "observation_reason": self.observation_reason,
         }
 
 
@@ -88,10 +111,11 @@ class RecedingHorizonController(LeafSystem):
     """The receding-horizon controller (see the module's docstring for the ports and the behaviour).
 
     Args:
-        scenario: the optimiser's settings and the believed scene.
+        scenario: the optimiser's settings; with ``perception.source: camera`` only the robot is
+            measured on ``state`` (the objects are what the ``scene`` input shows).
         plant: the world's plant (to split its state by model instance; not simulated here).
         pool: the rollout workers (the caller's).
-        initialiser: a fresh initial sequence from the measured model-instance states (None: none).
+        initialiser: a fresh initial sequence for the observed scene (``Initialiser``; None: none).
     """
 
     def __init__(
@@ -100,16 +124,19 @@ class RecedingHorizonController(LeafSystem):
         plant: MultibodyPlant,
         pool: RolloutPool,
         *,
-        initialiser: Callable[[dict[str, np.ndarray]], ControlSequence | None] | None = None,
+        initialiser: Initialiser | None = None,
     ) -> None:
         super().__init__()
         self._scenario, self._pool, self._initialiser = scenario, pool, initialiser
         self._plant = plant
-        names = [ROBOT_MODEL_NAME] + [
-            o.name for o in scenario.scene.objects if plant.HasModelInstanceNamed(o.name)
-        ]
+        objects = () if scenario.perception.source == "camera" else scenario.scene.objects
+        names = [ROBOT_MODEL_NAME] + [o.name for o in objects if plant.HasModelInstanceNamed(o.name)]
         self._instances = {n: plant.GetModelInstanceByName(n) for n in names}
         self._state = self.DeclareVectorInputPort("state", plant.num_multibody_states())
+        self._scene = declare_scene_input_port(self)
+        self._perception = self.DeclareAbstractInputPort(
+            "perception", AbstractValue.Make(Perception(None, "not perceived"))
+        )
         self._initial = self.DeclareAbstractInputPort("initial", AbstractValue.Make(EMPTY_RESULT))
         self._record = self.DeclareAbstractState(AbstractValue.Make(ControllerRecord()))
         nq = plant.num_positions(self._instances[ROBOT_MODEL_NAME])
@@ -145,11 +172,33 @@ class RecedingHorizonController(LeafSystem):
             for name, i in self._instances.items()
         }
 
+    def _observe(self, context: Context, record: ControllerRecord) -> ControllerRecord:
+        """``record`` with the scene on the ``scene`` input observed (kept unless it has no target)."""
+        scene = scene_input(self._scene, context)
+        if scene.target is not None:
+            return replace(record, observed=scene, observations=record.observations + 1)
+        reason = "the observed scene has no target"
+        if self._perception.HasValue(context):
+            reason = self._perception.Eval(context).reason or reason
+        return replace(
+            record,
+            observations=record.observations + 1,
+            observation_failures=record.observation_failures + 1,
+            observation_reason=reason,
+        )
+
     def _initialise(self, context: Context, state: State) -> None:
         result: StoResult = self._initial.Eval(context)
         prediction = None if result.outcome is None else result.outcome.prediction
+        record = self._observe(context, ControllerRecord())
         state.get_mutable_abstract_state(int(self._record)).set_value(
-            ControllerRecord(result.sequence, float(context.get_time()), prediction)
+            replace(
+                record,
+                sequence=result.sequence,
+                t0=float(context.get_time()),
+                prediction=prediction,
+                scene=record.observed,
+            )
         )
 
     def _replan(self, context: Context, state: State) -> None:
@@ -160,12 +209,18 @@ class RecedingHorizonController(LeafSystem):
         rest = remainder(record.sequence, t - record.t0)
         if rest is None:
             return
+        record = self._observe(context, record)
+        if record.observed is None:  # never a good scene: nothing to plan on
+            state.get_mutable_abstract_state(int(self._record)).set_value(record)
+            return
         states = self._states(context)
+        measured = all(o.name in states for o in record.observed.objects)
+        scene = record.scene if measured and record.scene is not None else record.observed
         closed = self._scenario.closed_loop
         sto = self._scenario.optimiser
         initial, alternatives, initialised = rest, None, False
-        if self._initialiser is not None and self._moved_far(record, t, states):
-            fresh = self._initialiser(states)
+        if self._initialiser is not None and self._moved_far(record, t):
+            fresh = self._initialiser(record.observed, states[ROBOT_MODEL_NAME])
             if fresh is not None:
                 initial, alternatives, initialised = fresh, (lambda: [rest]), True
         budget = Budget(
@@ -176,7 +231,7 @@ class RecedingHorizonController(LeafSystem):
             seed=sto.seed + 1 + record.replans,
         )
         result = optimise(
-            self._scenario,
+            with_scene(self._scenario, scene),
             initial,
             self._pool,
             budget=budget,
@@ -185,33 +240,34 @@ class RecedingHorizonController(LeafSystem):
         )
         prediction = None if result.outcome is None else result.outcome.prediction
         state.get_mutable_abstract_state(int(self._record)).set_value(
-            ControllerRecord(
-                result.sequence,
-                t,
-                prediction,
-                record.replans + 1,
-                record.rollouts + result.rollouts,
-                record.initialised + int(initialised),
-                record.changed + int(result.sequence is not rest),
-                result.failure_reason,
+            replace(
+                record,
+                sequence=result.sequence,
+                t0=t,
+                prediction=prediction,
+                replans=record.replans + 1,
+                rollouts=record.rollouts + result.rollouts,
+                initialised=record.initialised + int(initialised),
+                changed=record.changed + int(result.sequence is not rest),
+                reason=result.failure_reason,
+                scene=scene,
             )
         )
 
-    def _moved_far(self, record: ControllerRecord, t: float, states: dict[str, np.ndarray]) -> bool:
-        """Whether an object is farther than ``closed_loop.replan_distance`` from where the
-        commanded sequence's rollout put it at ``t``."""
-        if record.prediction is None:
+    def _moved_far(self, record: ControllerRecord, t: float) -> bool:
+        """Whether an observed object is farther than ``closed_loop.replan_distance`` from where the
+        commanded sequence's rollout put it at ``t`` (the objects of its scene, by name)."""
+        if record.prediction is None or record.scene is None:
             return False
         expected = record.prediction.at(t - record.t0)
         if expected is None:
             return False
         positions, _ = expected
-        for k, obj in enumerate(self._scenario.scene.objects):
-            x = states.get(obj.name)
-            if (
-                x is not None
-                and np.linalg.norm(x[4:6] - positions[k, :2]) > self._scenario.closed_loop.replan_distance
-            ):
+        observed = {o.name: o for o in record.observed.objects}
+        limit = self._scenario.closed_loop.replan_distance
+        for k, obj in enumerate(record.scene.objects):
+            seen = observed.get(obj.name)
+            if seen is not None and np.hypot(seen.x - positions[k, 0], seen.y - positions[k, 1]) > limit:
                 return True
         return False
 
@@ -235,4 +291,4 @@ class RecedingHorizonController(LeafSystem):
         )
 
 
-__all__ = ["ControllerRecord", "RecedingHorizonController", "remainder"]
+__all__ = ["ControllerRecord", "Initialiser", "RecedingHorizonController", "remainder"]

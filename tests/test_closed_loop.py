@@ -2,24 +2,23 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
-from pydrake.systems.analysis import Simulator
-from pydrake.systems.framework import DiagramBuilder
+from closed_loop_support import run_controller
 
 from hlp_drake.run_scene import DEFAULT_SCENE
 from hlp_drake.scene.io import load_scene
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.model_error import UncertaintyConfig, sample_model_error
-from hlp_drake.systems.observed_planning import ObservedScenePlanner, measured_scene
-from hlp_drake.systems.optimiser import StoResult
-from hlp_drake.systems.receding_horizon import RecedingHorizonController, remainder
+from hlp_drake.systems.observed_planning import ObservedScenePlanner
+from hlp_drake.systems.receding_horizon import remainder
 from hlp_drake.systems.robot import ROBOT_MODEL_NAME
 from hlp_drake.systems.rollout_cost import Prediction, RolloutOutcome
-from hlp_drake.systems.rollout_pool import RolloutPool
 from hlp_drake.systems.rollout_world import RolloutWorld
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.world import connect_robot_command, make_world_diagram, world_plant
+from hlp_drake.systems.world import make_world_diagram, world_plant
 
 SETTINGS = (
     "optimiser: {samples: 2, workers: 1, verify: false}\n"
@@ -46,34 +45,6 @@ def test_the_remainder_starts_where_the_sequence_is_and_keeps_its_later_knots():
     assert rest.duration == pytest.approx(1.3) and rest.knots[0, 0] == pytest.approx(0.07)
     np.testing.assert_array_equal(rest.knots[1:], sequence.knots[2:])
     assert remainder(sequence, 2.0) is None
-
-
-def run_controller(
-    scenario: Scenario, sequence: ControlSequence, until: float, *, outcome=None, initialiser=None
-):
-    """Simulate the world driven by the controller (its initial optimisation ``sequence``, whose
-    rollout had ``outcome``) to ``until``."""
-    builder = DiagramBuilder()
-    world = builder.AddSystem(make_world_diagram(scenario))
-    plant, _ = world_plant(world)
-    with RolloutPool(1) as pool:
-        controller = builder.AddNamedSystem(
-            "controller", RecedingHorizonController(scenario, plant, pool, initialiser=initialiser)
-        )
-        builder.Connect(world.GetOutputPort("state"), controller.GetInputPort("state"))
-        connect_robot_command(builder, world, controller.GetOutputPort("desired_trajectory_state"), name="c")
-        simulator = Simulator(builder.Build())
-        context = simulator.get_mutable_context()
-        controller.GetInputPort("initial").FixValue(
-            controller.GetMyMutableContextFromRoot(context), StoResult(sequence, outcome, True, None)
-        )
-        simulator.AdvanceTo(until)
-        record = controller.record(context)
-        desired = controller.GetOutputPort("desired_trajectory_state").Eval(
-            controller.GetMyContextFromRoot(context)
-        )
-        q = plant.GetPositions(plant.GetMyContextFromRoot(context), world_plant(world)[1])
-    return record, desired, q
 
 
 def test_the_controller_re_optimises_every_period_within_its_budget_and_the_robot_follows(scenario):
@@ -115,19 +86,16 @@ def test_model_error_is_seeded_per_scene_and_changes_the_world(scenario):
     )
 
 
-def test_the_observed_scene_planner_plans_on_the_measured_scene_from_where_the_robot_is(scenario):
+def test_the_observed_scene_planner_plans_on_the_observed_scene_from_where_the_robot_is(scenario):
     world = RolloutWorld(scenario)
     world.begin(forward(world.start_positions, 0.0, 1.0))
-    states = world.states()
+    robot = world.states()[ROBOT_MODEL_NAME]
+    robot[0] += 0.02  # the base 2 cm on
     template = scenario.scene
-    pushed = template.obstacles[0].name
-    states[pushed][4] += 0.03  # measured 3 cm further along x
-    states[ROBOT_MODEL_NAME][0] += 0.02  # the base 2 cm on
-    scene = measured_scene(template, states)
-    assert scene.obstacles[0].x == pytest.approx(template.obstacles[0].x + 0.03, abs=1e-9)
-    assert scene.obstacles[1] is template.obstacles[1] and scene.target is template.target
-    sequence = ObservedScenePlanner(scenario)(states)
-    np.testing.assert_allclose(sequence.knots[0], states[ROBOT_MODEL_NAME][:11])
+    pushed = template.obstacles[0]
+    scene = replace(template, obstacles=(pushed.moved(pushed.x + 0.03, pushed.y), *template.obstacles[1:]))
+    sequence = ObservedScenePlanner(scenario)(scene, robot)
+    np.testing.assert_allclose(sequence.knots[0], robot[:11])
     assert sequence.duration > 1.0
 
 
@@ -137,8 +105,8 @@ def test_an_object_far_from_where_the_plan_expected_it_asks_for_a_new_initial_se
     positions = np.array([[o.x, o.y, 0.8] for o in scenario.scene.objects])
     calls = []
 
-    def initialiser(states):
-        calls.append(states)
+    def initialiser(scene, robot):
+        calls.append((scene, robot))
         return fresh
 
     def outcome(offset: float) -> RolloutOutcome:
@@ -151,4 +119,5 @@ def test_an_object_far_from_where_the_plan_expected_it_asks_for_a_new_initial_se
     far = 2 * scenario.closed_loop.replan_distance
     record, _, _ = run_controller(scenario, sequence, 0.5, outcome=outcome(far), initialiser=initialiser)
     assert record.replans == 1 and record.initialised == 1 and len(calls) == 1
-    assert set(calls[0]) >= {ROBOT_MODEL_NAME, scenario.scene.target.name}
+    assert calls[0][0].target.name == scenario.scene.target.name and len(calls[0][1]) == 22
+    assert record.observations == 2 and record.observation_failures == 0  # at the start and the re-plan

@@ -1,0 +1,52 @@
+"""The receding-horizon controller in a world: the tests' harness (``run_controller``)."""
+
+from __future__ import annotations
+
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+
+from hlp_drake.systems.control_sequence import ControlSequence
+from hlp_drake.systems.optimiser import StoResult
+from hlp_drake.systems.receding_horizon import RecedingHorizonController
+from hlp_drake.systems.rollout_pool import RolloutPool
+from hlp_drake.systems.scenario import Scenario
+from hlp_drake.systems.scene_perception import add_scene_perception
+from hlp_drake.systems.scene_source import SceneFromPlant
+from hlp_drake.systems.world import connect_robot_command, make_world_diagram, world_plant
+
+
+def run_controller(
+    scenario: Scenario, sequence: ControlSequence, until: float, *, outcome=None, initialiser=None
+):
+    """Simulate the world driven by the controller (its initial optimisation ``sequence``, whose
+    rollout had ``outcome``) to ``until``; the controller observes the scene through the
+    scenario's source (``SceneFromPlant``, or ``ScenePerception`` on the world's cameras).
+    Returns the controller's record, its command at ``until`` and the robot's positions."""
+    builder = DiagramBuilder()
+    world = builder.AddSystem(make_world_diagram(scenario))
+    plant, robot = world_plant(world)
+    with RolloutPool(1) as pool:
+        controller = builder.AddNamedSystem(
+            "controller", RecedingHorizonController(scenario, plant, pool, initialiser=initialiser)
+        )
+        if scenario.perception.source == "camera":
+            source = add_scene_perception(builder, world, scenario)
+            builder.Connect(source.get_perception_output_port(), controller.GetInputPort("perception"))
+        else:
+            source = builder.AddNamedSystem("scene_from_plant", SceneFromPlant(plant, scenario.scene))
+            builder.Connect(world.GetOutputPort("body_poses"), source.get_body_poses_input_port())
+        builder.Connect(world.GetOutputPort("state"), controller.GetInputPort("state"))
+        builder.Connect(source.get_scene_output_port(), controller.GetInputPort("scene"))
+        connect_robot_command(builder, world, controller.GetOutputPort("desired_trajectory_state"), name="c")
+        simulator = Simulator(builder.Build())
+        context = simulator.get_mutable_context()
+        controller.GetInputPort("initial").FixValue(
+            controller.GetMyMutableContextFromRoot(context), StoResult(sequence, outcome, True, None)
+        )
+        simulator.AdvanceTo(until)
+        record = controller.record(context)
+        desired = controller.GetOutputPort("desired_trajectory_state").Eval(
+            controller.GetMyContextFromRoot(context)
+        )
+        q = plant.GetPositions(plant.GetMyContextFromRoot(context), robot)
+    return record, desired, q

@@ -22,6 +22,7 @@ from hlp_drake.systems.perception_errors import perception_record
 from hlp_drake.systems.planning_diagram import first_rollout, initial_sequence, make_planning_diagram
 from hlp_drake.systems.planning_model import PlanningModel
 from hlp_drake.systems.push_transfer import ROBOT_ACTIONS, robot_alternatives, robot_plan
+from hlp_drake.systems.receding_horizon import RecedingHorizonController
 from hlp_drake.systems.robot import (
     ACTUATED_JOINTS,
     ARM_JOINTS,
@@ -93,6 +94,7 @@ __all__ = [
     "PlannerSettings",
     "PlanningModel",
     "PushRules",
+    "RecedingHorizonController",
     "RobotPlanTransfer",
     "RolloutOutcome",
     "RolloutPool",

@@ -130,9 +130,7 @@ def add_robot(
     try:
         (instance,) = parser.AddModels(url=ROBOT_URL)
     except RuntimeError as error:  # a damaged installation: one line and a hint, exit 2 on the command line
-        robot_file = (
-            Path(parser.package_map().GetPath(MODELS_PACKAGE)) / ROBOT_URL.split(f"{MODELS_PACKAGE}/", 1)[1]
-        )
+        robot_file = Path(parser.package_map().ResolveUrl(ROBOT_URL))
         raise InstallError(
             f"{ROBOT_URL}: the robot model cannot be parsed ({drake_reason(error, robot_file)}); {REINSTALL}"
         ) from None

@@ -165,8 +165,9 @@ def _nearest(
 
 
 ROUTE_OBSTACLES = 6
-"""Obstacles in the route graph: every VR scene (structured and unstructured) has six; with 16 a
-50-object plan took 1.8x a 6-object one, with 6 the same (``benchmarks/planning_time.py``)."""
+"""Obstacles in the route graph: every VR scene (structured and unstructured) has six. The graph's
+cost then no longer grows with the object count (``benchmarks/planning_time.py``: a two-row
+50-box plan took 1.8x a 6-box one with 16, 1.3x with 6, see docs/results.md)."""
 
 
 class RowChoiceScene:

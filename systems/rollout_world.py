@@ -27,6 +27,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from hlp_drake.systems.control_sequence import ControlSequence
+from hlp_drake.systems.proximity import ProximityContext
 from hlp_drake.systems.robot import TCP_FRAME
 from hlp_drake.systems.rollout_cost import (
     FinalState,
@@ -151,8 +152,6 @@ class RolloutWorld:
         self._simulator = Simulator(self.diagram)
         self._context = self._simulator.get_mutable_context()
         self._plant_context = plant.GetMyMutableContextFromRoot(self._context)
-        self._world_context = world.GetMyContextFromRoot(self._context)
-        self._query = world.GetOutputPort("query_object")
         self._initial = self._context.Clone()
         self.objects = [object_body(plant, obj.name) for obj in scene.objects]
         self.object_bodies = {int(body.index()) for body in self.objects}
@@ -182,6 +181,10 @@ class RolloutWorld:
         self._num_robot_watched = len(robot_bodies)
         self._watched = robot_bodies + self.objects
         self._watched_radii = np.array([self._body_radius(inspector, b) for b in self._watched])
+        # each object's quaternion floating joint: positions (qw, qx, qy, qz, x, y, z), velocities (w, v)
+        self._object_q = np.array([b.floating_positions_start() + np.arange(4, 7) for b in self.objects])
+        self._object_v = np.array([b.floating_velocities_start_in_v() + np.arange(6) for b in self.objects])
+        self._proximity = ProximityContext(self)
 
     def _body_radius(self, inspector, body) -> float:
         """Radius about the body's origin of a sphere holding its collision geometry, m."""
@@ -285,10 +288,10 @@ class RolloutWorld:
         return self._num_robot_watched
 
     def close_pairs(self, threshold: float) -> list[tuple[int, int, float]]:
-        """(body, body, distance) of the geometry pairs within ``threshold`` of each other (m; the
-        pairs SceneGraph filters, e.g. two sleeping objects, left out)."""
-        pairs = self._query.Eval(self._world_context).ComputeSignedDistancePairwiseClosestPoints(threshold)
-        return [(self.geometry_body[p.id_A], self.geometry_body[p.id_B], p.distance) for p in pairs]
+        """(body, body, distance) of the robot-object and object-object pairs within ``threshold`` of
+        each other now (m; ``ProximityContext``: the objects' shapes, not their support spheres)."""
+        self._proximity.set_positions(self.plant.GetPositions(self._plant_context))
+        return self._proximity.close_pairs(threshold)
 
     def object_name(self, body: int) -> str | None:
         """The scene object of body index ``body`` (None: the robot or the table)."""
@@ -296,19 +299,18 @@ class RolloutWorld:
 
     def object_speeds(self) -> tuple[np.ndarray, np.ndarray]:
         """Per object (scene order), its translational (m/s) and angular (rad/s) speed."""
-        velocities = [body.EvalSpatialVelocityInWorld(self._plant_context) for body in self.objects]
-        return (
-            np.array([np.linalg.norm(v.translational()) for v in velocities]),
-            np.array([np.linalg.norm(v.rotational()) for v in velocities]),
-        )
+        v = self.plant.GetVelocities(self._plant_context)[self._object_v]  # (m, 6): w then v, in world
+        return np.linalg.norm(v[:, 3:], axis=1), np.linalg.norm(v[:, :3], axis=1)
+
+    def object_positions(self) -> np.ndarray:
+        """(m, 3) object centres (scene order): their floating joints' translations."""
+        return self.plant.GetPositions(self._plant_context)[self._object_q]
 
     def read(self) -> Reading:
         """The rollout's state now."""
         plant, context = self.plant, self._plant_context
-        positions = np.array([body.EvalPoseInWorld(context).translation() for body in self.objects])
-        speeds = [
-            np.linalg.norm(body.EvalSpatialVelocityInWorld(context).translational()) for body in self.objects
-        ]
+        positions = self.object_positions()
+        speeds = self.object_speeds()[0]
         tcp = self._tcp.CalcPoseInWorld(context).translation()
         results = plant.get_contact_results_output_port().Eval(context)
         max_force, table_contact = 0.0, False

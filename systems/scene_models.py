@@ -20,7 +20,15 @@ from collections.abc import Iterable
 from dataclasses import dataclass, replace
 
 import numpy as np
-from pydrake.geometry import AddContactMaterial, Box, Cylinder, ProximityProperties, Sphere
+from pydrake.geometry import (
+    AddContactMaterial,
+    Box,
+    Cylinder,
+    GeometryId,
+    ProximityProperties,
+    SceneGraphInspector,
+    Sphere,
+)
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
 from pydrake.multibody.tree import ModelInstanceIndex, RigidBody, SpatialInertia, UnitInertia
@@ -133,6 +141,12 @@ def _add_object(
             body, RigidTransform(centre), sphere, f"{obj.name}_support_{index}", properties
         )
     return instance, body
+
+
+def is_support_geometry(inspector: SceneGraphInspector, geometry: GeometryId) -> bool:
+    """Whether ``geometry``, of an object's body, is one of its support spheres (inside its shape: an
+    object is a box or a cylinder)."""
+    return isinstance(inspector.GetShape(geometry), Sphere)
 
 
 def add_scene(

@@ -14,9 +14,9 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-from pydrake.geometry import CollisionFilterDeclaration, GeometrySet
 
 from hlp_drake.systems.control_sequence import ControlSequence
+from hlp_drake.systems.proximity import ProximityContext
 
 if TYPE_CHECKING:
     from hlp_drake.systems.rollout_world import RolloutWorld
@@ -49,31 +49,11 @@ AWAKE = SleepSchedule({}, 0.0, sleeping=False)
 
 class Sweep:
     """The robot's collision geometry following a commanded motion through a full world's scene, the
-    objects at their scene poses, in a context of its own where SceneGraph checks robot-object pairs only."""
+    objects at their scene poses, in a ``ProximityContext`` of its own checking robot-object pairs only."""
 
     def __init__(self, world: RolloutWorld) -> None:
         self._world = world
-        context = world.diagram.CreateDefaultContext()
-        scene_graph = world.world.GetSubsystemByName("scene_graph")
-        geometries = {"robot": [], "objects": [], "table": []}
-        for g, body in world.geometry_body.items():
-            kind = (
-                "robot"
-                if body in world.robot_bodies
-                else "objects"
-                if body in world.object_bodies
-                else "table"
-            )
-            geometries[kind].append(g)
-        robot, objects, table = (GeometrySet(geometries[k]) for k in ("robot", "objects", "table"))
-        scene_graph.collision_filter_manager(scene_graph.GetMyMutableContextFromRoot(context)).Apply(
-            CollisionFilterDeclaration()
-            .ExcludeWithin(robot)
-            .ExcludeWithin(objects)
-            .ExcludeBetween(robot, table)
-            .ExcludeBetween(objects, table)
-        )
-        self._context = context
+        self._proximity = ProximityContext(world, objects_apart=True)
 
     def approach_times(
         self, sequence: ControlSequence, clearance: float, states: dict[str, np.ndarray] | None = None
@@ -82,8 +62,7 @@ class Sweep:
         when following ``sequence``'s commanded motion exactly, the objects at their scene poses or
         as ``states`` has them (a ``RolloutStart``'s; checked every sample period and at every knot;
         inf if never)."""
-        world = self._world
-        plant_context = world.plant.GetMyMutableContextFromRoot(self._context)
+        world, proximity = self._world, self._proximity
         for body in world.objects:
             x = None if states is None else states.get(body.name())
             instance = body.model_instance()
@@ -92,19 +71,17 @@ class Sweep:
                 if x is None
                 else x[: world.plant.num_positions(instance)]
             )
-            world.plant.SetPositions(plant_context, instance, q)
-        world_context = world.world.GetMyContextFromRoot(self._context)
-        query = world.world.GetOutputPort("query_object")
+            proximity.set_instance_positions(instance, q)
         trajectory = sequence.to_trajectory()
         names = {int(b.index()): b.name() for b in world.objects}
         first = {obj.name: math.inf for obj in world.scene.objects}
         period = world.scenario.optimiser.sample_period
         times = np.union1d(sequence.times, np.arange(0.0, sequence.duration, period))
         for t in times:
-            world.plant.SetPositions(plant_context, world.robot, trajectory.value(t).ravel())
-            for pair in query.Eval(world_context).ComputeSignedDistancePairwiseClosestPoints(clearance):
-                for g in (pair.id_A, pair.id_B):
-                    name = names.get(world.geometry_body[g])
+            proximity.set_instance_positions(world.robot, trajectory.value(t).ravel())
+            for pair in proximity.close_pairs(clearance):
+                for body in pair[:2]:
+                    name = names.get(body)
                     if name is not None and first[name] == math.inf:
                         first[name] = float(t)
         return first

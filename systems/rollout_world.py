@@ -47,6 +47,10 @@ if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
 
 
+ROBOT, OBJECT, TABLE, OTHER = range(4)
+"""Kinds of body (the world's own body is ``OTHER``), in this order."""
+
+
 def simulation_failure(error: BaseException) -> str:
     """The first line of a Drake simulation failure: a ``RuntimeError``, or one of Drake's internal
     checks failing (pydrake raises those as ``SystemExit("Failure at ...")``, e.g. non-finite
@@ -185,6 +189,13 @@ class RolloutWorld:
         self._object_q = np.array([b.floating_positions_start() + np.arange(4, 7) for b in self.objects])
         self._object_v = np.array([b.floating_velocities_start_in_v() + np.arange(6) for b in self.objects])
         self._proximity = ProximityContext(self)
+        self._body_kind = np.full(plant.num_bodies(), OTHER)
+        for kind, bodies in (
+            (ROBOT, self.robot_bodies),
+            (OBJECT, self.object_bodies),
+            (TABLE, self._table_bodies),
+        ):
+            self._body_kind[sorted(bodies)] = kind
 
     def _body_radius(self, inspector, body) -> float:
         """Radius about the body's origin of a sphere holding its collision geometry, m."""
@@ -306,23 +317,26 @@ class RolloutWorld:
         """(m, 3) object centres (scene order): their floating joints' translations."""
         return self.plant.GetPositions(self._plant_context)[self._object_q]
 
+    def _contact_summary(self, results) -> tuple[float, bool]:
+        """The largest contact force on an object (N) and whether the robot touches the table."""
+        contacts = [results.point_pair_contact_info(i) for i in range(results.num_point_pair_contacts())]
+        if not contacts:
+            return 0.0, False
+        kinds = self._body_kind[[(int(c.bodyA_index()), int(c.bodyB_index())) for c in contacts]]
+        on_object = np.flatnonzero((kinds == OBJECT).any(axis=1))
+        forces = np.array([contacts[i].contact_force() for i in on_object]).reshape(-1, 3)
+        table_contact = bool(np.any(np.all(np.sort(kinds, axis=1) == (ROBOT, TABLE), axis=1)))
+        return float(np.max(np.linalg.norm(forces, axis=1), initial=0.0)), table_contact
+
     def read(self) -> Reading:
         """The rollout's state now."""
         plant, context = self.plant, self._plant_context
         positions = self.object_positions()
         speeds = self.object_speeds()[0]
         tcp = self._tcp.CalcPoseInWorld(context).translation()
-        results = plant.get_contact_results_output_port().Eval(context)
-        max_force, table_contact = 0.0, False
-        for i in range(results.num_point_pair_contacts()):
-            info = results.point_pair_contact_info(i)
-            a, b = int(info.bodyA_index()), int(info.bodyB_index())
-            if a in self.object_bodies or b in self.object_bodies:
-                max_force = max(max_force, float(np.linalg.norm(info.contact_force())))
-            if (a in self.robot_bodies and b in self._table_bodies) or (
-                b in self.robot_bodies and a in self._table_bodies
-            ):
-                table_contact = True
+        max_force, table_contact = self._contact_summary(
+            plant.get_contact_results_output_port().Eval(context)
+        )
         problem = None
         sto = self.scenario.optimiser
         table = self.scene.table

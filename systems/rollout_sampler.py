@@ -31,7 +31,8 @@ from hlp_drake.systems.optimiser_config import StoConfig
 from hlp_drake.systems.rollout_cost import RolloutSamples
 
 if TYPE_CHECKING:
-    from hlp_drake.systems.rollout_world import BodyPoses, RolloutStart, RolloutWorld
+    from hlp_drake.systems.rollout_reading import BodyPoses
+    from hlp_drake.systems.rollout_world import RolloutStart, RolloutWorld
     from hlp_drake.systems.sleep_schedule import SleepSchedule
 
 MOVED = 1.0e-3

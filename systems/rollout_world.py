@@ -18,7 +18,7 @@ import time
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from functools import cached_property
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING
 
 import numpy as np
 from pydrake.geometry import CollisionFilterDeclaration, GeometrySet, Role
@@ -36,6 +36,7 @@ from hlp_drake.systems.rollout_cost import (
     RolloutSamples,
     rollout_cost,
 )
+from hlp_drake.systems.rollout_reading import OBJECT, OTHER, ROBOT, TABLE, BodyPoses, Reading, contact_summary
 from hlp_drake.systems.rollout_sampler import sample_rollout
 from hlp_drake.systems.scene_models import TABLE_NAME, object_body, over_table_mask
 from hlp_drake.systems.sleep_schedule import AWAKE
@@ -45,10 +46,6 @@ from hlp_drake.systems.world_settings import EXECUTION_SETTLE_S
 
 if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
-
-
-ROBOT, OBJECT, TABLE, OTHER = range(4)
-"""Kinds of body (the world's own body is ``OTHER``), in this order."""
 
 
 def simulation_failure(error: BaseException) -> str:
@@ -90,40 +87,6 @@ class RolloutStart:
     ``RolloutWorld.states()``' form (positions then velocities)."""
 
     states: dict[str, np.ndarray]
-
-
-def _rotation_angles(R_a: np.ndarray, R_b: np.ndarray) -> np.ndarray:
-    """(n,) angles of the rotations taking each of the (n, 3, 3) ``R_a`` to ``R_b``."""
-    cosine = (np.einsum("nij,nij->n", R_a, R_b) - 1.0) / 2.0
-    return np.arccos(np.clip(cosine, -1.0, 1.0))
-
-
-@dataclass(frozen=True)
-class BodyPoses:
-    """World poses of some bodies: (n, 3) origins and (n, 3, 3) rotations."""
-
-    p: np.ndarray
-    R: np.ndarray
-
-    def motion(self, other: BodyPoses, radii: np.ndarray) -> np.ndarray:
-        """(n,) bound on how far a point of each body's geometry is from where it was in ``other``
-        (origin shift plus the turn times the geometry's radius about the origin)."""
-        return np.linalg.norm(self.p - other.p, axis=1) + _rotation_angles(other.R, self.R) * radii
-
-
-class Reading(NamedTuple):
-    """The state of a rollout read at one sample."""
-
-    positions: np.ndarray
-    """(m, 3) object centres (the target first)."""
-    tcp: np.ndarray
-    """(3,) the tcp's position."""
-    max_force: float
-    """The largest contact force on an object, N."""
-    table_contact: bool
-    """Whether the robot touches the table."""
-    problem: str | None
-    """Why the simulation is not to be trusted (None if it is sane)."""
 
 
 class RolloutWorld:
@@ -317,25 +280,14 @@ class RolloutWorld:
         """(m, 3) object centres (scene order): their floating joints' translations."""
         return self.plant.GetPositions(self._plant_context)[self._object_q]
 
-    def _contact_summary(self, results) -> tuple[float, bool]:
-        """The largest contact force on an object (N) and whether the robot touches the table."""
-        contacts = [results.point_pair_contact_info(i) for i in range(results.num_point_pair_contacts())]
-        if not contacts:
-            return 0.0, False
-        kinds = self._body_kind[[(int(c.bodyA_index()), int(c.bodyB_index())) for c in contacts]]
-        on_object = np.flatnonzero((kinds == OBJECT).any(axis=1))
-        forces = np.array([contacts[i].contact_force() for i in on_object]).reshape(-1, 3)
-        table_contact = bool(np.any(np.all(np.sort(kinds, axis=1) == (ROBOT, TABLE), axis=1)))
-        return float(np.max(np.linalg.norm(forces, axis=1), initial=0.0)), table_contact
-
     def read(self) -> Reading:
         """The rollout's state now."""
         plant, context = self.plant, self._plant_context
         positions = self.object_positions()
         speeds = self.object_speeds()[0]
         tcp = self._tcp.CalcPoseInWorld(context).translation()
-        max_force, table_contact = self._contact_summary(
-            plant.get_contact_results_output_port().Eval(context)
+        max_force, table_contact = contact_summary(
+            plant.get_contact_results_output_port().Eval(context), self._body_kind
         )
         problem = None
         sto = self.scenario.optimiser

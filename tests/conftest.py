@@ -11,6 +11,8 @@ from pathlib import Path
 
 import pytest
 
+pytest_plugins = ("sto_support",)  # the optimiser's tests' fixtures
+
 REPO = Path(__file__).resolve().parents[1]
 DEFAULT_DATA = REPO.parent / "shared" / "data"  # the structured archive and the unstructured part 1 beside it
 DEFAULT_ARCHIVE = DEFAULT_DATA / "hlp-vr-dataset.tar.xz"

@@ -1,7 +1,8 @@
 """Which rollout model: throughput per core and agreement with the execution model, side by side.
 
     python benchmarks/rollout_models.py [--out DIR] [--rollouts 8] [--repeats 3] [--sequences 8]
-        [--scenes 2] [--models full_5ms default ...] [--agreement-models ...] [--skip-agreement]
+        [--scenes 2] [--models full_5ms default ...] [--agreement-models ...] [--nudge 1e-6]
+        [--skip-agreement]
 
 1. Throughput: CPU seconds per rollout, in this process (one core; CPU time, not wall time, so a
    busy machine changes it little), of the same noisy 3 s sequences on the 9-obstacle
@@ -12,12 +13,14 @@
    planners' initial sequences on the default scene, the throughput sequences, both planners'
    initial sequences with a noisy copy on Generalization I and II scenes) rolled out on every model
    and on the execution model (the world at the plant's time step, every object free); how many
-   success verdicts agree, and how far apart the costs are.
+   success verdicts agree, and how far apart the costs are; and the execution model's own verdict
+   with the sequence's base nudged 1 um to either side (``--nudge``): a sequence whose verdict
+   that flips is borderline for the verdict itself (``borderline``), no model can be held to it.
 
 The models (``MODELS``): the full model at 5 ms (the issue's reference), the reduced model (objects
 nothing comes near asleep) at 5 and 10 ms, the full model at 10 ms, each contact trim alone on the
-reduced 10 ms model, the default trims at 20 ms (with and without sampled output ports), and the
-default (``Scenario().optimiser``). Writes ``DIR/rollout_models.json``
+reduced 10 ms model, the default trims at 10 and 20 ms (at 20 ms also with sampled output ports),
+and the default (``Scenario().optimiser``). Writes ``DIR/rollout_models.json``
 and ``DIR/rollout_models.png``.
 """
 
@@ -31,7 +34,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from sto import HORIZON, throughput_sequences, validation_sequences
+from sto import HORIZON, nudged, throughput_sequences, validation_sequences
 from tqdm import tqdm
 
 from hlp_drake.systems.rollout_world import RolloutWorld
@@ -54,6 +57,7 @@ MODELS = {
     "{top_spheres: true, rim_spheres: 8, robot_self_contact: false, sampled_output_ports: true}}",
     "reduced_10ms_unsampled": "{rollout_time_step: 0.01, reduced_model: true, rollout_trims: "
     "{top_spheres: true, rim_spheres: 8, robot_self_contact: true, sampled_output_ports: false}}",
+    "trimmed_10ms": "{rollout_time_step: 0.01}",
     "trimmed_20ms": "{rollout_time_step: 0.02}",
     "trimmed_20ms_sampled": "{rollout_time_step: 0.02, rollout_trims: {sampled_output_ports: true}}",
     "default": "{}",
@@ -102,8 +106,10 @@ def throughput(names: list[str], count: int, repeats: int) -> dict:
     return summary
 
 
-def agreement(names: list[str], count: int, scenes: int) -> dict:
-    """Verdicts and costs of the validation sequences on every model against the execution model's."""
+def agreement(names: list[str], count: int, scenes: int, nudge: float) -> dict:
+    """Verdicts and costs of the validation sequences on every model against the execution model's,
+    and (``nudge`` > 0) the execution model's verdicts of each sequence with the base ``nudge`` m to
+    either side (``sto.nudged``): a sequence whose verdict that flips is borderline for the verdict itself."""
     triples = validation_sequences(count, scenes)
     cache: dict = {}
 
@@ -118,25 +124,37 @@ def agreement(names: list[str], count: int, scenes: int) -> dict:
             )
         return cache[key]
 
+    def entry(outcome) -> dict:
+        return {
+            "success": outcome.success,
+            "cost": outcome.cost,
+            "failure_reason": outcome.failure_reason,
+            "target_distance": outcome.target_distance,
+            "wall_s": outcome.wall_s,
+        }
+
     rows = []
     for scene, label, sequence, settle in tqdm(triples, desc="agreement", unit="sequence"):
         row = {"sequence": label, "objects": len(scene.objects)}
         for name in (None, *names):
-            outcome = rollouts(scene, name, settle).rollout(sequence)
-            row[name or "execution"] = {
-                "success": outcome.success,
-                "cost": outcome.cost,
-                "wall_s": outcome.wall_s,
-            }
+            row[name or "execution"] = entry(rollouts(scene, name, settle).rollout(sequence))
+        if nudge > 0:  # the execution's own verdict with the base 1 um off to either side
+            execution = rollouts(scene, None, settle)
+            row["execution_nudged"] = [entry(execution.rollout(nudged(sequence, d))) for d in (nudge, -nudge)]
+            row["borderline"] = any(
+                n["success"] != row["execution"]["success"] for n in row["execution_nudged"]
+            )
         rows.append(row)
     summary: dict = {
         "sequences": len(rows),
         "successes_execution": sum(r["execution"]["success"] for r in rows),
+        "borderline": [r["sequence"] for r in rows if r.get("borderline")],
     }
     for name in names:
         gaps = [abs(r[name]["cost"] - r["execution"]["cost"]) for r in rows]
         summary[name] = {
             "verdicts_agree": int(sum(r[name]["success"] == r["execution"]["success"] for r in rows)),
+            "disagreeing": [r["sequence"] for r in rows if r[name]["success"] != r["execution"]["success"]],
             "passed_here_failed_in_execution": int(
                 sum(r[name]["success"] and not r["execution"]["success"] for r in rows)
             ),
@@ -188,7 +206,10 @@ def main() -> None:
         "--agreement-models",
         nargs="+",
         choices=list(MODELS),
-        default=["full_5ms", "reduced_5ms", "reduced_10ms", "default"],
+        default=["full_5ms", "reduced_5ms", "trimmed_10ms", "default"],
+    )
+    parser.add_argument(
+        "--nudge", type=float, default=1e-6, help="agreement: the execution's own sensitivity, m (0: off)"
     )
     parser.add_argument("--skip-agreement", action="store_true")
     args = parser.parse_args()
@@ -213,15 +234,16 @@ def main() -> None:
         )
     if not args.skip_agreement:
         checked = list(dict.fromkeys(args.agreement_models))
-        report["agreement"] = a = agreement(checked, args.sequences, args.scenes)
+        report["agreement"] = a = agreement(checked, args.sequences, args.scenes, args.nudge)
         print(
-            f"agreement with the execution model ({a['sequences']} sequences, {a['successes_execution']} pass):"
+            f"agreement with the execution model ({a['sequences']} sequences, {a['successes_execution']} pass; "
+            f"borderline, the execution's verdict flipping under a {args.nudge:g} m nudge: {a['borderline']}):"
         )
         for n in checked:
             print(
                 f"  {n}: {a[n]['verdicts_agree']}/{a['sequences']} verdicts agree, "
                 f"{a[n]['passed_here_failed_in_execution']} passed here and failed there, "
-                f"cost gap median {a[n]['cost_gap_median']:.3g}"
+                f"cost gap median {a[n]['cost_gap_median']:.3g}; disagreeing: {a[n]['disagreeing']}"
             )
     (out / "rollout_models.json").write_text(json.dumps(report, indent=2) + "\n")
     plot(report, out / "rollout_models.png")

@@ -146,7 +146,7 @@ class StoConfig:
     mppi_temperature: float = 10.0
     workers: int = 2
     seed: int = 0
-    rollout_time_step: float = 0.01
+    rollout_time_step: float = 0.02
     rollout_trims: RolloutTrims = field(default_factory=RolloutTrims)
     reduced_model: bool = True
     weld_clearance: float = 0.15

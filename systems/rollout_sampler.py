@@ -60,19 +60,20 @@ def _near_asleep(
     world: RolloutWorld,
     pairs: _ClosePairs,
     poses: BodyPoses,
-    previous: BodyPoses,
+    motion: np.ndarray,
     start: BodyPoses,
     asleep: frozenset[str],
 ) -> frozenset[str]:
     """The sleeping objects within the margin (see the module's docstring) of the robot or of an
-    awake object that has moved since ``start`` (the poses now)."""
-    names = [body.name() for body in world.objects]
+    awake object that has moved since ``start`` (the poses now; ``motion``: every watched body's
+    since the previous sample)."""
+    names = world.object_names
     moved = world.motion_bounds(poses, start) > MOVED
     moved[: world.num_robot_bodies] = True  # the robot always counts
     for i, name in enumerate(names):
         if name in asleep:
             moved[world.num_robot_bodies + i] = False
-    step = float(np.max(world.motion_bounds(poses, previous)[moved], initial=0.0))
+    step = float(np.max(motion[moved], initial=0.0))
     watchers = {name for name, m in zip(names, moved[world.num_robot_bodies :]) if m}
     near = set()
     for a, b, _ in pairs.within(world.scenario.optimiser.weld_margin + step):
@@ -86,8 +87,7 @@ def _near_asleep(
 def _sleepers(
     world: RolloutWorld,
     pairs: _ClosePairs,
-    poses: BodyPoses,
-    previous: BodyPoses,
+    motion: np.ndarray,
     asleep: frozenset[str],
     keep_awake: frozenset[str],
     sto: StoConfig,
@@ -95,9 +95,9 @@ def _sleepers(
     """The awake objects that may go to sleep now (see the module's docstring): at rest, with
     neither the robot nor a moving object within ``weld_clearance`` and no object staying awake
     within twice ``weld_margin`` (resting objects touching each other go to sleep together)."""
-    names = [body.name() for body in world.objects]
+    names = world.object_names
     speed, turn = world.object_speeds()
-    step = world.motion_bounds(poses, previous)[world.num_robot_bodies :]
+    step = motion[world.num_robot_bodies :]
     resting = (speed < sto.sleep_speed) & (turn < ANGULAR_REST) & (step < sto.sleep_speed * sto.sample_period)
     index = {name: i for i, name in enumerate(names)}
     chosen = {n for i, n in enumerate(names) if resting[i] and n not in asleep and n not in keep_awake}
@@ -163,7 +163,8 @@ def sample_rollout(
                 break
         poses = world.watched_poses()
         pairs = _ClosePairs(world, sto.weld_clearance)
-        near = _near_asleep(world, pairs, poses, previous, first, asleep) if asleep else frozenset()
+        motion = world.motion_bounds(poses, previous)
+        near = _near_asleep(world, pairs, poses, motion, first, asleep) if asleep else frozenset()
         if near:  # back to the previous sample (or the start) with those objects awake
             asleep, switches = asleep - near, switches + 1
             world.begin(sequence, time=saved[0], states=saved[1], asleep=asleep)
@@ -176,7 +177,7 @@ def sample_rollout(
         due = schedule.due(t) - woken
         woken |= due
         sleepers = (
-            _sleepers(world, pairs, poses, previous, asleep, schedule.approaching(t), sto)
+            _sleepers(world, pairs, motion, asleep, schedule.approaching(t), sto)
             if schedule.sleeping
             else frozenset()
         )

@@ -123,6 +123,8 @@ class RolloutWorld:
         self.objects = [object_body(plant, obj.name) for obj in scene.objects]
         self.object_bodies = {int(body.index()) for body in self.objects}
         self._object_names = {int(body.index()): body.name() for body in self.objects}
+        self.object_names = [body.name() for body in self.objects]
+        """The objects' names, in scene order."""
         self._joints = {
             b.name(): [plant.get_joint(j) for j in plant.GetJointIndices(b.model_instance())]
             for b in self.objects

@@ -102,9 +102,11 @@ def _rays(width: int, height: int, fx: float, fy: float, cx: float, cy: float) -
     return np.dstack([(col - cx) / fx, (row - cy) / fy, np.ones((height, width))])
 
 
-def _pixel_rays(views: list[CameraView], points: Points) -> tuple[np.ndarray, np.ndarray]:
-    """Per point (n, 3): its pixel's ray in the world (the point at unit depth, relative to the
-    camera) and its camera's position."""
+def _pixel_rays(
+    views: list[CameraView], points: Points, offset: tuple[float, float] = (0.0, 0.0)
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per point (n, 3): the ray in the world (the point at unit depth, relative to the camera)
+    through its pixel's centre moved by ``offset`` pixels (columns, rows), and its camera's position."""
     rays, origins = np.zeros((len(points), 3)), np.zeros((len(points), 3))
     for k, view in enumerate(views):
         mine = points.camera == k
@@ -112,16 +114,23 @@ def _pixel_rays(views: list[CameraView], points: Points) -> tuple[np.ndarray, np
         grid = _rays(
             info.width(), info.height(), info.focal_x(), info.focal_y(), info.center_x(), info.center_y()
         )
-        rays[mine] = grid[points.row[mine], points.col[mine]] @ X.rotation().matrix().T
+        shift = np.array([offset[0] / info.focal_x(), offset[1] / info.focal_y(), 0.0])
+        rays[mine] = (grid[points.row[mine], points.col[mine]] + shift) @ X.rotation().matrix().T
         origins[mine] = X.translation()
     return rays, origins
 
 
-def on_plane(points: Points, views: list[CameraView], coefficients: tuple[float, float, float]) -> np.ndarray:
-    """(n, 3): where each point's pixel ray meets the plane z = a x + b y + c (its depth's noise
-    left out)."""
+def on_plane(
+    points: Points,
+    views: list[CameraView],
+    coefficients: tuple[float, float, float | np.ndarray],
+    offset: tuple[float, float] = (0.0, 0.0),
+) -> np.ndarray:
+    """(n, 3): where each point's pixel ray (through its pixel's centre moved by ``offset`` pixels:
+    columns, rows) meets the plane z = a x + b y + c (its depth's noise left out; ``c`` one for
+    all or one per point)."""
     a, b, c = coefficients
-    rays, origins = _pixel_rays(views, points)
+    rays, origins = _pixel_rays(views, points, offset)
     normal = np.array([-a, -b, 1.0])
     with np.errstate(divide="ignore", invalid="ignore"):
         t = (c - np.einsum("ij,j->i", origins, normal)) / (rays @ normal)

@@ -103,10 +103,11 @@ def _rays(width: int, height: int, fx: float, fy: float, cx: float, cy: float) -
 
 
 def _pixel_rays(
-    views: list[CameraView], points: Points, offset: tuple[float, float] = (0.0, 0.0)
+    views: list[CameraView], points: Points, offset: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """Per point (n, 3): the ray in the world (the point at unit depth, relative to the camera)
-    through its pixel's centre moved by ``offset`` pixels (columns, rows), and its camera's position."""
+    through its pixel's centre moved by ``offset`` pixels (n, 2: columns, rows; none if None), and
+    its camera's position."""
     rays, origins = np.zeros((len(points), 3)), np.zeros((len(points), 3))
     for k, view in enumerate(views):
         mine = points.camera == k
@@ -114,8 +115,10 @@ def _pixel_rays(
         grid = _rays(
             info.width(), info.height(), info.focal_x(), info.focal_y(), info.center_x(), info.center_y()
         )
-        shift = np.array([offset[0] / info.focal_x(), offset[1] / info.focal_y(), 0.0])
-        rays[mine] = (grid[points.row[mine], points.col[mine]] + shift) @ X.rotation().matrix().T
+        ray = grid[points.row[mine], points.col[mine]]
+        if offset is not None:
+            ray[:, :2] += offset[mine] / [info.focal_x(), info.focal_y()]
+        rays[mine] = ray @ X.rotation().matrix().T
         origins[mine] = X.translation()
     return rays, origins
 
@@ -124,11 +127,11 @@ def on_plane(
     points: Points,
     views: list[CameraView],
     coefficients: tuple[float, float, float | np.ndarray],
-    offset: tuple[float, float] = (0.0, 0.0),
+    offset: np.ndarray | None = None,
 ) -> np.ndarray:
     """(n, 3): where each point's pixel ray (through its pixel's centre moved by ``offset`` pixels:
-    columns, rows) meets the plane z = a x + b y + c (its depth's noise left out; ``c`` one for
-    all or one per point)."""
+    n, 2, columns and rows) meets the plane z = a x + b y + c (its depth's noise left out; ``c``
+    one for all or one per point)."""
     a, b, c = coefficients
     rays, origins = _pixel_rays(views, points, offset)
     normal = np.array([-a, -b, 1.0])

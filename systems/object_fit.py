@@ -44,23 +44,24 @@ TOP_BAND = 0.005
 @dataclass(frozen=True)
 class Cluster:
     """One object's points: its ``points`` and, per point, whether its pixel lies on the silhouette,
-    on an occlusion boundary or at the image's border; and per point and ``NEIGHBOURS`` entry (n, 4)
-    whether the object ends there against something further away (``steps``) and, where it does,
-    the plan-view point (n, 4, 2; NaN elsewhere) where the ray through the middle of that step meets
-    the plane parallel to the table through the point (``step_points``)."""
+    on an occlusion boundary or at the image's border; and where the object ends against something
+    further away, per such step to a neighbour pixel the plan-view point (m, 2) where the ray
+    through the step's middle meets the plane parallel to the table through the point
+    (``step_points``), and that point's index (``step_of``, m)."""
 
     points: Points
     silhouette: np.ndarray
     occluded: np.ndarray
     at_border: np.ndarray
-    steps: np.ndarray
     step_points: np.ndarray
+    step_of: np.ndarray
 
     def outline(self, on_top: np.ndarray) -> np.ndarray:
         """(m, 2) the footprint's boundary in plan view: per silhouette point ``on_top`` (n,) its
         steps' points, per other silhouette point the point itself (see the module's docstring)."""
-        top_steps = self.steps & on_top[:, None]
-        own = self.silhouette & ~top_steps.any(axis=1)
+        top_steps = on_top[self.step_of]
+        own = self.silhouette.copy()
+        own[self.step_of[top_steps]] = False
         return np.concatenate([self.points.xyz[own, :2], self.step_points[top_steps]])
 
 
@@ -131,31 +132,34 @@ def boundaries(
             r, c = row + dr, col + dc
             inside = (r >= 0) & (r < h) & (c >= 0) & (c < w)
             r, c = np.clip(r, 0, h - 1), np.clip(c, 0, w - 1)
-            other = owner[r, c] != mine
+            other = inside & (owner[r, c] != mine)
             depth = view.depth[r, c]
-            known = valid_depth(depth) | np.isposinf(depth)
             nearer = (depth < own - NEARER) | (depth == 0)
-            occ |= inside & other & nearer
-            sil |= inside & other & known & ~nearer
-            step[:, d] = inside & other & known & (depth > own + NEARER)
+            ends = other & (valid_depth(depth) | np.isposinf(depth))
+            occ |= other & nearer
+            sil |= ends & ~nearer
+            step[:, d] = ends & (depth > own + NEARER)
         silhouette[here], occluded[here], steps[here] = sil & ~occ, occ, step & ~occ[:, None]
-    step_points = np.full((len(points), len(NEIGHBOURS), 2), np.nan)
-    a, b, _ = table.coefficients
-    for d, (dr, dc) in enumerate(NEIGHBOURS):
-        mine = points.subset(steps[:, d])
-        through = mine.xyz[:, 2] - a * mine.xyz[:, 0] - b * mine.xyz[:, 1]
-        crossing = on_plane(mine, views, (a, b, through), offset=(dc / 2.0, dr / 2.0))
-        step_points[steps[:, d], d] = crossing[:, :2]
+    at, towards = np.nonzero(steps)  # by point, so by group once sorted stably
+    stepped, (a, b, _) = points.subset(at), table.coefficients
+    through = stepped.xyz[:, 2] - a * stepped.xyz[:, 0] - b * stepped.xyz[:, 1]
+    half_step = np.array(NEIGHBOURS)[towards, ::-1] / 2.0  # (columns, rows)
+    crossings = on_plane(stepped, views, (a, b, through), half_step)[:, :2]
+    local = np.zeros(len(points), dtype=np.int64)  # each point's index in its group
+    for members in groups:
+        local[members] = np.arange(len(members))
+    by_group = np.argsort(group[at], kind="stable")
+    split = np.split(by_group, np.searchsorted(group[at][by_group], np.arange(1, len(groups) + 1)))
     return [
         Cluster(
             points.subset(members),
             silhouette[members],
             occluded[members],
             at_border[members],
-            steps[members],
-            step_points[members],
+            crossings[mine],
+            local[at[mine]],
         )
-        for members in groups
+        for members, mine in zip(groups, split)
     ]
 
 
@@ -237,8 +241,8 @@ def fit_object(cluster: Cluster, heights: np.ndarray, pixel: float, *, cylinder:
     outline = cluster.outline(on_top)
     edge = outline if len(outline) >= 8 else xy
     cx, cy, r, circle_residual = _circle(edge)
-    hull = np.concatenate([xy, edge])
-    yaw, bounds, box_residual = (0.0, None, np.inf) if cylinder else _rectangle(hull, edge)
+    seen = np.concatenate([edge, xy[cluster.occluded]])  # where what shows of it ends
+    yaw, bounds, box_residual = (0.0, None, np.inf) if cylinder else _rectangle(seen, edge)
     if cylinder or (cylinder is None and circle_residual < box_residual):
         return Fit("cylinder", cx, cy, 0.0, (2.0 * r, 2.0 * r, height), circle_residual)
     u0, v0, u1, v1 = _sides(edge, yaw, bounds, corner=pixel)

@@ -27,7 +27,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, cKDTree
 
-from hlp_drake.systems.depth_points import CameraView, Points, TablePlane, on_plane, valid_depth
+from hlp_drake.systems.depth_points import NEIGHBOURS, CameraView, Points, TablePlane, on_plane, valid_depth
 
 NEARER = 0.005
 """A neighbour pixel this much nearer the camera (m) hides what lies beyond: an occlusion boundary."""
@@ -36,7 +36,6 @@ YAW_STEPS = (30, 12, 10)
 (0.25 degrees apart), then 10 on each side of that (0.025 degrees apart)."""
 COARSE_EDGE = 64
 """The coarsest yaws are scored on at most this many of the silhouette's points (evenly spaced)."""
-NEIGHBOURS = ((0, 1), (0, -1), (1, 0), (-1, 0))
 TOP_BAND = 0.005
 """An object's top: its points within this (m) below the 99th percentile of their heights."""
 

@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import json
 import platform
+import sys
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -148,8 +149,7 @@ def main() -> None:
         print(f"  {name}: {value:.2f}")
     if args.json is not None:
         record = {
-            "command": "python benchmarks/init_time.py "
-            + " ".join(f"{k}={v}" for k, v in vars(args).items()),
+            "command": " ".join(["python benchmarks/init_time.py", *sys.argv[1:]]),
             "machine": platform.platform(),
             "ik_max_iterations": settings.ik.max_iterations,
             "summary": summary,

@@ -57,6 +57,17 @@ def perceive_fixed(depth, labels, pose, scenario: Scenario = SCENARIO):
     return block.get_perception_output_port().Eval(context), block.get_scene_output_port().Eval(context)
 
 
+def perceive_rendered(scenario: Scenario):
+    """``perceive_fixed`` on the frame the world of ``scenario`` renders with its first camera."""
+    context = (world := make_world_diagram(scenario)).CreateDefaultContext()
+    name = scenario.perception.cameras[0].name
+    ports = [
+        world.GetOutputPort(f"{name}.{p}").Eval(context)
+        for p in ("depth_image", "label_image", "camera_pose")
+    ]
+    return perceive_fixed(*ports, scenario)
+
+
 def images(depth: np.ndarray, labels: np.ndarray) -> tuple[ImageDepth32F, ImageLabel16I]:
     h, w = depth.shape
     depth_image, label_image = ImageDepth32F(w, h), ImageLabel16I(w, h)
@@ -259,14 +270,7 @@ def test_an_object_partly_hidden_by_a_taller_one_is_found_with_the_outline_that_
     short = SceneObject("short", "box", 0.4, -0.40, (0.08, 0.06, 0.05))
     tall = SceneObject("tall", "box", 0.4, -0.32, (0.08, 0.06, 0.2))
     scene = replace(SCENE, obstacles=(short, tall))
-    scenario = replace(SCENARIO, scene=scene)
-    world = make_world_diagram(scenario)
-    context = world.CreateDefaultContext()
-    ports = [
-        world.GetOutputPort(f"{CAMERA.name}.{p}").Eval(context)
-        for p in ("depth_image", "label_image", "camera_pose")
-    ]
-    perception, _ = perceive_fixed(*ports, scenario)
+    perception, _ = perceive_rendered(replace(SCENARIO, scene=scene))
     assert perception.ok, perception.reason
     record = perception_record(scene, perception)
     assert record["missed"] == [] and record["invented"] == []
@@ -335,12 +339,7 @@ def test_off_axis_objects_are_located_without_the_pixel_grids_bias():
         obstacles=(SceneObject("yawed", "box", 0.22, -0.21, (0.06, 0.12, 0.10), yaw=0.3),),
     )
     scenario = Scenario(scene=scene, perception=PerceptionConfig(source="camera", cameras=(camera,)))
-    context = (world := make_world_diagram(scenario)).CreateDefaultContext()
-    ports = [
-        world.GetOutputPort(f"{camera.name}.{p}").Eval(context)
-        for p in ("depth_image", "label_image", "camera_pose")
-    ]
-    perception, _ = perceive_fixed(*ports, scenario)
+    perception, _ = perceive_rendered(scenario)
     assert perception.ok, perception.reason
     errors = {o["name"]: o for o in perception_record(scene, perception)["objects"]}
     assert set(errors) == {"Target", "yawed"}
@@ -350,17 +349,12 @@ def test_off_axis_objects_are_located_without_the_pixel_grids_bias():
 
 
 def test_a_rolled_cameras_table_edges_are_found_without_the_pixel_grids_bias():
-    """The default camera turned 3 degrees about its axis: the table's edges cross the pixel grid
+    """The camera turned about 3 degrees about its axis: the table's edges cross the pixel grid
     at a slant, so their steps' middles average onto them: its length and width within 0.5 mm (a
     pixel here is ~5 mm; grown by half a pixel from its extremes they were 2.3 and 4.8 mm long)."""
     camera = replace(CAMERA, up=(1.0, 0.05, 0.0))
     scenario = replace(SCENARIO, perception=replace(SCENARIO.perception, cameras=(camera,)))
-    context = (world := make_world_diagram(scenario)).CreateDefaultContext()
-    ports = [
-        world.GetOutputPort(f"{camera.name}.{p}").Eval(context)
-        for p in ("depth_image", "label_image", "camera_pose")
-    ]
-    perception, scene = perceive_fixed(*ports, scenario)
+    perception, scene = perceive_rendered(scenario)
     assert perception.ok, perception.reason
     assert scene.table.length == pytest.approx(SCENE.table.length, abs=0.0005)
     assert scene.table.width == pytest.approx(SCENE.table.width, abs=0.0005)

@@ -217,10 +217,13 @@ def test_depth_noise_is_seeded_by_the_time_and_drops_the_asked_share():
 
 
 def test_camera_pose_looks_at_the_table_and_rejects_a_parallel_up():
-    pose = camera_pose(CameraSettings(), SCENE)
+    pose = camera_pose(CameraSettings(up=(1.0, 0.0, 0.0)), SCENE)
     np.testing.assert_allclose(pose.translation(), [0.4, 0.0, 0.75 + 1.6])
     np.testing.assert_allclose(pose.rotation().matrix()[:, 2], [0, 0, -1], atol=1e-12)  # looking down
     np.testing.assert_allclose(pose.rotation().matrix()[:, 1], [-1, 0, 0], atol=1e-12)  # +x up the image
+    turned = camera_pose(CameraSettings(), SCENE).rotation().matrix()  # the default: 3 degrees off the grid
+    np.testing.assert_allclose(turned[:, 2], [0, 0, -1], atol=1e-12)
+    assert math.degrees(math.atan2(-turned[1, 1], -turned[0, 1])) == pytest.approx(3.0, abs=0.01)
     with pytest.raises(ValueError, match="parallel to its view"):
         camera_pose(CameraSettings(up=(0.0, 0.0, 1.0)), SCENE)
 

@@ -32,6 +32,7 @@ from hlp_drake.planner.plan import HighLevelPlan, PlanCandidate, PlanKeypoint
 from hlp_drake.planner.rollout import PrefixTree, arm_configurations, expected_collisions
 from hlp_drake.scene.rows import Row
 from hlp_drake.taskspace import DIRECTIONS, TaskSpace
+from hlp_drake.taskspace.lazy import LazyRows
 from hlp_drake.taskspace.relocation import relocated_array
 from hlp_drake.taskspace.routes import segment_inside
 
@@ -90,10 +91,7 @@ class _Expander:
         self.features = RowChoiceScene(space, hand_width)
         self.names = space.obstacle_names
         self.directions = DirectionTable(space, self.names, mode=config.mode)
-        regions = relocated_array(space.obstacle_bounds, space.alpha)  # (n, 8, 4)
-        self.releases = np.stack(
-            [(regions[..., 0] + regions[..., 2]) / 2.0, (regions[..., 1] + regions[..., 3]) / 2.0], axis=-1
-        )
+        self.releases = LazyRows(len(self.names), lambda index: _release_points(space, index))  # (n, 8, 2)
 
     def candidates(
         self, beam: list[_Partial], row: Row
@@ -163,7 +161,7 @@ class _Expander:
                 children.append(_Partial(keypoints, point, partial.removed, log_likelihood, scores))
                 continue
             obstacle, direction = int(candidates.obstacles[k]), direction_of_move[id(choice)]
-            release = tuple(float(v) for v in self.releases[obstacle, DIRECTIONS.index(direction)])
+            release = tuple(float(v) for v in self.releases[obstacle][DIRECTIONS.index(direction)])
             keypoints = (
                 *partial.keypoints,
                 PlanKeypoint("move", point, row.index, element, direction),
@@ -175,6 +173,14 @@ class _Expander:
         return children
 
 
+def _release_points(space: TaskSpace, index: np.ndarray) -> np.ndarray:
+    """(k, 8, 2) the centres of the regions obstacles ``index`` are pushed into, per direction."""
+    regions = relocated_array(space.obstacle_bounds[index], space.alpha)
+    return np.stack(
+        [(regions[..., 0] + regions[..., 2]) / 2.0, (regions[..., 1] + regions[..., 3]) / 2.0], axis=-1
+    )
+
+
 def segment_collisions(
     space: TaskSpace, keypoints: tuple[PlanKeypoint, ...], hand_width: float
 ) -> list[dict]:
@@ -184,7 +190,7 @@ def segment_collisions(
     the centre of its relocated region from its release on, and not on the ways to and with it)."""
     if len(keypoints) < 2:
         return []
-    names, regions = space.obstacle_names, relocated_array(space.obstacle_bounds, space.alpha)
+    names = space.obstacle_names
     segments = len(keypoints) - 1
     # Every place an obstacle stands, and the segments it stands there for: the original places
     # until the obstacle's release, its relocated region after it.
@@ -197,7 +203,9 @@ def segment_collisions(
         if b.action == "release":
             k = space.obstacle_index[b.element]
             spans[k] = [0, i + 1]
-            rects.append(regions[k, DIRECTIONS.index(b.direction)])
+            rects.append(
+                relocated_array(space.obstacle_bounds[k], space.alpha)[0, DIRECTIONS.index(b.direction)]
+            )
             owners.append(k)
             spans.append([i + 1, segments])
     spans = np.array(spans, dtype=int).reshape(-1, 2)

@@ -32,8 +32,6 @@ from hlp_drake.planner.plan import HighLevelPlan, PlanCandidate, PlanKeypoint
 from hlp_drake.planner.rollout import PrefixTree, arm_configurations, expected_collisions
 from hlp_drake.scene.rows import Row
 from hlp_drake.taskspace import DIRECTIONS, TaskSpace
-from hlp_drake.taskspace.lazy import LazyRows
-from hlp_drake.taskspace.relocation import relocated_array
 from hlp_drake.taskspace.routes import segment_inside
 
 REACH_FRACTION = 0.25  # the hand stops this many hand widths short of the target's near face
@@ -91,7 +89,6 @@ class _Expander:
         self.features = RowChoiceScene(space, hand_width)
         self.names = space.obstacle_names
         self.directions = DirectionTable(space, self.names, mode=config.mode)
-        self.releases = LazyRows(len(self.names), lambda index: _release_points(space, index))  # (n, 8, 2)
 
     def candidates(
         self, beam: list[_Partial], row: Row
@@ -161,7 +158,8 @@ class _Expander:
                 children.append(_Partial(keypoints, point, partial.removed, log_likelihood, scores))
                 continue
             obstacle, direction = int(candidates.obstacles[k]), direction_of_move[id(choice)]
-            release = tuple(float(v) for v in self.releases[obstacle][DIRECTIONS.index(direction)])
+            region = self.space.relocated[obstacle][DIRECTIONS.index(direction)]
+            release = (float((region[0] + region[2]) / 2.0), float((region[1] + region[3]) / 2.0))
             keypoints = (
                 *partial.keypoints,
                 PlanKeypoint("move", point, row.index, element, direction),
@@ -171,14 +169,6 @@ class _Expander:
                 _Partial(keypoints, release, partial.removed | {obstacle}, log_likelihood, scores)
             )
         return children
-
-
-def _release_points(space: TaskSpace, index: np.ndarray) -> np.ndarray:
-    """(k, 8, 2) the centres of the regions obstacles ``index`` are pushed into, per direction."""
-    regions = relocated_array(space.obstacle_bounds[index], space.alpha)
-    return np.stack(
-        [(regions[..., 0] + regions[..., 2]) / 2.0, (regions[..., 1] + regions[..., 3]) / 2.0], axis=-1
-    )
 
 
 def segment_collisions(
@@ -203,9 +193,7 @@ def segment_collisions(
         if b.action == "release":
             k = space.obstacle_index[b.element]
             spans[k] = [0, i + 1]
-            rects.append(
-                relocated_array(space.obstacle_bounds[k], space.alpha)[0, DIRECTIONS.index(b.direction)]
-            )
+            rects.append(space.relocated[k][DIRECTIONS.index(b.direction)])
             owners.append(k)
             spans.append([i + 1, segments])
     spans = np.array(spans, dtype=int).reshape(-1, 2)

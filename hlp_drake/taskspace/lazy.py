@@ -25,13 +25,14 @@ class LazyRows:
 
     def __getitem__(self, index: int | np.ndarray) -> np.ndarray:
         index = np.asarray(index, dtype=int)
-        missing = np.unique(index[~self._known[index]])
-        if len(missing):
+        known = self._known[index]
+        if not known.all():
+            missing = np.unique(index[~known])
             values = np.asarray(self._compute(missing))
             if self._values is None:
                 self._values = np.empty((len(self._known), *values.shape[1:]), dtype=values.dtype)
             self._values[missing] = values
             self._known[missing] = True
-        if self._values is None:  # nothing asked for yet
+        if self._values is None:  # nothing asked for yet, nor now
             return np.empty((*index.shape, 0))
         return self._values[index]

@@ -91,7 +91,15 @@ class DirectionTable:
 
     def hand_direction(self, k: int, hand: Sequence[float]) -> str | None:
         """Direction class from a hand at ``hand`` to obstacle ``k``."""
-        return direction_of(*(self._rows[k][8:10] - np.asarray(hand, float)), faithful=self.faithful)
+        return self.hand_directions([k], [hand])[0]
+
+    def hand_directions(self, index: Sequence[int], hands: Sequence[Sequence[float]]) -> list[str | None]:
+        """Direction class from each hand of ``hands`` to its obstacle of ``index``."""
+        origins = self._rows[np.asarray(index, dtype=int)][:, 8:10]
+        return [
+            direction_of(*(o - np.asarray(hand, float)), faithful=self.faithful)
+            for o, hand in zip(origins, hands)
+        ]
 
     def features(self, index: int | np.ndarray, hand_class: int | np.ndarray) -> np.ndarray:
         """Xd of obstacles ``index`` approached from direction class indices ``hand_class``

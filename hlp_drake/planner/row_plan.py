@@ -118,9 +118,7 @@ class _Expander:
         """Cd's direction for each obstacle approached from its hand (one prediction for all)."""
         if not obstacles:
             return []
-        classes = [
-            direction_index(self.directions.hand_direction(k, hand)) for k, hand in zip(obstacles, hands)
-        ]
+        classes = [direction_index(d) for d in self.directions.hand_directions(obstacles, hands)]
         X = self.directions.features(np.asarray(obstacles, int), np.asarray(classes, int))
         return [
             DIRECTIONS[int(label)]
@@ -139,8 +137,12 @@ class _Expander:
             ]
             chosen += [(partial, candidates, p, evidence, int(k)) for k in keep]
         moved = [c for c in chosen if c[4] is not None and c[1].kinds[c[4]] == "object"]
-        directions = self.moves([c[0].hand for c in moved], [int(c[1].obstacles[c[4]]) for c in moved])
-        direction_of_move = {id(c): d for c, d in zip(moved, directions)}
+        obstacles = [int(c[1].obstacles[c[4]]) for c in moved]
+        directions = self.moves([c[0].hand for c in moved], obstacles)
+        regions = self.space.relocated[obstacles]  # (moves, 8, 4)
+        move_of = {
+            id(c): (d, region[DIRECTIONS.index(d)]) for c, d, region in zip(moved, directions, regions)
+        }
         children = []
         for choice in chosen:
             partial, candidates, p, evidence, k = choice
@@ -157,8 +159,7 @@ class _Expander:
                 keypoints = (*partial.keypoints, PlanKeypoint("gap", point, row.index, element))
                 children.append(_Partial(keypoints, point, partial.removed, log_likelihood, scores))
                 continue
-            obstacle, direction = int(candidates.obstacles[k]), direction_of_move[id(choice)]
-            region = self.space.relocated[obstacle][DIRECTIONS.index(direction)]
+            obstacle, (direction, region) = int(candidates.obstacles[k]), move_of[id(choice)]
             release = (float((region[0] + region[2]) / 2.0), float((region[1] + region[3]) / 2.0))
             keypoints = (
                 *partial.keypoints,

@@ -179,14 +179,44 @@ def segment_collisions(
     ``{"segment": i, "obstacle": name, "depth": m}``: the length of the way inside the obstacle
     grown by half the hand's width, the obstacles where they stand at that moment (a moved one at
     the centre of its relocated region from its release on, and not on the ways to and with it)."""
-    if len(keypoints) < 2:
-        return []
-    names = space.obstacle_names
-    segments = len(keypoints) - 1
-    # Every place an obstacle stands, and the segments it stands there for: the original places
-    # until the obstacle's release, its relocated region after it.
-    rects, owners, spans = list(space.obstacle_bounds), list(range(len(names))), [[0, segments]] * len(names)
-    own = np.zeros((segments, len(names)), dtype=bool)  # the ways to and with the obstacle moved
+    return plans_segment_collisions(space, [keypoints], hand_width)[0]
+
+
+def plans_segment_collisions(
+    space: TaskSpace, plans: list[tuple[PlanKeypoint, ...]], hand_width: float
+) -> list[list[dict]]:
+    """``segment_collisions`` of each plan of ``plans``, with one segment test for all."""
+    placed = [_placements(space, keypoints) for keypoints in plans]
+    ends = [np.array([k.position for k in keypoints], dtype=float).reshape(-1, 2) for keypoints in plans]
+    rects = np.vstack([np.array(r, dtype=float).reshape(-1, 4) for r, _, _ in placed])
+    grown = rects + np.array([-hand_width, -hand_width, hand_width, hand_width]) / 2.0
+    inside = segment_inside(
+        np.vstack([e[:-1] for e in ends]).reshape(-1, 2),
+        np.vstack([e[1:] for e in ends]).reshape(-1, 2),
+        grown,
+    )
+    names, result, row, column = space.obstacle_names, [], 0, 0
+    for (plan_rects, owners, counted), e in zip(placed, ends):
+        segments, count = max(len(e) - 1, 0), len(plan_rects)
+        own = inside[row : row + segments, column : column + count] * counted
+        row, column = row + segments, column + count
+        result.append(
+            [
+                {"segment": int(i), "obstacle": names[owners[r]], "depth": float(own[i, r])}
+                for i, r in zip(*np.nonzero(own > 1e-9))
+            ]
+        )
+    return result
+
+
+def _placements(space: TaskSpace, keypoints: tuple[PlanKeypoint, ...]) -> tuple[list, list[int], np.ndarray]:
+    """Every place an obstacle stands along a plan, the obstacle's position in scene order and the
+    segments (keypoint to keypoint) it counts for there: (rects, owners, (segments, places)). The
+    original places count until the obstacle's release, its relocated region after it; neither on
+    the ways to and with it."""
+    n, segments = len(space.obstacle_names), max(len(keypoints) - 1, 0)
+    rects, owners, spans = list(space.obstacle_bounds), list(range(n)), [[0, segments]] * n
+    own = np.zeros((segments, n), dtype=bool)  # the ways to and with the obstacle moved
     for i, (a, b) in enumerate(pairwise(keypoints)):
         for k in (a, b):
             if k.action in ("move", "release"):
@@ -197,18 +227,9 @@ def segment_collisions(
             rects.append(space.relocated[k][DIRECTIONS.index(b.direction)])
             owners.append(k)
             spans.append([i + 1, segments])
-    spans = np.array(spans, dtype=int).reshape(-1, 2)
+    spans_ = np.array(spans, dtype=int).reshape(-1, 2)
     j = np.arange(segments)[:, None]
-    counted = (j >= spans[:, 0]) & (j < spans[:, 1]) & ~own[:, owners]
-    ends = np.array([k.position for k in keypoints], dtype=float)
-    grown = (
-        np.array(rects).reshape(-1, 4) + np.array([-hand_width, -hand_width, hand_width, hand_width]) / 2.0
-    )
-    inside = segment_inside(ends[:-1], ends[1:], grown) * counted
-    return [
-        {"segment": int(i), "obstacle": names[owners[r]], "depth": float(inside[i, r])}
-        for i, r in zip(*np.nonzero(inside > 1e-9))
-    ]
+    return rects, owners, (j >= spans_[:, 0]) & (j < spans_[:, 1]) & ~own[:, owners]
 
 
 def plan_rows(
@@ -233,7 +254,7 @@ def plan_rows(
     tree = PrefixTree.of(keypoints)
     arms = arm_configurations(models, tree, q0, links[0] + links[1], False)
     costs = expected_collisions(space, tree, arms, links, config.arm_band, False)
-    collisions = [segment_collisions(space, tuple(k), hand_width) for k in keypoints]
+    collisions = plans_segment_collisions(space, [tuple(k) for k in keypoints], hand_width)
     score = [
         beam[i].log_likelihood - config.collision_weight * sum(c["depth"] for c in collisions[i]) / hand_width
         for i in range(len(beam))

@@ -12,7 +12,7 @@ of interest see (the corners, the goal), so routes from them cost a few array op
 from __future__ import annotations
 
 from collections.abc import Collection
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -111,6 +111,7 @@ class Sight:
     corner_length: np.ndarray
     goal_hits: np.ndarray
     goal_length: np.ndarray
+    reach: dict[bytes, np.ndarray] = field(default_factory=dict, repr=False)  # FreeRoutes._reach's
 
 
 class FreeRoutes:
@@ -168,7 +169,11 @@ class FreeRoutes:
         self._edge_hits[upper] = segment_hits(self.corners[upper[0]], self.corners[upper[1]], self.grown)
         self._edge_hits |= self._edge_hits.transpose(1, 0, 2)
         self._edge_length = np.linalg.norm(self.corners[:, None] - self.corners[None], axis=2)
-        self._corners_to_goal = self.sight(self.corners)
+        # The corners' straight ways to the goal: which grown obstacles they pass through, their lengths.
+        self._goal_hits = segment_hits(
+            self.corners, np.broadcast_to(self.goal, self.corners.shape), self.grown
+        )
+        self._goal_length = np.linalg.norm(self.corners - self.goal, axis=1)
         self._tables: dict[frozenset[int], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
     def kept(self, removed: Collection[int]) -> np.ndarray:
@@ -182,8 +187,7 @@ class FreeRoutes:
             kept = self.kept(removed)
             open_ = ~self._edge_hits[:, :, kept].any(axis=2)
             distances = all_pairs_shortest(np.where(open_, self._edge_length, np.inf))
-            sight = self._corners_to_goal
-            straight = np.where(sight.goal_hits[:, kept].any(axis=1), np.inf, sight.goal_length)
+            straight = np.where(self._goal_hits[:, kept].any(axis=1), np.inf, self._goal_length)
             to_goal = np.min(distances + straight[None, :], axis=1) if len(straight) else straight
             self._tables[removed] = (kept, distances, to_goal)
         return self._tables[removed]
@@ -239,7 +243,7 @@ class FreeRoutes:
         from_point = np.min(reach[:, :, None] + distances[None], axis=1)  # (n, c)
         through = np.where(crossing(sight.corner_hits[rows]), sight.corner_length[rows], np.inf)
         edge = np.where(crossing(self._edge_hits), self._edge_length, np.inf)
-        last = np.where(crossing(self._corners_to_goal.goal_hits), self._corners_to_goal.goal_length, np.inf)
+        last = np.where(crossing(self._goal_hits), self._goal_length, np.inf)
         via_edge = np.min(from_point[:, :, None] + edge[None] + to_goal[None, None, :], axis=(1, 2))
         return np.minimum.reduce(
             [best, np.min(through + to_goal[None], axis=1), np.min(from_point + last[None], axis=1), via_edge]
@@ -265,4 +269,11 @@ class FreeRoutes:
         return np.minimum(direct, np.min(from_source + reach[len(sources) :], axis=1))
 
     def _reach(self, sight: Sight, rows: np.ndarray, kept: np.ndarray) -> np.ndarray:
-        return np.where(sight.corner_hits[rows][:, :, kept].any(axis=2), np.inf, sight.corner_length[rows])
+        """(rows, c) the straight lengths from the points ``rows`` of ``sight`` to the corners (inf
+        where a ``kept`` obstacle blocks the way), for all of the sight's points once per kept set."""
+        key = kept.tobytes()
+        if key not in sight.reach:
+            sight.reach[key] = np.where(
+                sight.corner_hits[:, :, kept].any(axis=2), np.inf, sight.corner_length
+            )
+        return sight.reach[key][rows]

@@ -111,7 +111,8 @@ class Sight:
     corner_length: np.ndarray
     goal_hits: np.ndarray
     goal_length: np.ndarray
-    reach: dict[bytes, np.ndarray] = field(default_factory=dict, repr=False)  # FreeRoutes._reach's
+    memo: dict[tuple[str, frozenset[int]], np.ndarray] = field(default_factory=dict, repr=False)
+    """``FreeRoutes``' per-point results for all the points at once, per set of obstacles removed."""
 
 
 class FreeRoutes:
@@ -178,7 +179,7 @@ class FreeRoutes:
 
     def kept(self, removed: Collection[int]) -> np.ndarray:
         """(m,) which obstacles stand (their ids not in ``removed``)."""
-        return ~np.isin(self.ids, list(removed))
+        return np.array([int(k) not in removed for k in self.ids], dtype=bool)
 
     def tables(self, removed: frozenset[int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(kept (m,), corner distances (c, c), corner route lengths to the goal (c,)) with the
@@ -210,12 +211,14 @@ class FreeRoutes:
 
     def to_goal(self, sight: Sight, rows: np.ndarray, removed: frozenset[int]) -> np.ndarray:
         """Route lengths from the points ``rows`` of ``sight`` to the goal (inf: no route)."""
-        kept, _, to_goal = self.tables(removed)
-        direct = np.where(sight.goal_hits[rows][:, kept].any(axis=1), np.inf, sight.goal_length[rows])
-        if len(self.corners) == 0:
-            return direct
-        reach = self._reach(sight, rows, kept)
-        return np.minimum(direct, np.min(reach + to_goal[None], axis=1))
+        key = ("to_goal", removed)
+        if key not in sight.memo:
+            kept, _, to_goal = self.tables(removed)
+            direct = np.where(sight.goal_hits[:, kept].any(axis=1), np.inf, sight.goal_length)
+            if len(self.corners):
+                direct = np.minimum(direct, np.min(self._reach(sight, removed) + to_goal[None], axis=1))
+            sight.memo[key] = direct
+        return sight.memo[key][rows]
 
     def to_goal_without(
         self, sight: Sight, rows: np.ndarray, removed: frozenset[int], obstacle: int
@@ -239,7 +242,7 @@ class FreeRoutes:
         best = np.minimum(base, direct)
         if len(self.corners) == 0:
             return best
-        reach = self._reach(sight, rows, kept)  # (n, c) with the obstacle standing
+        reach = self._reach(sight, removed)[rows]  # (n, c) with the obstacle standing
         from_point = np.min(reach[:, :, None] + distances[None], axis=1)  # (n, c)
         through = np.where(crossing(sight.corner_hits[rows]), sight.corner_length[rows], np.inf)
         edge = np.where(crossing(self._edge_hits), self._edge_length, np.inf)
@@ -264,16 +267,15 @@ class FreeRoutes:
         direct = np.where(direct_hits[:, kept].any(axis=1), np.inf, straight)
         if len(self.corners) == 0:
             return direct
-        reach = self._reach(sight, np.concatenate([sources, targets]), kept)
+        reach = self._reach(sight, removed)[np.concatenate([sources, targets])]
         from_source = np.min(reach[: len(sources), :, None] + distances[None], axis=1)  # (pairs, c)
         return np.minimum(direct, np.min(from_source + reach[len(sources) :], axis=1))
 
-    def _reach(self, sight: Sight, rows: np.ndarray, kept: np.ndarray) -> np.ndarray:
-        """(rows, c) the straight lengths from the points ``rows`` of ``sight`` to the corners (inf
-        where a ``kept`` obstacle blocks the way), for all of the sight's points once per kept set."""
-        key = kept.tobytes()
-        if key not in sight.reach:
-            sight.reach[key] = np.where(
-                sight.corner_hits[:, :, kept].any(axis=2), np.inf, sight.corner_length
-            )
-        return sight.reach[key][rows]
+    def _reach(self, sight: Sight, removed: frozenset[int]) -> np.ndarray:
+        """(points, c) the straight lengths from the points of ``sight`` to the corners (inf where an
+        obstacle not ``removed`` blocks the way)."""
+        key = ("reach", removed)
+        if key not in sight.memo:
+            kept = self.tables(removed)[0]
+            sight.memo[key] = np.where(sight.corner_hits[:, :, kept].any(axis=2), np.inf, sight.corner_length)
+        return sight.memo[key]

@@ -1,17 +1,21 @@
-"""Per-obstacle geometry computed on demand and sparse segment tests give the eager values exactly."""
+"""Per-obstacle geometry computed on demand, sparse segment tests and validation on bounding boxes first
+give the eager answers exactly."""
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from hlp_drake.features.direction import DirectionTable
 from hlp_drake.features.row_choice import free_space
+from hlp_drake.lazy import LazyRows
 from hlp_drake.planner import PlanKeypoint
 from hlp_drake.planner.row_plan import plans_segment_collisions, segment_collisions
 from hlp_drake.scene.generators import generate_scene
+from hlp_drake.scene.validation import scene_problems
 from hlp_drake.taskspace import TaskSpace, block_array, free_fractions, rect_array
-from hlp_drake.taskspace.lazy import LazyRows
 from hlp_drake.taskspace.model import table_walls
 from hlp_drake.taskspace.relocation import relocated_array
 from hlp_drake.taskspace.routes import _clip, segment_inside
@@ -88,3 +92,13 @@ def test_segment_collisions_of_several_plans_equal_each_plan_alone(space):
     batched = plans_segment_collisions(space, plans, 0.05)
     assert batched == [segment_collisions(space, p, 0.05) for p in plans]
     assert batched[0] and batched[2] == []
+
+
+def test_start_inside_a_footprint_not_only_inside_its_bounding_box():
+    scene = generate_scene("vr", 0)
+    box = replace(scene.obstacles[0], x=0.3, y=0.0, yaw=float(np.pi / 4))  # a diamond seen from above
+    far = replace(scene.obstacles[1], x=0.3, y=0.3)  # out of the way of the diamond
+    corner = 0.999 * max(box.size[:2]) / 2.0  # inside the bounding box, outside the diamond
+    for start, inside in (((0.3, 0.0), True), ((0.3 - corner, -corner), False)):
+        problems = scene_problems(replace(scene, start=start, obstacles=(box, far, *scene.obstacles[2:])))
+        assert (f"start point lies inside obstacle {box.name!r}" in problems) == inside

@@ -7,6 +7,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from hlp_drake.features.plane import corner_origin
+from hlp_drake.lazy import LazyRows
 from hlp_drake.segmentation.modes import Mode, is_faithful
 from hlp_drake.taskspace import (
     DIRECTIONS,
@@ -17,7 +18,6 @@ from hlp_drake.taskspace import (
     rect_array,
     rect_centres,
 )
-from hlp_drake.taskspace.lazy import LazyRows
 
 DIRECTION_FEATURES = (*(f"free_{d}" for d in DIRECTIONS), "hand_to_object", "object_to_target")
 UNDEFINED_DIRECTION = -1  # class index of a zero displacement (the original's empty label)

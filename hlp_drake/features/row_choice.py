@@ -18,8 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hlp_drake.lazy import LazyRows
 from hlp_drake.taskspace import TaskSpace, block_array, free_fractions, rect_array
-from hlp_drake.taskspace.lazy import LazyRows
 from hlp_drake.taskspace.model import table_walls
 from hlp_drake.taskspace.routes import FreeRoutes, segment_inside
 

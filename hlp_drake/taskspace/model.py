@@ -7,11 +7,11 @@ from functools import cached_property
 
 import numpy as np
 
+from hlp_drake.lazy import LazyRows
 from hlp_drake.scene.geometry import footprint_bounds
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.rows import Row, find_rows
 from hlp_drake.taskspace.directions import DIRECTION_VECTORS, DIRECTIONS
-from hlp_drake.taskspace.lazy import LazyRows
 from hlp_drake.taskspace.rect import Rect
 
 ALPHA = 1.5  # scaling factor of the direction blocks (the original's scaling_factor)

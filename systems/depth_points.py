@@ -16,7 +16,6 @@ import numpy as np
 import sklearn
 from pydrake.math import RigidTransform
 from pydrake.systems.sensors import CameraInfo
-from scipy import ndimage
 from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.linear_model import RANSACRegressor
 
@@ -27,6 +26,8 @@ MIN_TABLE_SHARE = 0.1
 """The table plane holds at least this many points and this share of the points with a depth."""
 EDGE_SAMPLES = 7
 """Points sampled along each table edge for the visibility test."""
+NEIGHBOURS = ((0, 1), (0, -1), (1, 0), (-1, 0))
+"""A pixel's 4-neighbours, (rows, columns) away."""
 EDGES = ("front", "right", "back", "left")
 """The table's edges in the order of its bounds (x_min, y_min, x_max, y_max), as seen from the start."""
 RENDERED_PIXEL_CENTRE = 0.5
@@ -102,9 +103,12 @@ def _rays(width: int, height: int, fx: float, fy: float, cx: float, cy: float) -
     return np.dstack([(col - cx) / fx, (row - cy) / fy, np.ones((height, width))])
 
 
-def _pixel_rays(views: list[CameraView], points: Points) -> tuple[np.ndarray, np.ndarray]:
-    """Per point (n, 3): its pixel's ray in the world (the point at unit depth, relative to the
-    camera) and its camera's position."""
+def _pixel_rays(
+    views: list[CameraView], points: Points, offset: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per point (n, 3): the ray in the world (the point at unit depth, relative to the camera)
+    through its pixel's centre moved by ``offset`` pixels (n, 2: columns, rows; none if None), and
+    its camera's position."""
     rays, origins = np.zeros((len(points), 3)), np.zeros((len(points), 3))
     for k, view in enumerate(views):
         mine = points.camera == k
@@ -112,16 +116,25 @@ def _pixel_rays(views: list[CameraView], points: Points) -> tuple[np.ndarray, np
         grid = _rays(
             info.width(), info.height(), info.focal_x(), info.focal_y(), info.center_x(), info.center_y()
         )
-        rays[mine] = grid[points.row[mine], points.col[mine]] @ X.rotation().matrix().T
+        ray = grid[points.row[mine], points.col[mine]]
+        if offset is not None:
+            ray[:, :2] += offset[mine] / [info.focal_x(), info.focal_y()]
+        rays[mine] = ray @ X.rotation().matrix().T
         origins[mine] = X.translation()
     return rays, origins
 
 
-def on_plane(points: Points, views: list[CameraView], coefficients: tuple[float, float, float]) -> np.ndarray:
-    """(n, 3): where each point's pixel ray meets the plane z = a x + b y + c (its depth's noise
-    left out)."""
+def on_plane(
+    points: Points,
+    views: list[CameraView],
+    coefficients: tuple[float, float, float | np.ndarray],
+    offset: np.ndarray | None = None,
+) -> np.ndarray:
+    """(n, 3): where each point's pixel ray (through its pixel's centre moved by ``offset`` pixels:
+    n, 2, columns and rows) meets the plane z = a x + b y + c (its depth's noise left out; ``c``
+    one for all or one per point)."""
     a, b, c = coefficients
-    rays, origins = _pixel_rays(views, points)
+    rays, origins = _pixel_rays(views, points, offset)
     normal = np.array([-a, -b, 1.0])
     with np.errstate(divide="ignore", invalid="ignore"):
         t = (c - np.einsum("ij,j->i", origins, normal)) / (rays @ normal)
@@ -182,8 +195,10 @@ class TablePlane:
 
     Attributes:
         coefficients: (a, b, c).
-        bounds: (x_min, y_min, x_max, y_max) of the table top: where its pixels' rays meet the plane
-            (not its noisy points: their extremes lie beyond the edges), grown by half a pixel.
+        bounds: (x_min, y_min, x_max, y_max) of the table top, from where the rays through the
+            middles of the steps from its pixels to others meet the plane (``step_crossings``;
+            not its noisy points: their extremes lie beyond the edges): per side the mean of
+            those within a pixel of the extreme.
         inliers: how many points lie on it.
         pixel: the width of a pixel seen on it (the median over its points), m.
         unseen_edges: the edges (``EDGES``) the cameras did not see past (the table may go on there).
@@ -237,9 +252,9 @@ def fit_table(
     refitted by least squares to the sample's points within ``tolerance`` of it; the table's
     pixels are all those within ``tolerance`` of the refit (by ``TablePlane.height_image``: no
     pixel but the sample's becomes a point). The plane must be within 10 degrees of horizontal and
-    hold ``MIN_TABLE_POINTS`` points and ``MIN_TABLE_SHARE`` of all. Its bounds are the extremes
-    of where the rays of its pixels on the border of its region in the image meet it (a region's
-    extremes lie on its border: the image maps to the plane by a homography).
+    hold ``MIN_TABLE_POINTS`` points and ``MIN_TABLE_SHARE`` of all. Its bounds come from the
+    steps out of its region in the image (``TablePlane.bounds``; a region's extremes lie on its
+    border: the image maps to the plane by a homography).
     """
     n = sum(int(m.sum()) for m in masks)
     if n < MIN_TABLE_POINTS:
@@ -281,15 +296,43 @@ def fit_table(
         return "no table plane found (no plane holds enough of the points)"
     if np.hypot(a, b) > MAX_TILT:
         return "no table plane found (the largest plane is not horizontal)"
-    border = [o & ~ndimage.binary_erosion(o, border_value=0) for o in on]
-    xy = on_plane(pixel_points(views, border), views, (a, b, c))[:, :2]
+    xy = step_crossings(views, on, (a, b, c))
     focal = np.array([v.info.focal_x() for v in views])
     pixel = float(np.median(sampled.depth / focal[sampled.camera]))
-    bounds = (*(xy.min(axis=0) - pixel / 2.0), *(xy.max(axis=0) + pixel / 2.0))
+    bounds = _sides(xy, band=pixel)
     table = replace(
         plane, bounds=tuple(float(v) for v in bounds), inliers=count, pixel=pixel, heights=heights
     )
     return replace(table, unseen_edges=unseen_edges(table, views, margin))
+
+
+def step_crossings(
+    views: list[CameraView], regions: list[np.ndarray], coefficients: tuple[float, float, float]
+) -> np.ndarray:
+    """(m, 2): per step from a pixel of a view's region (h, w mask) to a 4-neighbour outside it
+    (inside the image), where the ray through the step's middle meets the plane z = a x + b y + c.
+    An edge crosses the step half way on average, where the pixel's own centre lies inside by
+    half a pixel."""
+    parts = []
+    for dr, dc in NEIGHBOURS:
+        stepping = []
+        for region in regions:
+            h, w = region.shape
+            beyond = np.pad(region, 1, constant_values=True)[1 + dr : 1 + dr + h, 1 + dc : 1 + dc + w]
+            stepping.append(region & ~beyond)
+        points = pixel_points(views, stepping)
+        half_step = np.broadcast_to([dc / 2.0, dr / 2.0], (len(points), 2))
+        parts.append(on_plane(points, views, coefficients, half_step)[:, :2])
+    return np.concatenate(parts)
+
+
+def _sides(xy: np.ndarray, band: float) -> tuple[float, float, float, float]:
+    """(x_min, y_min, x_max, y_max) of the points ``xy`` (n, 2) on a rectangle's outline: per side,
+    the mean of the points within ``band`` of the extreme."""
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    low = [float(np.mean(xy[xy[:, i] <= lo[i] + band, i])) for i in (0, 1)]
+    high = [float(np.mean(xy[xy[:, i] >= hi[i] - band, i])) for i in (0, 1)]
+    return (*low, *high)
 
 
 def unseen_edges(table: TablePlane, views: list[CameraView], margin: float) -> tuple[str, ...]:
@@ -316,12 +359,14 @@ def unseen_edges(table: TablePlane, views: list[CameraView], margin: float) -> t
 
 __all__ = [
     "EDGES",
+    "NEIGHBOURS",
     "CameraView",
     "Points",
     "TablePlane",
     "fit_table",
     "on_plane",
     "pixel_points",
+    "step_crossings",
     "unseen_edges",
     "valid_depth",
     "view_points",

@@ -8,6 +8,14 @@ Where something nearer hides it (a taller object, the robot), the object's end i
 *occlusion* boundary, not its own. Shapes are fitted to the silhouette only, so a partly hidden
 object keeps the outline of what shows: a circle (least squares) or the rectangle, over the yaws,
 whose sides the silhouette lies on best; the one that fits better decides the shape.
+
+The outline is the footprint's boundary without the pixel grid's bias: where the object's top ends
+against something further away, the boundary crosses the step to the next pixel, on average half
+way, so that edge's point is where the ray through the middle of the step meets the top's plane
+(a pixel's own centre lies inside the footprint by half a pixel on average, and more so on the side
+away from the camera: a quarter-pixel shift of every off-axis object towards the camera before).
+A side's silhouette pixels (a wall facing the camera, where its points end at ``min_height``, or a
+cylinder's sides) lie on the footprint's boundary themselves.
 """
 
 from __future__ import annotations
@@ -19,7 +27,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, cKDTree
 
-from hlp_drake.systems.depth_points import CameraView, Points, valid_depth
+from hlp_drake.systems.depth_points import NEIGHBOURS, CameraView, Points, TablePlane, on_plane, valid_depth
 
 NEARER = 0.005
 """A neighbour pixel this much nearer the camera (m) hides what lies beyond: an occlusion boundary."""
@@ -28,7 +36,6 @@ YAW_STEPS = (30, 12, 10)
 (0.25 degrees apart), then 10 on each side of that (0.025 degrees apart)."""
 COARSE_EDGE = 64
 """The coarsest yaws are scored on at most this many of the silhouette's points (evenly spaced)."""
-NEIGHBOURS = ((0, 1), (0, -1), (1, 0), (-1, 0))
 TOP_BAND = 0.005
 """An object's top: its points within this (m) below the 99th percentile of their heights."""
 
@@ -36,12 +43,25 @@ TOP_BAND = 0.005
 @dataclass(frozen=True)
 class Cluster:
     """One object's points: its ``points`` and, per point, whether its pixel lies on the silhouette,
-    on an occlusion boundary or at the image's border."""
+    on an occlusion boundary or at the image's border; and where the object ends against something
+    further away, per such step to a neighbour pixel the plan-view point (m, 2) where the ray
+    through the step's middle meets the plane parallel to the table through the point
+    (``step_points``), and that point's index (``step_of``, m)."""
 
     points: Points
     silhouette: np.ndarray
     occluded: np.ndarray
     at_border: np.ndarray
+    step_points: np.ndarray
+    step_of: np.ndarray
+
+    def outline(self, on_top: np.ndarray) -> np.ndarray:
+        """(m, 2) the footprint's boundary in plan view: per silhouette point ``on_top`` (n,) its
+        steps' points, per other silhouette point the point itself (see the module's docstring)."""
+        top_steps = on_top[self.step_of]
+        own = self.silhouette.copy()
+        own[self.step_of[top_steps]] = False
+        return np.concatenate([self.points.xyz[own, :2], self.step_points[top_steps]])
 
 
 @dataclass(frozen=True)
@@ -82,17 +102,19 @@ def cluster_points(points: Points, *, radius: float, min_points: int) -> list[np
 
 
 def boundaries(
-    views: list[CameraView], points: Points, groups: list[np.ndarray], border: int
+    views: list[CameraView], points: Points, groups: list[np.ndarray], border: int, table: TablePlane
 ) -> list[Cluster]:
     """Each group of ``points`` with its silhouette, occlusion and border pixels (4-neighbours in
     its camera's image: another group's pixel or the robot nearer by ``NEARER`` occludes; a pixel
-    without a depth tells nothing; anything else ends the object)."""
+    without a depth tells nothing; anything else ends the object, a step if it lies further by
+    ``NEARER``) and its steps' points (``Cluster``; ``table``'s plane gives their planes)."""
     group = np.full(len(points), -1, dtype=np.int32)
     for g, members in enumerate(groups):
         group[members] = g
     silhouette = np.zeros(len(points), bool)
     occluded = np.zeros(len(points), bool)
     at_border = np.zeros(len(points), bool)
+    steps = np.zeros((len(points), len(NEIGHBOURS)), bool)
     for k, view in enumerate(views):
         here = np.flatnonzero((points.camera == k) & (group >= 0))
         if not len(here):
@@ -104,20 +126,39 @@ def boundaries(
         own = view.depth[row, col]
         at_border[here] = (row < border) | (col < border) | (row >= h - border) | (col >= w - border)
         sil, occ = np.zeros(len(here), bool), np.zeros(len(here), bool)
-        for dr, dc in NEIGHBOURS:
+        step = np.zeros((len(here), len(NEIGHBOURS)), bool)
+        for d, (dr, dc) in enumerate(NEIGHBOURS):
             r, c = row + dr, col + dc
             inside = (r >= 0) & (r < h) & (c >= 0) & (c < w)
             r, c = np.clip(r, 0, h - 1), np.clip(c, 0, w - 1)
-            other = owner[r, c] != mine
+            other = inside & (owner[r, c] != mine)
             depth = view.depth[r, c]
-            known = valid_depth(depth) | np.isposinf(depth)
             nearer = (depth < own - NEARER) | (depth == 0)
-            occ |= inside & other & nearer
-            sil |= inside & other & known & ~nearer
-        silhouette[here], occluded[here] = sil & ~occ, occ
+            ends = other & (valid_depth(depth) | np.isposinf(depth))
+            occ |= other & nearer
+            sil |= ends & ~nearer
+            step[:, d] = ends & (depth > own + NEARER)
+        silhouette[here], occluded[here], steps[here] = sil & ~occ, occ, step & ~occ[:, None]
+    at, towards = np.nonzero(steps)  # by point, so by group once sorted stably
+    stepped, (a, b, _) = points.subset(at), table.coefficients
+    through = stepped.xyz[:, 2] - a * stepped.xyz[:, 0] - b * stepped.xyz[:, 1]
+    half_step = np.array(NEIGHBOURS)[towards, ::-1] / 2.0  # (columns, rows)
+    crossings = on_plane(stepped, views, (a, b, through), half_step)[:, :2]
+    local = np.zeros(len(points), dtype=np.int64)  # each point's index in its group
+    for members in groups:
+        local[members] = np.arange(len(members))
+    by_group = np.argsort(group[at], kind="stable")
+    split = np.split(by_group, np.searchsorted(group[at][by_group], np.arange(1, len(groups) + 1)))
     return [
-        Cluster(points.subset(members), silhouette[members], occluded[members], at_border[members])
-        for members in groups
+        Cluster(
+            points.subset(members),
+            silhouette[members],
+            occluded[members],
+            at_border[members],
+            crossings[mine],
+            local[at[mine]],
+        )
+        for members, mine in zip(groups, split)
     ]
 
 
@@ -173,37 +214,43 @@ def _top(heights: np.ndarray) -> tuple[float, np.ndarray]:
     return float(np.median(heights[on_top])), on_top
 
 
-def fit_object(cluster: Cluster, heights: np.ndarray, pixel: float, *, cylinder: bool | None = None) -> Fit:
-    """The upright box or cylinder of ``cluster`` (a cylinder if ``cylinder`` is True, a box if
-    False, the better fit if None), as tall as its top above the table (``heights``: per point).
-
-    The silhouette's pixels on the top's edge lie inside the footprint by half a pixel (``pixel``
-    wide, m) on average, those on a side facing the camera on it: each side of the outline grows
-    by half a pixel times the share of its silhouette on the top.
-    """
-    xy = cluster.points.xyz[:, :2]
-    height, on_top = _top(heights)
-    enough = cluster.silhouette.sum() >= 8
-    edge = xy[cluster.silhouette] if enough else xy
-    top = on_top[cluster.silhouette] if enough else on_top
-    cx, cy, r, circle_residual = _circle(edge)
-    yaw, bounds, box_residual = (0.0, None, np.inf) if cylinder else _rectangle(xy, edge)
-    if cylinder or (cylinder is None and circle_residual < box_residual):
-        d = 2.0 * (r + pixel / 2.0 * float(np.mean(top)))
-        return Fit("cylinder", cx, cy, 0.0, (d, d, height), circle_residual)
+def _sides(edge: np.ndarray, yaw: float, bounds: np.ndarray, corner: float) -> np.ndarray:
+    """The rectangle at ``yaw`` (bounds u0, v0, u1, v1 in the frame turned by it) with each side
+    where the ``edge`` points nearest to it lie on average (those within ``corner`` of the side's
+    ends left out); a side without such points keeps its place in ``bounds``."""
     c, s = np.cos(yaw), np.sin(yaw)
     uv = edge @ np.array([[c, -s], [s, c]])
-    near = np.abs(uv[:, :, None] - bounds.reshape(2, 2).T[None, :, :]) <= max(pixel / 2.0, 1e-3)
-    grow = [
-        pixel / 2.0 * (float(np.mean(top[near[:, i % 2, i // 2]])) if near[:, i % 2, i // 2].any() else 0.0)
-        for i in range(4)
-    ]
-    u0, v0, u1, v1 = bounds - np.array(grow[:2] + [0, 0]) + np.array([0, 0] + grow[2:])
+    across = np.tile(uv, 2)  # per side (u0, v0, u1, v1): the coordinate across it
+    nearest = np.argmin(np.abs(across - bounds), axis=1)
+    sides = bounds.copy()
+    for i in range(4):
+        along, lo, hi = uv[:, 1 - i % 2], bounds[1 - i % 2], bounds[3 - i % 2]
+        on = (nearest == i) & (along > lo + corner) & (along < hi - corner)
+        if on.any():
+            sides[i] = float(np.mean(across[on, i]))
+    return sides
+
+
+def fit_object(cluster: Cluster, heights: np.ndarray, pixel: float, *, cylinder: bool | None = None) -> Fit:
+    """The upright box or cylinder of ``cluster`` (a cylinder if ``cylinder`` is True, a box if
+    False, the better fit if None) to its outline (``Cluster.outline``), as tall as its top above
+    the table (``heights``: per point); ``pixel``: a pixel's width on the object, m."""
+    xy = cluster.points.xyz[:, :2]
+    height, on_top = _top(heights)
+    outline = cluster.outline(on_top)
+    edge = outline if len(outline) >= 8 else xy
+    cx, cy, r, circle_residual = _circle(edge)
+    seen = np.concatenate([edge, xy[cluster.occluded]])  # where what shows of it ends
+    yaw, bounds, box_residual = (0.0, None, np.inf) if cylinder else _rectangle(seen, edge)
+    if cylinder or (cylinder is None and circle_residual < box_residual):
+        return Fit("cylinder", cx, cy, 0.0, (2.0 * r, 2.0 * r, height), circle_residual)
+    u0, v0, u1, v1 = _sides(edge, yaw, bounds, corner=pixel)
     u, v = (u0 + u1) / 2.0, (v0 + v1) / 2.0
     sides = [float(u1 - u0), float(v1 - v0)]
     turns = round(yaw / (np.pi / 2))  # the same box with its yaw in [-pi/4, pi/4], sides swapped if odd
     if turns % 2:
         sides.reverse()
+    c, s = np.cos(yaw), np.sin(yaw)
     x, y = float(c * u - s * v), float(s * u + c * v)
     return Fit("box", x, y, yaw - turns * np.pi / 2, (*sides, height), box_residual)
 

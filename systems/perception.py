@@ -205,7 +205,7 @@ def _perceive(
     object_points = high.subset((x >= x0) & (x <= x1) & (y >= y0) & (y <= y1))
     radius = max(config.cluster_radius, 1.5 * table.pixel)
     groups = cluster_points(object_points, radius=radius, min_points=config.min_points)
-    clusters = boundaries(views, object_points, groups, config.border_margin)
+    clusters = boundaries(views, object_points, groups, config.border_margin, table)
     classes = []  # the display's classes per pixel (``Perception.cloud_class``)
     clustered = np.zeros(len(object_points), bool)
     clustered[np.concatenate(groups) if groups else []] = True

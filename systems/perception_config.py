@@ -34,7 +34,10 @@ class CameraSettings:
         position: where the camera is, m.
         look_at: the point on the optical axis, m.
         up: the world direction the image's top points to (must not be parallel to the view; default
-            +x, the table's far edge at the top of the image).
+            3 degrees from +x, the table's far edge at the top of the image: turned so, edges along
+            the table's axes cross the pixel grid and locate to a fraction of a pixel; along the
+            grid they cannot, and at 15 objects 94.4 % of the plans' row decisions matched the true
+            scene's instead of 98.1 %, docs/perception.md).
         min_depth, max_depth: the depth sensor's range, m; nearer or further pixels have no depth.
         depth_noise: standard deviation of the Gaussian noise added to every depth pixel, m.
         dropout: fraction of depth pixels that return no depth (NaN), chosen at random.
@@ -48,7 +51,7 @@ class CameraSettings:
     frame: Literal["table", "world"] = "table"
     position: tuple[float, float, float] = (0.0, 0.0, 1.6)
     look_at: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    up: tuple[float, float, float] = (1.0, 0.0, 0.0)
+    up: tuple[float, float, float] = (1.0, 0.0524, 0.0)  # tan(3 degrees)
     min_depth: float = 0.1
     max_depth: float = 4.0
     depth_noise: float = 0.001

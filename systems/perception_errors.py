@@ -3,7 +3,7 @@ human-like plan on it takes the same decisions row by row.
 
 ``perception_record(true_scene, perception)`` is the ``perception`` record of ``run_scene``'s JSON and
 the benchmark's unit: per true object its perceived match (the targets with each other, the
-obstacles by least total centre distance, scipy's ``linear_sum_assignment``, within
+obstacles by least total centre distance, ``object_matching.match_obstacles``, within
 ``MATCH_DISTANCE``), ``position_error_m`` (centres), ``size_error_m`` (the largest error of the
 three extents), ``yaw_error_rad`` (boxes; a box's outline repeats every quarter turn with its sides
 swapped, so the yaw is compared modulo pi/2 and the sizes in the matching order), the objects
@@ -16,10 +16,10 @@ import math
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from hlp_drake.planner import HighLevelPlan
 from hlp_drake.scene.model import Scene, SceneObject
+from hlp_drake.systems.object_matching import match_obstacles
 
 if TYPE_CHECKING:
     from hlp_drake.systems.scene_perception import Perception
@@ -56,13 +56,12 @@ def match_objects(true: Scene, seen: Scene) -> dict[str, str]:
     matches = {}
     if math.hypot(seen.target.x - true.target.x, seen.target.y - true.target.y) <= MATCH_DISTANCE:
         matches[true.target.name] = seen.target.name
-    if true.obstacles and seen.obstacles:
-        a = np.array([o.position for o in true.obstacles])
-        b = np.array([o.position for o in seen.obstacles])
-        cost = np.linalg.norm(a[:, None, :] - b[None, :, :], axis=2)
-        for i, j in zip(*linear_sum_assignment(cost)):
-            if cost[i, j] <= MATCH_DISTANCE:
-                matches[true.obstacles[i].name] = seen.obstacles[j].name
+    rows, cols, distances = match_obstacles(
+        np.array([o.position for o in true.obstacles]), np.array([o.position for o in seen.obstacles])
+    )
+    for i, j, distance in zip(rows, cols, distances):
+        if distance <= MATCH_DISTANCE:
+            matches[true.obstacles[i].name] = seen.obstacles[j].name
     return matches
 
 

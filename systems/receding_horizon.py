@@ -43,6 +43,7 @@ from pydrake.systems.framework import Context, LeafSystem, State
 
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.control_sequence import ControlSequence
+from hlp_drake.systems.object_matching import largest_displacement
 from hlp_drake.systems.optimiser import EMPTY_RESULT, Budget, StoResult, optimise
 from hlp_drake.systems.perception import Perception
 from hlp_drake.systems.robot import ROBOT_MODEL_NAME
@@ -256,20 +257,17 @@ class RecedingHorizonController(LeafSystem):
 
     def _moved_far(self, record: ControllerRecord, t: float) -> bool:
         """Whether an observed object is farther than ``closed_loop.replan_distance`` from where the
-        commanded sequence's rollout put it at ``t`` (the objects of its scene, by name)."""
+        commanded sequence's rollout put it at ``t``, or one appeared or went (the objects paired
+        by position, ``largest_displacement``: a perceived scene's names follow the objects' order
+        on the table, which a frame's noise may swap)."""
         if record.prediction is None or record.scene is None:
             return False
         expected = record.prediction.at(t - record.t0)
         if expected is None:
             return False
         positions, _ = expected
-        observed = {o.name: o for o in record.observed.objects}
-        limit = self._scenario.closed_loop.replan_distance
-        for k, obj in enumerate(record.scene.objects):
-            seen = observed.get(obj.name)
-            if seen is not None and np.hypot(seen.x - positions[k, 0], seen.y - positions[k, 1]) > limit:
-                return True
-        return False
+        observed = np.array([o.position for o in record.observed.objects])
+        return largest_displacement(positions, observed) > self._scenario.closed_loop.replan_distance
 
     def _calc_desired(self, context: Context, output) -> None:
         record: ControllerRecord = context.get_abstract_state(int(self._record)).get_value()

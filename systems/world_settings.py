@@ -136,7 +136,10 @@ class IkConfig:
         base_max_yaw: largest turn of the base away from facing +x, rad.
         start_reach: horizontal distance from the base's centre to the tcp at the start, m.
         start_base_clearance: smallest gap between the base's front and the table edge at the start, m.
-        max_iterations: SNOPT major-iteration limit per solve.
+        max_iterations: SNOPT major-iteration limit per solve (minor iterations: 50 times it). A
+            solve that stops at the limit counts when its iterate meets every constraint: SNOPT
+            often lingers at a converged point of the clearance constraint, so 100 gives the keyframes
+            500 gives (308 of 310 Gen I/II scenes the same within 1e-4) in 0.42 of the IK time.
         attempts: solves per keypoint (the previous keyframe, then seeds with the base shifted, then
             a continuation along the tcp's straight line).
     """
@@ -151,7 +154,7 @@ class IkConfig:
     base_max_yaw: float = math.pi / 2
     start_reach: float = 1.10
     start_base_clearance: float = 0.05
-    max_iterations: int = 500
+    max_iterations: int = 100
     attempts: int = 5
 
 

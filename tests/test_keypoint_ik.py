@@ -386,3 +386,25 @@ def test_a_persons_plan_wired_straight_into_ik_is_refused_not_executed(system):
     assert not refused.ok and "RobotPlanTransfer" in refused.problems[0]
     robot = robot_plan(person, scene, push_rules(CONFIG.transfer, gripper_geometry()))
     assert solve(system, robot).ok and person.details.get("robot_plan") is None
+
+
+def test_the_default_iteration_cap_gives_the_keyframes_of_a_five_times_larger_one():
+    """On gen2-7-5 SNOPT lingers at a converged point of one keypoint for hundreds of major
+    iterations; stopping at ``ik.max_iterations`` (an iterate meeting every constraint counts)
+    leaves every keyframe where 5x the iterations put it."""
+    from hlp_drake.systems.planning_diagram import make_planning_diagram
+    from hlp_drake.systems.scene_source import SCENE_PORT
+
+    scene = generate_scene("gen2", 5, 7)
+
+    def keyframes(max_iterations: int) -> Keyframes:
+        scenario = replace(CONFIG, scene=scene, ik=replace(CONFIG.ik, max_iterations=max_iterations))
+        diagram = make_planning_diagram(scenario)
+        context = diagram.CreateDefaultContext()
+        diagram.GetInputPort(SCENE_PORT).FixValue(context, scene)
+        return diagram.GetOutputPort("keyframes").Eval(context)
+
+    capped, longer = keyframes(CONFIG.ik.max_iterations), keyframes(5 * CONFIG.ik.max_iterations)
+    assert CONFIG.ik.max_iterations == 100
+    assert capped.ok and longer.ok and len(capped.keypoints) >= 6
+    np.testing.assert_allclose(capped.positions, longer.positions, atol=1e-4)

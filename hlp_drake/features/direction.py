@@ -7,6 +7,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from hlp_drake.features.plane import corner_origin
+from hlp_drake.lazy import LazyRows
 from hlp_drake.segmentation.modes import Mode, is_faithful
 from hlp_drake.taskspace import (
     DIRECTIONS,
@@ -56,46 +57,53 @@ def direction_features(
 
 
 class DirectionTable:
-    """The hand-independent part of Xd for several obstacles, computed together.
+    """The hand-independent part of Xd for several obstacles, each obstacle's computed the first
+    time it is asked about (``LazyRows``: a planner moves few of a scene's obstacles).
 
-    Attributes:
-        free: (k, 8) free fractions of the direction blocks.
-        origins: (k, 2) the points directions are measured from (centres; corner origins in faithful mode).
-        to_target: (k,) class index of the direction from each obstacle to the target.
+    Per obstacle: the free fractions of its direction blocks, the point directions are measured
+    from (its centre; its corner origin in faithful mode) and the class index of the direction
+    from it to the target.
     """
 
     def __init__(self, space: TaskSpace, names: Sequence[str], *, mode: Mode, training: bool = False) -> None:
         self.faithful = is_faithful(mode)
-        rects = space.obstacle_bounds[[space.obstacle_index[n] for n in names]].reshape(-1, 4)
+        self._rects = space.obstacle_bounds[[space.obstacle_index[n] for n in names]].reshape(-1, 4)
+        self._alpha = space.alpha
         if self.faithful and training:
-            occluders = space.occluder_bounds()
+            self._occluders = space.occluder_bounds()
         elif self.faithful:
-            occluders = space.occluder_bounds(target=True, walls=("back", "left", "right"))
+            self._occluders = space.occluder_bounds(target=True, walls=("back", "left", "right"))
         else:
-            occluders = space.occluder_bounds(target=True)
-        self.free = free_fractions(block_array(rects, space.alpha), occluders)
+            self._occluders = space.occluder_bounds(target=True)
         target = rect_array([space.target])
-        if self.faithful:
-            self.origins, target_origin = corner_origin(rects), corner_origin(target[0])
-        else:
-            self.origins = rect_centres(rects)
-            target_origin = np.array(space.target.center)
-        self.to_target = np.array(
-            [
-                direction_index(direction_of(*(target_origin - o), faithful=self.faithful))
-                for o in self.origins
-            ],
-            dtype=int,
-        ).reshape(-1)
+        self._target_origin = corner_origin(target[0]) if self.faithful else np.array(space.target.center)
+        self._rows = LazyRows(len(self._rects), self._compute)
+
+    def _compute(self, index: np.ndarray) -> np.ndarray:
+        """(k, 11) per obstacle of ``index``: 8 free fractions, origin (x, y), direction class to the target."""
+        rects = self._rects[index]
+        free = free_fractions(block_array(rects, self._alpha), self._occluders)
+        origins = corner_origin(rects) if self.faithful else rect_centres(rects)
+        to_target = [
+            direction_index(direction_of(*(self._target_origin - o), faithful=self.faithful)) for o in origins
+        ]
+        return np.column_stack([free, origins, np.asarray(to_target, float)])
 
     def hand_direction(self, k: int, hand: Sequence[float]) -> str | None:
         """Direction class from a hand at ``hand`` to obstacle ``k``."""
-        return direction_of(*(self.origins[k] - np.asarray(hand, float)), faithful=self.faithful)
+        return self.hand_directions([k], [hand])[0]
+
+    def hand_directions(self, index: Sequence[int], hands: Sequence[Sequence[float]]) -> list[str | None]:
+        """Direction class from each hand of ``hands`` to its obstacle of ``index``."""
+        origins = self._rows[np.asarray(index, dtype=int)][:, 8:10]
+        return [
+            direction_of(*(o - np.asarray(hand, float)), faithful=self.faithful)
+            for o, hand in zip(origins, hands)
+        ]
 
     def features(self, index: int | np.ndarray, hand_class: int | np.ndarray) -> np.ndarray:
         """Xd of obstacles ``index`` approached from direction class indices ``hand_class``
         (broadcast together): (..., 10)."""
         index, hand_class = np.broadcast_arrays(index, hand_class)
-        return np.concatenate(
-            [self.free[index], hand_class[..., None], self.to_target[index][..., None]], axis=-1
-        )
+        rows = self._rows[index]
+        return np.concatenate([rows[..., :8], hand_class[..., None], rows[..., 10:]], axis=-1)

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hlp_drake.lazy import LazyRows
 from hlp_drake.taskspace import TaskSpace, block_array, free_fractions, rect_array
 from hlp_drake.taskspace.model import table_walls
 from hlp_drake.taskspace.routes import FreeRoutes, segment_inside
@@ -94,8 +95,7 @@ def _corridor_overlap(y_min: np.ndarray, y_max: np.ndarray, line: np.ndarray, wi
 
 @dataclass(frozen=True, eq=False)
 class _RowGeometry:
-    """What a row offers, whoever looks at it: its gaps and its obstacles, left to right, and the
-    obstacles' free space (in the scene as it was set up)."""
+    """What a row offers, whoever looks at it: its gaps and its obstacles, left to right."""
 
     x: float
     gap_rows: np.ndarray  # positions in the gap table
@@ -103,11 +103,10 @@ class _RowGeometry:
     at_edge: np.ndarray  # (G,) whether a gap is bounded by the table's edge
     members: np.ndarray  # obstacle positions in scene order
     obstacles: np.ndarray  # (M, 4)
-    free: np.ndarray  # (M, 8) free fractions of the obstacles' direction blocks
 
     @classmethod
-    def of(cls, space: TaskSpace, row: int, free: np.ndarray) -> _RowGeometry:
-        """Row ``row`` of ``space``; ``free``: every obstacle's free fractions (``free_space``)."""
+    def of(cls, space: TaskSpace, row: int) -> _RowGeometry:
+        """Row ``row`` of ``space``."""
         r = space.rows[row - 1]
         table = space.gap_table
         gap_rows = np.flatnonzero(table.row == row)
@@ -120,7 +119,6 @@ class _RowGeometry:
             at_edge,
             members,
             space.obstacle_bounds[members],
-            free[members].reshape(-1, 8),
         )
 
     def best(
@@ -138,13 +136,17 @@ class _RowGeometry:
         return offsets.min(axis=-1), widths[open_][np.argmin(offsets, axis=-1)], block
 
 
-def free_space(space: TaskSpace) -> np.ndarray:
-    """(n, 8) the free fraction of each obstacle's eight direction blocks in the scene as set up:
-    the other obstacles and the target occlude, and so does everything off the table, however far
-    a block reaches past its edge (walls as thick as the table's diagonal)."""
+def free_space(space: TaskSpace) -> LazyRows:
+    """(n, 8) the free fraction of each obstacle's eight direction blocks in the scene as set up,
+    each obstacle's computed when first asked for: the other obstacles and the target occlude, and
+    so does everything off the table, however far a block reaches past its edge (walls as thick as
+    the table's diagonal)."""
     walls = rect_array(list(table_walls(space.scene.table.bounds, space.scene.table.diagonal).values()))
     occluders = np.vstack([space.obstacle_bounds, rect_array([space.target]), walls])
-    return free_fractions(block_array(space.obstacle_bounds, space.alpha), occluders).reshape(-1, 8)
+    bounds, alpha = space.obstacle_bounds, space.alpha
+    return LazyRows(
+        len(bounds), lambda index: free_fractions(block_array(bounds[index], alpha), occluders).reshape(-1, 8)
+    )
 
 
 def _nearest(
@@ -202,7 +204,7 @@ class RowChoiceScene:
 
     def row(self, index: int) -> _RowGeometry:
         if index not in self._rows:
-            self._rows[index] = _RowGeometry.of(self.space, index, self._free)
+            self._rows[index] = _RowGeometry.of(self.space, index)
         return self._rows[index]
 
     def candidates(
@@ -237,7 +239,8 @@ class RowChoiceScene:
         gap_keep, obj_keep = _nearest(geometry, line, w, limit)  # per hand, positions in the row
         gap_union, obj_union = sorted(set().union(*gap_keep)), sorted(set().union(*obj_keep))
         gb, ob = geometry.gaps[gap_union], geometry.obstacles[obj_union]
-        members, free = geometry.members[obj_union], geometry.free[obj_union]
+        members = geometry.members[obj_union]
+        free = self._free[members].reshape(-1, 8)
         n_gaps, n_obj = len(gb), len(ob)
         n = n_gaps + n_obj
         points = np.empty((len(hands), n, 2))

@@ -32,7 +32,6 @@ from hlp_drake.planner.plan import HighLevelPlan, PlanCandidate, PlanKeypoint
 from hlp_drake.planner.rollout import PrefixTree, arm_configurations, expected_collisions
 from hlp_drake.scene.rows import Row
 from hlp_drake.taskspace import DIRECTIONS, TaskSpace
-from hlp_drake.taskspace.relocation import relocated_array
 from hlp_drake.taskspace.routes import segment_inside
 
 REACH_FRACTION = 0.25  # the hand stops this many hand widths short of the target's near face
@@ -90,10 +89,6 @@ class _Expander:
         self.features = RowChoiceScene(space, hand_width)
         self.names = space.obstacle_names
         self.directions = DirectionTable(space, self.names, mode=config.mode)
-        regions = relocated_array(space.obstacle_bounds, space.alpha)  # (n, 8, 4)
-        self.releases = np.stack(
-            [(regions[..., 0] + regions[..., 2]) / 2.0, (regions[..., 1] + regions[..., 3]) / 2.0], axis=-1
-        )
 
     def candidates(
         self, beam: list[_Partial], row: Row
@@ -123,9 +118,7 @@ class _Expander:
         """Cd's direction for each obstacle approached from its hand (one prediction for all)."""
         if not obstacles:
             return []
-        classes = [
-            direction_index(self.directions.hand_direction(k, hand)) for k, hand in zip(obstacles, hands)
-        ]
+        classes = [direction_index(d) for d in self.directions.hand_directions(obstacles, hands)]
         X = self.directions.features(np.asarray(obstacles, int), np.asarray(classes, int))
         return [
             DIRECTIONS[int(label)]
@@ -144,8 +137,12 @@ class _Expander:
             ]
             chosen += [(partial, candidates, p, evidence, int(k)) for k in keep]
         moved = [c for c in chosen if c[4] is not None and c[1].kinds[c[4]] == "object"]
-        directions = self.moves([c[0].hand for c in moved], [int(c[1].obstacles[c[4]]) for c in moved])
-        direction_of_move = {id(c): d for c, d in zip(moved, directions)}
+        obstacles = [int(c[1].obstacles[c[4]]) for c in moved]
+        directions = self.moves([c[0].hand for c in moved], obstacles)
+        regions = self.space.relocated[obstacles]  # (moves, 8, 4)
+        move_of = {
+            id(c): (d, region[DIRECTIONS.index(d)]) for c, d, region in zip(moved, directions, regions)
+        }
         children = []
         for choice in chosen:
             partial, candidates, p, evidence, k = choice
@@ -162,8 +159,8 @@ class _Expander:
                 keypoints = (*partial.keypoints, PlanKeypoint("gap", point, row.index, element))
                 children.append(_Partial(keypoints, point, partial.removed, log_likelihood, scores))
                 continue
-            obstacle, direction = int(candidates.obstacles[k]), direction_of_move[id(choice)]
-            release = tuple(float(v) for v in self.releases[obstacle, DIRECTIONS.index(direction)])
+            obstacle, (direction, region) = int(candidates.obstacles[k]), move_of[id(choice)]
+            release = (float((region[0] + region[2]) / 2.0), float((region[1] + region[3]) / 2.0))
             keypoints = (
                 *partial.keypoints,
                 PlanKeypoint("move", point, row.index, element, direction),
@@ -182,14 +179,44 @@ def segment_collisions(
     ``{"segment": i, "obstacle": name, "depth": m}``: the length of the way inside the obstacle
     grown by half the hand's width, the obstacles where they stand at that moment (a moved one at
     the centre of its relocated region from its release on, and not on the ways to and with it)."""
-    if len(keypoints) < 2:
-        return []
-    names, regions = space.obstacle_names, relocated_array(space.obstacle_bounds, space.alpha)
-    segments = len(keypoints) - 1
-    # Every place an obstacle stands, and the segments it stands there for: the original places
-    # until the obstacle's release, its relocated region after it.
-    rects, owners, spans = list(space.obstacle_bounds), list(range(len(names))), [[0, segments]] * len(names)
-    own = np.zeros((segments, len(names)), dtype=bool)  # the ways to and with the obstacle moved
+    return plans_segment_collisions(space, [keypoints], hand_width)[0]
+
+
+def plans_segment_collisions(
+    space: TaskSpace, plans: list[tuple[PlanKeypoint, ...]], hand_width: float
+) -> list[list[dict]]:
+    """``segment_collisions`` of each plan of ``plans``, with one segment test for all."""
+    placed = [_placements(space, keypoints) for keypoints in plans]
+    ends = [np.array([k.position for k in keypoints], dtype=float).reshape(-1, 2) for keypoints in plans]
+    rects = np.vstack([np.array(r, dtype=float).reshape(-1, 4) for r, _, _ in placed])
+    grown = rects + np.array([-hand_width, -hand_width, hand_width, hand_width]) / 2.0
+    inside = segment_inside(
+        np.vstack([e[:-1] for e in ends]).reshape(-1, 2),
+        np.vstack([e[1:] for e in ends]).reshape(-1, 2),
+        grown,
+    )
+    names, result, row, column = space.obstacle_names, [], 0, 0
+    for (plan_rects, owners, counted), e in zip(placed, ends):
+        segments, count = max(len(e) - 1, 0), len(plan_rects)
+        own = inside[row : row + segments, column : column + count] * counted
+        row, column = row + segments, column + count
+        result.append(
+            [
+                {"segment": int(i), "obstacle": names[owners[r]], "depth": float(own[i, r])}
+                for i, r in zip(*np.nonzero(own > 1e-9))
+            ]
+        )
+    return result
+
+
+def _placements(space: TaskSpace, keypoints: tuple[PlanKeypoint, ...]) -> tuple[list, list[int], np.ndarray]:
+    """Every place an obstacle stands along a plan, the obstacle's position in scene order and the
+    segments (keypoint to keypoint) it counts for there: (rects, owners, (segments, places)). The
+    original places count until the obstacle's release, its relocated region after it; neither on
+    the ways to and with it."""
+    n, segments = len(space.obstacle_names), max(len(keypoints) - 1, 0)
+    rects, owners, spans = list(space.obstacle_bounds), list(range(n)), [[0, segments]] * n
+    own = np.zeros((segments, n), dtype=bool)  # the ways to and with the obstacle moved
     for i, (a, b) in enumerate(pairwise(keypoints)):
         for k in (a, b):
             if k.action in ("move", "release"):
@@ -197,21 +224,12 @@ def segment_collisions(
         if b.action == "release":
             k = space.obstacle_index[b.element]
             spans[k] = [0, i + 1]
-            rects.append(regions[k, DIRECTIONS.index(b.direction)])
+            rects.append(space.relocated[k][DIRECTIONS.index(b.direction)])
             owners.append(k)
             spans.append([i + 1, segments])
-    spans = np.array(spans, dtype=int).reshape(-1, 2)
+    spans_ = np.array(spans, dtype=int).reshape(-1, 2)
     j = np.arange(segments)[:, None]
-    counted = (j >= spans[:, 0]) & (j < spans[:, 1]) & ~own[:, owners]
-    ends = np.array([k.position for k in keypoints], dtype=float)
-    grown = (
-        np.array(rects).reshape(-1, 4) + np.array([-hand_width, -hand_width, hand_width, hand_width]) / 2.0
-    )
-    inside = segment_inside(ends[:-1], ends[1:], grown) * counted
-    return [
-        {"segment": int(i), "obstacle": names[owners[r]], "depth": float(inside[i, r])}
-        for i, r in zip(*np.nonzero(inside > 1e-9))
-    ]
+    return rects, owners, (j >= spans_[:, 0]) & (j < spans_[:, 1]) & ~own[:, owners]
 
 
 def plan_rows(
@@ -236,7 +254,7 @@ def plan_rows(
     tree = PrefixTree.of(keypoints)
     arms = arm_configurations(models, tree, q0, links[0] + links[1], False)
     costs = expected_collisions(space, tree, arms, links, config.arm_band, False)
-    collisions = [segment_collisions(space, tuple(k), hand_width) for k in keypoints]
+    collisions = plans_segment_collisions(space, [tuple(k) for k in keypoints], hand_width)
     score = [
         beam[i].log_likelihood - config.collision_weight * sum(c["depth"] for c in collisions[i]) / hand_width
         for i in range(len(beam))

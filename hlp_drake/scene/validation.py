@@ -16,6 +16,7 @@ import shapely
 
 from hlp_drake.documents import brief
 from hlp_drake.errors import MAX_PROBLEMS, SceneError
+from hlp_drake.lazy import LazyRows
 from hlp_drake.scene.geometry import footprint_bounds, footprints
 from hlp_drake.scene.model import SHAPES, Scene, SceneObject, Table
 
@@ -221,8 +222,8 @@ def scene_problems(scene: Scene) -> list[str]:
         if not own:
             sound.append((obj, role))
 
-    shapes = footprints([obj for obj, _ in sound])
-    boxes = np.array([footprint_bounds(obj) for obj, _ in sound], dtype=float).reshape(-1, 4)
+    objects = [obj for obj, _ in sound]
+    boxes = np.array([footprint_bounds(obj) for obj in objects], dtype=float).reshape(-1, 4)
     if table_ok:
         table = scene.table
         if start_ok:
@@ -237,22 +238,30 @@ def scene_problems(scene: Scene) -> list[str]:
         )
         for k in np.flatnonzero(outside).tolist():  # the message names the sides
             problems.append(_off_table(*sound[k], boxes[k], table))
-    tree = shapely.STRtree(shapes)
-    problems += _overlaps(sound, shapes, tree)
+    # The footprints' bounding boxes find the candidates; a footprint is built only for an object
+    # of a candidate pair, or one whose box holds the start.
+    shapes = LazyRows(len(objects), lambda index: footprints([objects[k] for k in index]))
+    envelopes = shapely.box(boxes[:, 0], boxes[:, 1], boxes[:, 2], boxes[:, 3])
+    tree = shapely.STRtree(envelopes)
+    problems += _overlaps(sound, envelopes, shapes, tree)
     if start_ok:
         point = shapely.Point(float(scene.start[0]), float(scene.start[1]))
-        inside = sorted(tree.query(point, predicate="within").tolist())
+        near = np.sort(tree.query(point))
+        inside = near[shapely.within(point, shapes[near])].tolist() if len(near) else []
         problems += [f"start point lies inside {_label(*sound[k])}" for k in inside]
     return problems
 
 
-def _overlaps(sound: list[tuple[SceneObject, str]], shapes: np.ndarray, tree: shapely.STRtree) -> list[str]:
-    """A message per pair of footprints sharing more than ``AREA_TOLERANCE``, in index order; after
-    ``MAX_PROBLEMS - 1`` pairs one line says more overlap (so a pile of n equal objects costs O(n))."""
+def _overlaps(
+    sound: list[tuple[SceneObject, str]], envelopes: np.ndarray, shapes: LazyRows, tree: shapely.STRtree
+) -> list[str]:
+    """A message per pair of footprints (``shapes``) sharing more than ``AREA_TOLERANCE``, in index
+    order, among the pairs whose ``envelopes`` (the ``tree``'s) meet; after ``MAX_PROBLEMS - 1``
+    pairs one line says more overlap (so a pile of n equal objects costs O(n))."""
     problems: list[str] = []
     first, chunk = 0, 1
-    while first < len(shapes):  # chunks of 1, 2, 4, ... 256 objects: a pile is found in the first
-        a, b = tree.query(shapes[first : first + chunk], predicate="intersects")
+    while first < len(envelopes):  # chunks of 1, 2, 4, ... 256 objects: a pile is found in the first
+        a, b = tree.query(envelopes[first : first + chunk], predicate="intersects")
         a = a + first
         first, chunk = first + chunk, min(2 * chunk, 256)
         keep = a < b

@@ -7,6 +7,7 @@ from functools import cached_property
 
 import numpy as np
 
+from hlp_drake.lazy import LazyRows
 from hlp_drake.scene.geometry import footprint_bounds
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.rows import Row, find_rows
@@ -196,6 +197,15 @@ class TaskSpace:
     def obstacle_centres(self) -> np.ndarray:
         """(n_obstacles, 2) centres of the obstacles, in scene order."""
         return rect_centres(self.obstacle_bounds)
+
+    @cached_property
+    def relocated(self) -> LazyRows:
+        """Per obstacle (scene order), the (8, 4) regions it is pushed into, per direction
+        (``relocation.relocated_array``), each obstacle's computed when first asked for."""
+        from hlp_drake.taskspace.relocation import relocated_array  # relocation builds on this module
+
+        bounds, alpha = self.obstacle_bounds, self.alpha
+        return LazyRows(len(bounds), lambda index: relocated_array(bounds[index], alpha))
 
     @cached_property
     def obstacle_index(self) -> dict[str, int]:

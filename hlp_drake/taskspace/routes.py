@@ -12,7 +12,7 @@ of interest see (the corners, the goal), so routes from them cost a few array op
 from __future__ import annotations
 
 from collections.abc import Collection
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -66,13 +66,25 @@ def segment_hits(p0: np.ndarray, p1: np.ndarray, rects: np.ndarray) -> np.ndarra
     return hits
 
 
+REACH_MARGIN = 1e-9  # m: rectangles this far from every segment's bounding box are not clipped
+
+
 def segment_inside(p0: np.ndarray, p1: np.ndarray, rects: np.ndarray) -> np.ndarray:
-    """(n, m): the length of segment p0[i] -> p1[i] inside rectangle j."""
-    low, high = _clip(p0, p1, rects)
-    length = np.linalg.norm(
-        np.asarray(p1, float).reshape(-1, 2) - np.asarray(p0, float).reshape(-1, 2), axis=1
-    )
-    return np.maximum(high - low, 0.0) * length[:, None]
+    """(n, m): the length of segment p0[i] -> p1[i] inside rectangle j.
+
+    Only the rectangles within ``REACH_MARGIN`` of the segments' common bounding box are clipped
+    (the others hold 0), so a few segments among many obstacles stay cheap."""
+    a, b = np.asarray(p0, float).reshape(-1, 2), np.asarray(p1, float).reshape(-1, 2)
+    r = np.asarray(rects, float).reshape(-1, 4)
+    inside = np.zeros((len(a), len(r)))
+    if len(a) == 0:
+        return inside
+    lo = np.minimum(a.min(axis=0), b.min(axis=0)) - REACH_MARGIN
+    hi = np.maximum(a.max(axis=0), b.max(axis=0)) + REACH_MARGIN
+    near = np.flatnonzero((r[:, 0] <= hi[0]) & (r[:, 2] >= lo[0]) & (r[:, 1] <= hi[1]) & (r[:, 3] >= lo[1]))
+    low, high = _clip(a, b, r[near])
+    inside[:, near] = np.maximum(high - low, 0.0) * np.linalg.norm(b - a, axis=1)[:, None]
+    return inside
 
 
 def all_pairs_shortest(graph: np.ndarray) -> np.ndarray:
@@ -99,6 +111,8 @@ class Sight:
     corner_length: np.ndarray
     goal_hits: np.ndarray
     goal_length: np.ndarray
+    memo: dict[tuple[str, frozenset[int]], np.ndarray] = field(default_factory=dict, repr=False)
+    """``FreeRoutes``' per-point results for all the points at once, per set of obstacles removed."""
 
 
 class FreeRoutes:
@@ -156,12 +170,16 @@ class FreeRoutes:
         self._edge_hits[upper] = segment_hits(self.corners[upper[0]], self.corners[upper[1]], self.grown)
         self._edge_hits |= self._edge_hits.transpose(1, 0, 2)
         self._edge_length = np.linalg.norm(self.corners[:, None] - self.corners[None], axis=2)
-        self._corners_to_goal = self.sight(self.corners)
+        # The corners' straight ways to the goal: which grown obstacles they pass through, their lengths.
+        self._goal_hits = segment_hits(
+            self.corners, np.broadcast_to(self.goal, self.corners.shape), self.grown
+        )
+        self._goal_length = np.linalg.norm(self.corners - self.goal, axis=1)
         self._tables: dict[frozenset[int], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
     def kept(self, removed: Collection[int]) -> np.ndarray:
         """(m,) which obstacles stand (their ids not in ``removed``)."""
-        return ~np.isin(self.ids, list(removed))
+        return np.array([int(k) not in removed for k in self.ids], dtype=bool)
 
     def tables(self, removed: frozenset[int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(kept (m,), corner distances (c, c), corner route lengths to the goal (c,)) with the
@@ -170,8 +188,7 @@ class FreeRoutes:
             kept = self.kept(removed)
             open_ = ~self._edge_hits[:, :, kept].any(axis=2)
             distances = all_pairs_shortest(np.where(open_, self._edge_length, np.inf))
-            sight = self._corners_to_goal
-            straight = np.where(sight.goal_hits[:, kept].any(axis=1), np.inf, sight.goal_length)
+            straight = np.where(self._goal_hits[:, kept].any(axis=1), np.inf, self._goal_length)
             to_goal = np.min(distances + straight[None, :], axis=1) if len(straight) else straight
             self._tables[removed] = (kept, distances, to_goal)
         return self._tables[removed]
@@ -194,12 +211,14 @@ class FreeRoutes:
 
     def to_goal(self, sight: Sight, rows: np.ndarray, removed: frozenset[int]) -> np.ndarray:
         """Route lengths from the points ``rows`` of ``sight`` to the goal (inf: no route)."""
-        kept, _, to_goal = self.tables(removed)
-        direct = np.where(sight.goal_hits[rows][:, kept].any(axis=1), np.inf, sight.goal_length[rows])
-        if len(self.corners) == 0:
-            return direct
-        reach = self._reach(sight, rows, kept)
-        return np.minimum(direct, np.min(reach + to_goal[None], axis=1))
+        key = ("to_goal", removed)
+        if key not in sight.memo:
+            kept, _, to_goal = self.tables(removed)
+            direct = np.where(sight.goal_hits[:, kept].any(axis=1), np.inf, sight.goal_length)
+            if len(self.corners):
+                direct = np.minimum(direct, np.min(self._reach(sight, removed) + to_goal[None], axis=1))
+            sight.memo[key] = direct
+        return sight.memo[key][rows]
 
     def to_goal_without(
         self, sight: Sight, rows: np.ndarray, removed: frozenset[int], obstacle: int
@@ -223,11 +242,11 @@ class FreeRoutes:
         best = np.minimum(base, direct)
         if len(self.corners) == 0:
             return best
-        reach = self._reach(sight, rows, kept)  # (n, c) with the obstacle standing
+        reach = self._reach(sight, removed)[rows]  # (n, c) with the obstacle standing
         from_point = np.min(reach[:, :, None] + distances[None], axis=1)  # (n, c)
         through = np.where(crossing(sight.corner_hits[rows]), sight.corner_length[rows], np.inf)
         edge = np.where(crossing(self._edge_hits), self._edge_length, np.inf)
-        last = np.where(crossing(self._corners_to_goal.goal_hits), self._corners_to_goal.goal_length, np.inf)
+        last = np.where(crossing(self._goal_hits), self._goal_length, np.inf)
         via_edge = np.min(from_point[:, :, None] + edge[None] + to_goal[None, None, :], axis=(1, 2))
         return np.minimum.reduce(
             [best, np.min(through + to_goal[None], axis=1), np.min(from_point + last[None], axis=1), via_edge]
@@ -248,9 +267,15 @@ class FreeRoutes:
         direct = np.where(direct_hits[:, kept].any(axis=1), np.inf, straight)
         if len(self.corners) == 0:
             return direct
-        reach = self._reach(sight, np.concatenate([sources, targets]), kept)
+        reach = self._reach(sight, removed)[np.concatenate([sources, targets])]
         from_source = np.min(reach[: len(sources), :, None] + distances[None], axis=1)  # (pairs, c)
         return np.minimum(direct, np.min(from_source + reach[len(sources) :], axis=1))
 
-    def _reach(self, sight: Sight, rows: np.ndarray, kept: np.ndarray) -> np.ndarray:
-        return np.where(sight.corner_hits[rows][:, :, kept].any(axis=2), np.inf, sight.corner_length[rows])
+    def _reach(self, sight: Sight, removed: frozenset[int]) -> np.ndarray:
+        """(points, c) the straight lengths from the points of ``sight`` to the corners (inf where an
+        obstacle not ``removed`` blocks the way)."""
+        key = ("reach", removed)
+        if key not in sight.memo:
+            kept = self.tables(removed)[0]
+            sight.memo[key] = np.where(sight.corner_hits[:, :, kept].any(axis=2), np.inf, sight.corner_length)
+        return sight.memo[key]

@@ -1,0 +1,173 @@
+"""Initialisation time (high-level plan + keypoint IK) per object count, the issue's flatness figure.
+
+    python benchmarks/init_time.py [--scenes 30] [--seed S] [--objects 5 7 9] [--planner hlp]
+        [--against-iterations 500] [--json OUT] [--png OUT]
+
+Plans every seeded Generalization II scene (and as many Generalization I scenes) in this process
+and solves its keypoints' IK through ``make_planning_diagram`` (no optimiser), timing each scene in
+CPU seconds of this thread (``time.thread_time``: the figure does not depend on the machine's load)
+and in wall seconds beside it. Prints the median, mean and p95 per object count and the max/min
+ratio of the medians and of the means across the counts (the issue's target: <= 1.2 from 5 to 9
+objects). With ``--against-iterations N`` every scene is solved a second time, right after, with
+``ik.max_iterations = N`` (e.g. the earlier default, 500): both times per scene and whether the
+keyframes agree (every keypoint's success alike, positions within 1e-4).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from hlp_drake.atomic import write_text_atomic
+from hlp_drake.learners.bundled import default_models
+from hlp_drake.plotting import new_figure, save_png
+from hlp_drake.scene.generators import generate_scene
+from hlp_drake.scene.model import Scene
+from hlp_drake.systems.keyframes import Keyframes
+from hlp_drake.systems.planning_diagram import make_planning_diagram
+from hlp_drake.systems.scenario import Scenario, load_scenario
+from hlp_drake.systems.scene_source import SCENE_PORT
+
+SAME_POSITIONS = 1e-4
+"""Keyframes whose positions differ by at most this (rad or m) count as the same."""
+
+
+def timed_init(scenario: Scenario) -> tuple[float, float, Keyframes, int]:
+    """(CPU s, wall s, keyframes, keypoints) of planning ``scenario``'s scene and solving its IK."""
+    diagram = make_planning_diagram(scenario, models=default_models())
+    context = diagram.CreateDefaultContext()
+    diagram.GetInputPort(SCENE_PORT).FixValue(context, scenario.scene)
+    cpu, wall = time.thread_time(), time.perf_counter()
+    keyframes = diagram.GetOutputPort("keyframes").Eval(context)
+    cpu, wall = time.thread_time() - cpu, time.perf_counter() - wall
+    return cpu, wall, keyframes, len(keyframes.keypoints)
+
+
+def same_keyframes(a: Keyframes, b: Keyframes) -> bool:
+    return (
+        a.success == b.success
+        and a.positions.shape == b.positions.shape
+        and bool(np.all(np.abs(a.positions - b.positions) <= SAME_POSITIONS))
+    )
+
+
+def stats(values: list[float]) -> dict[str, float]:
+    return {
+        "median": float(np.median(values)),
+        "mean": float(np.mean(values)),
+        "p95": float(np.percentile(values, 95)),
+        "max": float(np.max(values)),
+    }
+
+
+def spread(groups: dict[str, dict[str, dict[str, float]]], key: str, statistic: str) -> float:
+    """max/min of ``statistic`` of ``key`` over the Generalization II groups."""
+    values = [g[key][statistic] for label, g in groups.items() if label.startswith("gen2")]
+    return max(values) / min(values)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scenes", type=int, default=30, help="scenes per group")
+    parser.add_argument("--seed", type=int, default=0, help="scene i has seed S + i")
+    parser.add_argument("--objects", type=int, nargs="+", default=[5, 7, 9], help="gen2 object counts")
+    parser.add_argument("--planner", choices=("hlp", "sto"), default="hlp")
+    parser.add_argument("--against-iterations", type=int, help="also solve with this ik.max_iterations")
+    parser.add_argument("--json", type=Path, help="write the figures and rows here")
+    parser.add_argument("--png", type=Path, help="box plot of the CPU times per group")
+    args = parser.parse_args()
+    settings = load_scenario()
+    settings = replace(settings, planner=replace(settings.planner, kind=args.planner))
+    groups: dict[str, list[Scene]] = {
+        "gen1": [generate_scene("gen1", args.seed + i) for i in range(args.scenes)],
+        **{
+            f"gen2, {n} objects": [generate_scene("gen2", args.seed + i, n) for i in range(args.scenes)]
+            for n in args.objects
+        },
+    }
+    default_models()  # loaded before the first timed scene
+    rows = []
+    progress = tqdm(total=sum(map(len, groups.values())), desc="plan + IK", unit="scene")
+    for label, scenes in groups.items():
+        for scene in scenes:
+            scenario = replace(settings, scene=scene)
+            cpu, wall, keyframes, keypoints = timed_init(scenario)
+            row = {"group": label, "scene": scene.name, "cpu_s": cpu, "wall_s": wall, "keypoints": keypoints}
+            row["ik_ok"] = keyframes.ok
+            if args.against_iterations is not None:
+                other = replace(scenario, ik=replace(scenario.ik, max_iterations=args.against_iterations))
+                other_cpu, other_wall, other_keyframes, _ = timed_init(other)
+                row |= {
+                    "against_cpu_s": other_cpu,
+                    "against_wall_s": other_wall,
+                    "same_keyframes": same_keyframes(keyframes, other_keyframes),
+                }
+            rows.append(row)
+            progress.update()
+    progress.close()
+    summary: dict[str, dict] = {}
+    for label in groups:
+        group = [r for r in rows if r["group"] == label]
+        summary[label] = {
+            "scenes": len(group),
+            "cpu_s": stats([r["cpu_s"] for r in group]),
+            "wall_s": stats([r["wall_s"] for r in group]),
+            "keypoints": stats([r["keypoints"] for r in group]),
+            "ik_ok": sum(r["ik_ok"] for r in group),
+        }
+        if args.against_iterations is not None:
+            summary[label]["against_cpu_s"] = stats([r["against_cpu_s"] for r in group])
+            summary[label]["same_keyframes"] = sum(r["same_keyframes"] for r in group)
+    figures = {
+        f"gen2 max/min of the {statistic} CPU s": spread(summary, "cpu_s", statistic)
+        for statistic in ("median", "mean")
+    }
+    print(f"{args.planner} init (plan + IK) per scene, ms: median / mean / p95 CPU (wall median)")
+    for label, s in summary.items():
+        cpu, wall = s["cpu_s"], s["wall_s"]
+        line = (
+            f"  {label:16s} {cpu['median'] * 1e3:6.0f} / {cpu['mean'] * 1e3:6.0f} / {cpu['p95'] * 1e3:6.0f}"
+            f"  ({wall['median'] * 1e3:.0f})  keypoints {s['keypoints']['median']:.0f}, IK ok {s['ik_ok']}"
+        )
+        if args.against_iterations is not None:
+            against = s["against_cpu_s"]
+            line += (
+                f"; max_iterations {args.against_iterations}: {against['median'] * 1e3:.0f} / "
+                f"{against['mean'] * 1e3:.0f} / {against['p95'] * 1e3:.0f}, "
+                f"same keyframes {s['same_keyframes']}/{s['scenes']}"
+            )
+        print(line)
+    for name, value in figures.items():
+        print(f"  {name}: {value:.2f}")
+    if args.json is not None:
+        record = {
+            "command": " ".join(["python benchmarks/init_time.py", *sys.argv[1:]]),
+            "machine": platform.platform(),
+            "ik_max_iterations": settings.ik.max_iterations,
+            "summary": summary,
+            "figures": figures,
+            "rows": rows,
+        }
+        write_text_atomic(args.json, json.dumps(record, indent=1))
+    if args.png is not None:
+        figure, axes = new_figure(7.0, 4.0)
+        axes.boxplot([[r["cpu_s"] * 1e3 for r in rows if r["group"] == g] for g in groups])
+        axes.set_xticks(range(1, len(groups) + 1), list(groups))
+        axes.set_ylabel("plan + IK, CPU ms")
+        axes.set_yscale("log")
+        axes.set_title(
+            f"{args.planner} initialisation per scene (ik.max_iterations {settings.ik.max_iterations})"
+        )
+        save_png(figure, args.png)
+
+
+if __name__ == "__main__":
+    main()

@@ -19,8 +19,9 @@
 
 The models (``MODELS``): the full model at 5 ms (the issue's reference), the reduced model (objects
 nothing comes near asleep) at 5 and 10 ms, the full model at 10 ms, each contact trim alone on the
-reduced 10 ms model, the default trims at 10 and 20 ms (at 20 ms also with sampled output ports),
-and the default (``Scenario().optimiser``). Writes ``DIR/rollout_models.json``
+reduced 10 ms model, the default trims at 10 and 20 ms (at 20 ms also with sampled output ports and
+with the state read every 0.25 s), every one of them reading the state every 0.1 s otherwise, and
+the default (``Scenario().optimiser``: 20 ms, read every 0.2 s). Writes ``DIR/rollout_models.json``
 and ``DIR/rollout_models.png``.
 """
 
@@ -44,22 +45,25 @@ from hlp_drake.systems.scene_rollouts import SceneRollouts
 UNTRIMMED = (
     "rollout_trims: {top_spheres: true, rim_spheres: 8, robot_self_contact: true, sampled_output_ports: true}"
 )
+EVERY_100MS = "rollout_sample_period: 0.1"
+"""The state read every 0.1 s, as the execution model's (and every model's before the default's 0.2 s)."""
 MODELS = {
-    "full_5ms": f"{{rollout_time_step: 0.005, reduced_model: false, {UNTRIMMED}}}",
-    "reduced_5ms": f"{{rollout_time_step: 0.005, reduced_model: true, {UNTRIMMED}}}",
-    "full_10ms": f"{{rollout_time_step: 0.01, reduced_model: false, {UNTRIMMED}}}",
-    "reduced_10ms": f"{{rollout_time_step: 0.01, reduced_model: true, {UNTRIMMED}}}",
+    "full_5ms": f"{{rollout_time_step: 0.005, reduced_model: false, {UNTRIMMED}, {EVERY_100MS}}}",
+    "reduced_5ms": f"{{rollout_time_step: 0.005, reduced_model: true, {UNTRIMMED}, {EVERY_100MS}}}",
+    "full_10ms": f"{{rollout_time_step: 0.01, reduced_model: false, {UNTRIMMED}, {EVERY_100MS}}}",
+    "reduced_10ms": f"{{rollout_time_step: 0.01, reduced_model: true, {UNTRIMMED}, {EVERY_100MS}}}",
     "reduced_10ms_bottom_spheres": "{rollout_time_step: 0.01, reduced_model: true, rollout_trims: "
-    "{top_spheres: false, rim_spheres: 8, robot_self_contact: true, sampled_output_ports: true}}",
+    f"{{top_spheres: false, rim_spheres: 8, robot_self_contact: true, sampled_output_ports: true}}, {EVERY_100MS}}}",
     "reduced_10ms_rim4": "{rollout_time_step: 0.01, reduced_model: true, rollout_trims: "
-    "{top_spheres: true, rim_spheres: 4, robot_self_contact: true, sampled_output_ports: true}}",
+    f"{{top_spheres: true, rim_spheres: 4, robot_self_contact: true, sampled_output_ports: true}}, {EVERY_100MS}}}",
     "reduced_10ms_no_self_contact": "{rollout_time_step: 0.01, reduced_model: true, rollout_trims: "
-    "{top_spheres: true, rim_spheres: 8, robot_self_contact: false, sampled_output_ports: true}}",
+    f"{{top_spheres: true, rim_spheres: 8, robot_self_contact: false, sampled_output_ports: true}}, {EVERY_100MS}}}",
     "reduced_10ms_unsampled": "{rollout_time_step: 0.01, reduced_model: true, rollout_trims: "
-    "{top_spheres: true, rim_spheres: 8, robot_self_contact: true, sampled_output_ports: false}}",
-    "trimmed_10ms": "{rollout_time_step: 0.01}",
-    "trimmed_20ms": "{rollout_time_step: 0.02}",
-    "trimmed_20ms_sampled": "{rollout_time_step: 0.02, rollout_trims: {sampled_output_ports: true}}",
+    f"{{top_spheres: true, rim_spheres: 8, robot_self_contact: true, sampled_output_ports: false}}, {EVERY_100MS}}}",
+    "trimmed_10ms": f"{{rollout_time_step: 0.01, {EVERY_100MS}}}",
+    "trimmed_20ms": f"{{rollout_time_step: 0.02, {EVERY_100MS}}}",
+    "trimmed_20ms_sampled": f"{{rollout_time_step: 0.02, rollout_trims: {{sampled_output_ports: true}}, {EVERY_100MS}}}",
+    "trimmed_20ms_every_250ms": "{rollout_time_step: 0.02, rollout_sample_period: 0.25}",
     "default": "{}",
 }
 

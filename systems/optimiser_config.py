@@ -120,7 +120,10 @@ class StoConfig:
             rollout goes back to the previous sample and on with it awake, m.
         sleep_speed: an awake object slower than this at two samples in a row has come to rest, m/s.
         settle_s: simulated time after the last control step before the final state is read, s.
-        sample_period: how often a rollout's state is read for the cost, s.
+        sample_period: how often a rollout's state is read for the cost on the execution model
+            (verifying), s.
+        rollout_sample_period: the same on the rollout model (the cost terms are per second, the
+            sleep checks' margins grow with the motion between samples), s.
         max_object_speed: an object faster than this (m/s) means the simulation blew up.
         max_sink: an object's centre more than this below the table top while over it means it
             tunnelled into the table, m.
@@ -155,6 +158,7 @@ class StoConfig:
     sleep_speed: float = 0.005
     settle_s: float = 0.5
     sample_period: float = 0.1
+    rollout_sample_period: float = 0.2
     max_object_speed: float = 5.0
     max_sink: float = 0.03
     cost: StoCost = field(default_factory=StoCost)

@@ -4,7 +4,8 @@ The world is ``make_world_diagram`` of the rollout model (``rollout_scenario``: 
 ``rollout_time_step`` and ``rollout_trims``) or of the execution model itself (``execution=True``,
 for verifying), with a C++ ``TrajectorySource`` driving the robot; the initial context is kept. A
 rollout swaps the source's trajectory, resets the context (or sets a given start state) and
-simulates, Python only reading the state (``Reading``) every ``optimiser.sample_period``. Objects
+simulates, Python only reading the state (``Reading``) every ``optimiser.rollout_sample_period``
+(``optimiser.sample_period`` on the execution model). Objects
 may be put to sleep (their floating joints locked in the context: they neither move nor cost the
 contact solver a degree of freedom) and woken again, at any pose (see ``rollout_sampler``). On the
 execution model a rollout from the scene's start keeps its end state (``RolloutOutcome.final``): the
@@ -58,8 +59,9 @@ def simulation_failure(error: BaseException) -> str:
 
 
 def rollout_scenario(scenario: Scenario) -> Scenario:
-    """``scenario`` as the optimiser's rollout model: the plant stepping at ``optimiser.rollout_time_step``
-    and the contact geometry and plant outputs trimmed as ``optimiser.rollout_trims`` says."""
+    """``scenario`` as the optimiser's rollout model: the plant stepping at ``optimiser.rollout_time_step``,
+    the contact geometry and plant outputs trimmed as ``optimiser.rollout_trims`` says and the state
+    read every ``optimiser.rollout_sample_period``."""
     sto = scenario.optimiser
     trims = sto.rollout_trims
     plant = copy.copy(scenario.plant)
@@ -71,7 +73,8 @@ def rollout_scenario(scenario: Scenario) -> Scenario:
         rim_spheres=trims.rim_spheres,
         robot_self_contact=trims.robot_self_contact,
     )
-    return replace(scenario, plant=plant, contact=contact)
+    optimiser = replace(sto, sample_period=sto.rollout_sample_period)
+    return replace(scenario, plant=plant, contact=contact, optimiser=optimiser)
 
 
 def verification_scenario(scenario: Scenario) -> Scenario:
@@ -99,15 +102,13 @@ class RolloutWorld:
 
     def __init__(self, scenario: Scenario, *, execution: bool = False) -> None:
         self.execution, self.key = execution, scenario.key
-        if execution:
-            scenario = verification_scenario(scenario)
+        scenario = verification_scenario(scenario) if execution else rollout_scenario(scenario)
         scene = scenario.scene
         self.scene = scene
         self.scenario = scenario
+        """The model's own scenario (``rollout_scenario`` or ``verification_scenario``)."""
         builder = DiagramBuilder()
-        world = builder.AddSystem(
-            make_world_diagram(scenario if execution else rollout_scenario(scenario), cameras=False)
-        )
+        world = builder.AddSystem(make_world_diagram(scenario, cameras=False))
         plant, robot = world_plant(world)
         start = plant.GetPositions(plant.CreateDefaultContext(), robot)
         hold = ControlSequence(np.array([0.0, 1.0]), np.vstack([start, start])).to_trajectory()

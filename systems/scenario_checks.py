@@ -106,6 +106,7 @@ def scenario_problems(scenario: Scenario) -> list[str]:
         "step_duration",
         "mppi_temperature",
         "sample_period",
+        "rollout_sample_period",
         "max_object_speed",
         "max_sink",
     ):

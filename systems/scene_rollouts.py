@@ -54,9 +54,8 @@ class SceneRollouts:
 
     def simulate(self, sequence: ControlSequence, start: RolloutStart | None = None) -> RolloutSamples:
         """Roll ``sequence`` out (from ``start``), reading the state every sample period."""
-        return sample_rollout(
-            sequence, self.scenario.optimiser, self.full, self.sleep_schedule(sequence, start), start=start
-        )
+        schedule = self.sleep_schedule(sequence, start)
+        return sample_rollout(sequence, self.full.scenario.optimiser, self.full, schedule, start=start)
 
     def rollout(self, sequence: ControlSequence, start: RolloutStart | None = None) -> RolloutOutcome:
         """Simulate ``sequence`` (from ``start``) and cost it."""

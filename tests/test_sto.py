@@ -11,6 +11,7 @@ from human_plans import GEN1_15, GEN2_9_39, GEN2_9_39_NEXT, chain_first_rollout,
 from pydrake.trajectories import PiecewisePolynomial
 from sto_support import on, short
 
+from hlp_drake.errors import HlpError
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import SceneObject
 from hlp_drake.systems.control_sequence import ControlSequence
@@ -138,6 +139,17 @@ def test_rollouts_are_repeatable_and_the_hlp_initialisation_reaches_the_default_
     assert first.success, first.failure_reason
     assert first.cost == second.cost and first.terms == second.terms  # contexts are reset, not rebuilt
     assert first.simulated_s == pytest.approx(sequence.duration + world.scenario.optimiser.settle_s)
+
+
+def test_rollouts_read_every_rollout_sample_period_and_verifications_every_sample_period(scene, trajectories):
+    config = on(scene, "optimiser: {sample_period: 0.1, rollout_sample_period: 0.25, settle_s: 0.0}")
+    rollouts = SceneRollouts(config)
+    sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)
+    rolled, verified = rollouts.rollout(sequence), rollouts.verify(sequence)
+    np.testing.assert_allclose(rolled.prediction.times, [0.0, 0.25, 0.5, 0.75, 1.0])
+    assert np.allclose(np.diff(verified.prediction.times)[:-1], 0.1) and len(verified.prediction.times) > 10
+    with pytest.raises(HlpError, match=r"optimiser\.rollout_sample_period must be > 0"):
+        on(scene, "optimiser: {rollout_sample_period: 0.0}")
 
 
 def test_a_gripper_closed_among_the_obstacles_does_not_carry_one_into_the_target():

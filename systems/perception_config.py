@@ -36,8 +36,8 @@ class CameraSettings:
         up: the world direction the image's top points to (must not be parallel to the view; default
             3 degrees from +x, the table's far edge at the top of the image: turned so, edges along
             the table's axes cross the pixel grid and locate to a fraction of a pixel; along the
-            grid they cannot, and at 15 objects 94.4 % of the plans' row decisions matched the true
-            scene's instead of 98.1 %, docs/perception.md).
+            grid they cannot: at 15 objects 94.4 % of the plans' row decisions matched the true
+            scene's, turned 1-5 degrees 95.6-98.8 %, docs/perception.md).
         min_depth, max_depth: the depth sensor's range, m; nearer or further pixels have no depth.
         depth_noise: standard deviation of the Gaussian noise added to every depth pixel, m.
         dropout: fraction of depth pixels that return no depth (NaN), chosen at random.

@@ -55,7 +55,8 @@ def summary(result) -> str:
     verified = (result.optimisation or {}).get("verifications", 0)
     if verified:
         optimiser += (
-            f", {verified} verified on the execution model ({result.optimisation['rejected']} rejected)"
+            f", {verified} verified on the execution model ({result.optimisation['rejected']} rejected, "
+            f"{result.optimisation.get('verify_s', 0.0):.1f} s of it)"
         )
     loop = result.closed_loop
     if loop:

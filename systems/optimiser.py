@@ -55,6 +55,7 @@ class StoResult:
         start: which sequence the result grew from: 0 the initial one, i >= 1 the i-th alternative.
         verifications: passing rollouts simulated again on the execution model (not in ``rollouts``).
         rejected: of those, how many failed there (their rollout passed, the execution model's did not).
+        verify_s: wall-clock time of the verifications, s (part of ``optimise_s``).
     """
 
     sequence: ControlSequence
@@ -69,6 +70,7 @@ class StoResult:
     start: int = 0
     verifications: int = 0
     rejected: int = 0
+    verify_s: float = 0.0
 
     def to_dict(self) -> dict:
         return {
@@ -81,6 +83,7 @@ class StoResult:
             "start": self.start,
             "verifications": self.verifications,
             "rejected": self.rejected,
+            "verify_s": self.verify_s,
             "final_cost": self.outcome.cost if self.outcome is not None else None,
             "cost_terms": dict(self.outcome.terms) if self.outcome is not None else {},
             "costs": list(self.costs),
@@ -164,6 +167,7 @@ class _Run:
     ) -> None:
         self.scenario, self.pool, self.budget, self.start = scenario, pool, budget, start
         self.rollouts = self.verifications = self.rejected = 0
+        self.verify_s = 0.0
 
     def roll(self, sequences: list[ControlSequence]) -> list[RolloutOutcome]:
         """The rollouts of ``sequences`` (on the rollout model, from the run's start)."""
@@ -187,7 +191,9 @@ class _Run:
                     failure_reason="passed its rollout, but the verifications ran out",
                 )
                 continue
+            started = time.perf_counter()
             (verified,) = self.pool.rollouts(self.scenario, [sequences[i]], start=self.start, verify=True)
+            self.verify_s += time.perf_counter() - started
             self.verifications += 1
             if verified.success:
                 outcomes[i] = replace(outcomes[i], verification=verified)
@@ -300,6 +306,7 @@ def optimise(
     if not result.success and result.iterations >= budget.max_iterations and result.failure_reason:
         result.failure_reason = f"{result.failure_reason} (after {result.iterations} iterations)"
     result.rollouts, result.verifications, result.rejected = run.rollouts, run.verifications, run.rejected
+    result.verify_s = run.verify_s
     result.optimise_s = time.perf_counter() - started
     return result
 

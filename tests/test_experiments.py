@@ -39,13 +39,15 @@ def cheap_job(job: Job) -> dict:
     rng = random.Random(f"{job.scene}/{job.planner}")
     scene = job.make_scene()
     success = rng.random() < (0.9 if job.planner == "hlp" else 0.7)
+    optimise_s = rng.uniform(0.5, 2.0) * (1 if job.planner == "hlp" else 10)
     return make_row(
         job,
         success=success,
         failure_reason=None if success else "the target is out of reach",
         plan_s=rng.uniform(0.01, 0.1),
         ik_s=rng.uniform(0.1, 0.5),
-        optimise_s=rng.uniform(0.5, 2.0) * (1 if job.planner == "hlp" else 10),
+        optimise_s=optimise_s,
+        verify_s=optimise_s * rng.uniform(0.2, 0.8),
         execute_s=rng.uniform(2, 4),
         rollouts=rng.randint(8, 80),
         iterations=rng.randint(1, 10),
@@ -256,12 +258,20 @@ def test_summary_matches_the_csv_and_shows_the_paper_numbers(tmp_path):
             assert stats["success_pct"] == pytest.approx(100 * group.success.mean())
             assert stats["total_s"] == pytest.approx(group.total_s.mean(), abs=1e-4)
             assert stats["init_s"] + stats["optimise_s"] == pytest.approx(stats["total_s"], abs=2e-4)
+            assert 0 < stats["verify_s"] == pytest.approx(group.verify_s.mean(), abs=1e-4)
             assert stats["paper"]["total_s"] is None
         means = {
             p: frame[(frame.objects == condition["objects"]) & (frame.planner == p)].total_s.mean()
             for p in ("hlp", "sto")
         }
         assert condition["hlp_to_sto_total"] == pytest.approx(means["hlp"] / means["sto"], rel=1e-3)
+        searching = {
+            p: (group.total_s - group.verify_s).mean()
+            for p, group in frame[frame.objects == condition["objects"]].groupby("planner")
+        }
+        assert condition["hlp_to_sto_total_without_verification"] == pytest.approx(
+            searching["hlp"] / searching["sto"], rel=1e-3
+        )
     papers = {
         c["objects"]: tuple(c["planners"][p]["paper"]["success_pct"] for p in ("hlp", "sto"))
         for c in summary["conditions"]
@@ -285,6 +295,7 @@ def test_gen1_summary_has_table_ii_paper_figures():
             "init_s": 0.5,
             "optimise_s": 1.0 if p == "hlp" else 10.0,
             "total_s": 1.5 if p == "hlp" else 10.5,
+            "verify_s": 0.6 if p == "hlp" else 2.0,
             "execute_s": 3.0,
         }
         for i in range(4)
@@ -299,6 +310,7 @@ def test_gen1_summary_has_table_ii_paper_figures():
             "init_s": float("nan"),
             "optimise_s": float("nan"),
             "total_s": float("nan"),
+            "verify_s": float("nan"),
         }
     )
     (condition,) = summarise("gen1", rows)["conditions"]
@@ -307,6 +319,8 @@ def test_gen1_summary_has_table_ii_paper_figures():
     assert sto["paper"] == {"success_pct": 84.0, "init_s": 0.04, "optimise_s": 17.84, "total_s": 17.88}
     assert (hlp["n"], hlp["success_pct"], hlp["crashed"], hlp["total_s"]) == (5, 60.0, 1, 1.5)
     assert condition["hlp_to_sto_total"] == pytest.approx(1.5 / 10.5, abs=1e-4)
+    assert condition["hlp_to_sto_total_without_verification"] == pytest.approx(0.9 / 8.5, abs=1e-4)
+    assert (hlp["verify_s"], sto["verify_s"]) == (0.6, 2.0)
     assert condition["paper_hlp_to_sto_total"] == pytest.approx(1.56 / 17.88, abs=1e-4)
     assert hlp["success_ci95"][0] < 60.0 < hlp["success_ci95"][1]
 

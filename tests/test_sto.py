@@ -298,8 +298,10 @@ def test_a_failed_initial_rollout_goes_on_from_the_planners_first_passing_altern
         assert passed.success and passed.start == 0 and passed.rollouts == 1 and not calls  # not needed
         assert passed.verifications == 1 and passed.rejected == 0  # verified on the execution model
         assert passed.outcome.verification.success and passed.outcome.verification.wall_s > 0
+        assert passed.outcome.verification.wall_s <= passed.verify_s <= passed.optimise_s
         unverified = optimise(config.updated("optimiser: {max_verifications: 0}"), reaching, pool)
         assert not unverified.success and "verifications ran out" in unverified.failure_reason
+        assert unverified.verify_s == 0.0 and unverified.to_dict()["verify_s"] == 0.0
         result = optimise(config, stuck, pool, alternatives=alternatives)
         assert calls == [1]
         assert result.success and result.iterations == 0 and result.start == 2  # the first that passes

@@ -2,9 +2,9 @@
 
 Columns (in this order): the paper's ``scene, objects, planner, success, failure_reason, init_s,
 optimise_s, total_s, rollouts, objects_moved, objects_dropped``, then ``seed, iterations,
-verifications, rejected, passed_then_failed, replans, replan_rollouts, execute_s`` (``rollouts``
-counts the optimiser's rollouts, ``verifications`` its checks on the execution model, of which
-``rejected`` failed there; ``passed_then_failed``: the optimiser accepted a sequence and the
+verifications, rejected, verify_s, passed_then_failed, replans, replan_rollouts, execute_s``
+(``rollouts`` counts the optimiser's rollouts, ``verifications`` its checks on the execution model, of
+which ``rejected`` failed there, ``verify_s`` the seconds they took, part of ``optimise_s``; ``passed_then_failed``: the optimiser accepted a sequence and the
 execution failed; ``replans`` and ``replan_rollouts``: the closed-loop controller's).
 Times are seconds; ``init_s`` = plan + IK, ``total_s`` = init + optimise (planning time: the simulated
 execution, ``execute_s``, is excluded); ``objects_moved`` and ``objects_dropped`` are counts.
@@ -40,13 +40,14 @@ COLUMNS = (
     "iterations",
     "verifications",
     "rejected",
+    "verify_s",
     "passed_then_failed",
     "replans",
     "replan_rollouts",
     "execute_s",
 )
 BOOL_COLUMNS = frozenset({"success", "passed_then_failed"})
-FLOAT_COLUMNS = frozenset({"init_s", "optimise_s", "total_s", "execute_s"})
+FLOAT_COLUMNS = frozenset({"init_s", "optimise_s", "total_s", "verify_s", "execute_s"})
 INT_COLUMNS = frozenset(COLUMNS) - BOOL_COLUMNS - FLOAT_COLUMNS - {"scene", "planner", "failure_reason"}
 BOOLEANS = {"true": True, "false": False}
 

@@ -51,7 +51,8 @@ COMMON_NOTES = [
         "Times are planning times per scene in seconds, means over all scenes of the condition (successes "
         "and failures): init = high-level plan + keypoint IK (plan_s + ik_s), optimisation = the stochastic "
         "trajectory optimiser, total = init + optimisation. The simulated execution (execute_s in "
-        "results.csv) is excluded."
+        "results.csv) is excluded. Verification = the optimiser's checks of a passing rollout on the "
+        "execution model (verify_s, part of optimisation); the ratio without it compares the search alone."
     ),
     (
         "Success % is followed by its 95 % Wilson interval; success = the target in the gripper's pre-grasp "
@@ -109,6 +110,10 @@ def _ratio(numerator: float | None, denominator: float | None) -> float | None:
     return round(numerator / denominator, 4)
 
 
+def _less(total: float | None, part: float | None) -> float | None:
+    return None if total is None or part is None else total - part
+
+
 def planner_stats(rows: list[Row], paper: PaperFigures) -> dict[str, Any]:
     """n, successes, success % (and interval), crashes and mean times of one planner in one condition."""
     n = len(rows)
@@ -120,7 +125,7 @@ def planner_stats(rows: list[Row], paper: PaperFigures) -> dict[str, Any]:
         "success_ci95": wilson_interval(successes, n),
         "crashed": sum((row["failure_reason"] or "").startswith("crashed:") for row in rows),
     }
-    stats.update({column: _mean(row[column] for row in rows) for column in (*TIMES, "execute_s")})
+    stats.update({column: _mean(row[column] for row in rows) for column in (*TIMES, "verify_s", "execute_s")})
     stats["rollouts_mean"] = _mean(row.get("rollouts", 0) for row in rows)
     stats["passed_then_failed"] = sum(bool(row.get("passed_then_failed")) for row in rows)
     stats["paper"] = asdict(paper)
@@ -147,6 +152,10 @@ def summarise(kind: str, rows: Iterable[Row], measured_on: str | None = None) ->
                 "objects": objects,
                 "planners": planners,
                 "hlp_to_sto_total": _ratio(hlp.get("total_s"), sto.get("total_s")),
+                "hlp_to_sto_total_without_verification": _ratio(
+                    _less(hlp.get("total_s"), hlp.get("verify_s")),
+                    _less(sto.get("total_s"), sto.get("verify_s")),
+                ),
                 "paper_hlp_to_sto_total": _ratio(
                     paper_figures(kind, objects, "hlp").total_s, paper_figures(kind, objects, "sto").total_s
                 ),
@@ -200,22 +209,27 @@ def summary_markdown(summary: dict[str, Any]) -> str:
     ]
     for condition in summary["conditions"]:
         lines += _table_rows(condition)
-    lines += ["", "| condition | HLP / STO mean total time | paper |", "|---|---:|---:|"]
+    lines += [
+        "",
+        "| condition | HLP / STO mean total time | without verification | paper |",
+        "|---|---:|---:|---:|",
+    ]
     for condition in summary["conditions"]:
         lines.append(
             f"| {condition['condition']} | {_number(condition['hlp_to_sto_total'], 3)} | "
+            f"{_number(condition['hlp_to_sto_total_without_verification'], 3)} | "
             f"{_number(condition['paper_hlp_to_sto_total'], 3)} |"
         )
     lines += [
         "",
-        "| condition | planner | rollouts (mean) | rollout passed, execution failed |",
-        "|---|---|---:|---:|",
+        "| condition | planner | rollouts (mean) | verification s (mean) | rollout passed, execution failed |",
+        "|---|---|---:|---:|---:|",
     ]
     for condition in summary["conditions"]:
         for planner, stats in condition["planners"].items():
             lines.append(
                 f"| {condition['condition']} | {PLANNER_LABELS[planner]} | {_number(stats['rollouts_mean'], 1)} | "
-                f"{stats['passed_then_failed']} of {stats['n']} |"
+                f"{_number(stats['verify_s'])} | {stats['passed_then_failed']} of {stats['n']} |"
             )
     lines += ["", "Notes:", ""] + [f"- {note}" for note in summary["notes"]]
     return "\n".join(lines) + "\n"

@@ -24,7 +24,13 @@ from hlp_drake.cli import run_cli
 from hlp_drake.errors import HlpError
 from hlp_drake.experiments import ExperimentSettings, Job, make_row, run_experiment
 from hlp_drake.experiments.cli import main
-from hlp_drake.experiments.results import COLUMNS, read_results, results_csv, write_durable
+from hlp_drake.experiments.results import (
+    COLUMNS,
+    EARLIER_COLUMNS,
+    read_results,
+    results_csv,
+    write_durable,
+)
 from hlp_drake.experiments.summary import summarise
 
 # fmt: off
@@ -157,6 +163,31 @@ def test_interrupt_keeps_exactly_the_finished_rows_and_resume_runs_only_the_rest
     assert (out / "results.csv").read_text() == (reference / "results.csv").read_text()
     run = json.loads((out / "run.json").read_text())
     assert run["status"] == "complete" and run["jobs"]["kept"] == 4 and len(run["earlier_runs"]) == 1
+
+
+def test_a_results_file_from_before_verify_s_resumes_with_it_unknown(tmp_path):
+    reference = tmp_path / "reference"
+    run_experiment(settings(), reference, job=cheap_job)
+    frame = pd.read_csv(reference / "results.csv", dtype=str, keep_default_na=False)
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "config.json").write_text((reference / "config.json").read_text())
+    earlier = frame[list(EARLIER_COLUMNS)].iloc[:4]  # two scenes, as written before the column
+    earlier.to_csv(out / "results.csv", index=False, lineterminator="\n")
+    rows = read_results(out / "results.csv")
+    assert len(rows) == 4 and all(row["verify_s"] != row["verify_s"] for row in rows)  # NaN
+    assert [list(row) for row in rows] == [list(COLUMNS)] * 4
+    resumed = RecordingJob()
+    summary = run_experiment(settings(), out, job=resumed)
+    assert resumed.ran == [("gen1-12", "hlp"), ("gen1-12", "sto")]
+    written = pd.read_csv(out / "results.csv")
+    assert tuple(written.columns) == COLUMNS and written.verify_s.isna().sum() == 4
+    (condition,) = summary["conditions"]
+    hlp = written[written.planner == "hlp"]
+    assert condition["planners"]["hlp"]["verify_s"] == pytest.approx(hlp.verify_s.mean(), abs=1e-4)
+    (out / "results.csv").write_text("scene,planner\ngen1-0,hlp\n")
+    with pytest.raises(HlpError, match="unexpected columns"):
+        read_results(out / "results.csv")
 
 
 def test_interrupt_in_a_process_pool_then_resume(tmp_path):

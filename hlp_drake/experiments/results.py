@@ -46,6 +46,8 @@ COLUMNS = (
     "replan_rollouts",
     "execute_s",
 )
+EARLIER_COLUMNS = tuple(c for c in COLUMNS if c != "verify_s")
+"""The columns before ``verify_s``: such a file is read with ``verify_s`` NaN (unknown), and resumed."""
 BOOL_COLUMNS = frozenset({"success", "passed_then_failed"})
 FLOAT_COLUMNS = frozenset({"init_s", "optimise_s", "total_s", "verify_s", "execute_s"})
 INT_COLUMNS = frozenset(COLUMNS) - BOOL_COLUMNS - FLOAT_COLUMNS - {"scene", "planner", "failure_reason"}
@@ -93,7 +95,7 @@ def results_csv(rows: Iterable[Row]) -> str:
 
 
 def read_results(path: Path) -> list[Row]:
-    """The rows of ``path`` (none when it does not exist).
+    """The rows of ``path`` (none when it does not exist; ``verify_s`` NaN in an ``EARLIER_COLUMNS`` file).
 
     Raises:
         HlpError: the file has other columns or a malformed row (one line, naming the file and line).
@@ -103,16 +105,17 @@ def read_results(path: Path) -> list[Row]:
     with path.open(newline="", encoding="utf-8") as file:
         reader = csv.reader(file)
         header = tuple(next(reader, ()))
-        if header != COLUMNS:
+        if header not in (COLUMNS, EARLIER_COLUMNS):
             raise HlpError(
                 f"{path}: not an experiment results file (unexpected columns); use --fresh to start over"
             )
         rows = []
         for record in reader:
             try:
-                if len(record) != len(COLUMNS):
+                if len(record) != len(header):
                     raise ValueError(f"{len(record)} fields")
-                rows.append({column: _parse(column, text) for column, text in zip(COLUMNS, record)})
+                row = {"verify_s": float("nan")} | {c: _parse(c, text) for c, text in zip(header, record)}
+                rows.append({column: row[column] for column in COLUMNS})
             except (KeyError, ValueError) as error:
                 raise HlpError(
                     f"{path}: line {reader.line_num}: malformed row ({error}); use --fresh to start over"

@@ -285,9 +285,10 @@ def plan_and_execute(
     if execution == "open" and error is None and meshcat is None and result.failure_reason is None:
         reached = verified_reach(optimisation, scenario)
     result.reach_reused = reached is not None
-    if execution == "open" or result.failure_reason is None:  # closed loop: only an optimised sequence
+    executing = execution == "open" or result.failure_reason is None  # closed loop: an optimised sequence
+    if executing:
         _execute(result, simulator, command, scenario, meshcat, listener, reached)
-    if execution == "closed" and result.failure_reason is None:
+    if execution == "closed" and executing:  # what the controller did, the execution failed or not
         result.closed_loop = controller.record(simulator.get_context()).to_dict()
     executed = time.perf_counter()
     result.success = result.failure_reason is None

@@ -578,3 +578,22 @@ def test_the_gripper_slides_onto_the_target_along_its_approach_axis():
     assert before.position == pytest.approx(
         (space.rects[scene.target.name].x_min - APPROACH_GAP, scene.target.y)
     )
+
+
+def test_a_failed_closed_loop_execution_still_reports_what_the_controller_did(tmp_path):
+    out, config = tmp_path / "run.json", tmp_path / "one_rollout.yaml"
+    config.write_text(  # the straight line, never improved: it fails on this scene (as it did optimised)
+        "optimiser: {samples: 1, max_iterations: 1, max_rollouts: 1, verify: false}\n"
+        "closed_loop: {replan_period: 2.0, iterations: 1, rollouts: 1}\n"
+    )
+    args = ["--kind", "gen1", "--seed", "46", "--planner", "sto", "--workers", "1", "--config", str(config)]
+    result = run_module("hlp_drake.run_scene", *args, "--execution", "closed", "--json", str(out))
+    assert result.returncode == 1 and "Traceback" not in result.stderr, result.stderr
+    report = json.loads(out.read_text())
+    assert not report["success"] and report["failure_reason"].startswith("in execution")
+    loop = report["closed_loop"]
+    # one rollout per re-optimisation, and one more for the remainder where it re-planned the scene
+    assert (
+        loop["replans"] >= 1 and loop["replans"] <= loop["rollouts"] == loop["replans"] + loop["initialised"]
+    )
+    assert "closed loop:" in result.stdout

@@ -60,7 +60,10 @@ def summary(result) -> str:
         )
     loop = result.closed_loop
     if loop:
-        optimiser += f"; closed loop: {loop['replans']} re-optimisations, {loop['rollouts']} rollouts"
+        optimiser += (
+            f"; closed loop: {loop['replans']} re-optimisations, {loop['rollouts']} rollouts, "
+            f"{loop['on_track']} periods on track"
+        )
     lines = [
         (
             f"timings: plan {t['plan_s']:.3f} s, IK {t['ik_s']:.2f} s, {optimiser}, execute {t['execute_s']:.1f} s "

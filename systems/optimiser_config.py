@@ -178,6 +178,9 @@ class ClosedLoopConfig:
         replan_distance: an object this far from where the current plan's rollout put it has
             "moved far": the controller asks for a new initial sequence (the planner's, on the
             observed scene) and optimises from it, the remainder of the current one its alternative, m.
+        track_distance: while every observed object is within this of where the initial sequence's
+            verification on the execution model had it, that verified sequence is on track and is
+            kept without re-optimising (0: always re-optimise), m.
     """
 
     enabled: bool = False
@@ -185,3 +188,4 @@ class ClosedLoopConfig:
     iterations: int = 1
     rollouts: int = 9
     replan_distance: float = 0.05
+    track_distance: float = 0.005

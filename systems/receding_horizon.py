@@ -23,7 +23,10 @@ not measured start at rest where the observed scene has them) with the budget of
 ``closed_loop.iterations`` and ``closed_loop.rollouts``; the result's sequence is commanded from then
 on (the optimiser's acceptance is monotone: the remainder unless a candidate is cheaper or passes;
 re-optimisations do not verify on the execution model: the execution itself goes on from there).
-When an observed object is farther than ``closed_loop.replan_distance`` from where the current
+While the initial sequence passed its verification on the execution model and every observed object
+is within ``closed_loop.track_distance`` of where that verification had it (the plan is on track:
+the world is the model it was verified on), the controller keeps it and does not re-optimise; from
+the first re-plan off track on it re-optimises at every period. When an observed object is farther than ``closed_loop.replan_distance`` from where the current
 sequence's rollout put it (objects matched by name), and an ``initialiser`` is given, its sequence
 for the observed scene from the robot's measured state (e.g. the planner's) is optimised instead,
 the remainder its alternative. An observed scene without a target (a failed frame) is not used: the
@@ -66,8 +69,10 @@ Initialiser = Callable[[Scene, np.ndarray], "ControlSequence | None"]
 @dataclass(frozen=True)
 class ControllerRecord:
     """The controller's state: the commanded ``sequence`` (started at simulated time ``t0``), the
-    prediction of its last rollout and the ``scene`` that rollout was on, the last good observed
-    scene, and what the re-optimisations and observations did."""
+    prediction of its last rollout and the ``scene`` that rollout was on, the verified initial
+    sequence's prediction on the execution model while the plan is on track (``track``, from
+    ``track_t0``), the last good observed scene, and what the re-optimisations and observations did
+    (``on_track``: re-plans skipped on track)."""
 
     sequence: ControlSequence | None = None
     t0: float = 0.0
@@ -82,10 +87,14 @@ class ControllerRecord:
     observations: int = 0
     observation_failures: int = 0
     observation_reason: str | None = None
+    track: Prediction | None = None
+    track_t0: float = 0.0
+    on_track: int = 0
 
     def to_dict(self) -> dict:
         return {
             "replans": self.replans,
+            "on_track": self.on_track,
             "rollouts": self.rollouts,
             "initialised": self.initialised,
             "changed": self.changed,
@@ -191,6 +200,8 @@ class RecedingHorizonController(LeafSystem):
     def _initialise(self, context: Context, state: State) -> None:
         result: StoResult = self._initial.Eval(context)
         prediction = None if result.outcome is None else result.outcome.prediction
+        verified = None if result.outcome is None else result.outcome.verification
+        track = verified.prediction if verified is not None and verified.success else None
         record = self._observe(context, ControllerRecord())
         state.get_mutable_abstract_state(int(self._record)).set_value(
             replace(
@@ -199,6 +210,8 @@ class RecedingHorizonController(LeafSystem):
                 t0=float(context.get_time()),
                 prediction=prediction,
                 scene=record.observed,
+                track=track,
+                track_t0=float(context.get_time()),
             )
         )
 
@@ -213,6 +226,11 @@ class RecedingHorizonController(LeafSystem):
         record = self._observe(context, record)
         if record.observed is None:  # never a good scene: nothing to plan on
             state.get_mutable_abstract_state(int(self._record)).set_value(record)
+            return
+        if self._on_track(record, t):  # the verified sequence goes on as verified
+            state.get_mutable_abstract_state(int(self._record)).set_value(
+                replace(record, on_track=record.on_track + 1)
+            )
             return
         states = self._states(context)
         measured = all(o.name in states for o in record.observed.objects)
@@ -252,8 +270,22 @@ class RecedingHorizonController(LeafSystem):
                 changed=record.changed + int(result.sequence is not rest),
                 reason=result.failure_reason,
                 scene=scene,
+                track=None,  # off track: re-optimised from here on
             )
         )
+
+    def _on_track(self, record: ControllerRecord, t: float) -> bool:
+        """Whether every observed object is within ``closed_loop.track_distance`` of where the
+        verified initial sequence's run on the execution model had it at ``t`` (paired by
+        position, ``largest_displacement``)."""
+        distance = self._scenario.closed_loop.track_distance
+        if record.track is None or distance <= 0:
+            return False
+        expected = record.track.at(t - record.track_t0)
+        if expected is None:
+            return False
+        observed = np.array([o.position for o in record.observed.objects])
+        return largest_displacement(expected[0], observed) <= distance
 
     def _moved_far(self, record: ControllerRecord, t: float) -> bool:
         """Whether an observed object is farther than ``closed_loop.replan_distance`` from where the

@@ -129,6 +129,12 @@ def scenario_problems(scenario: Scenario) -> list[str]:
         positive(f"optimiser.cost.{name}", getattr(sto.cost, name), zero_ok=True)
     for name in TransferConfig.__dataclass_fields__:  # every margin may be 0, every length must be > 0
         positive(f"transfer.{name}", getattr(scenario.transfer, name), zero_ok=name.endswith("margin"))
+    closed = scenario.closed_loop
+    positive("closed_loop.replan_period", closed.replan_period)
+    count("closed_loop.iterations", closed.iterations, 0, 10_000)
+    count("closed_loop.rollouts", closed.rollouts, 1, 1_000_000)
+    positive("closed_loop.replan_distance", closed.replan_distance)
+    positive("closed_loop.track_distance", closed.track_distance, zero_ok=True)
     for name in ("close_s", "lift_s", "held_height"):
         positive(f"grasp.{name}", getattr(grasp, name))
     for name in ("lift_height", "hold_s"):

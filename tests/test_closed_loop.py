@@ -121,3 +121,26 @@ def test_an_object_far_from_where_the_plan_expected_it_asks_for_a_new_initial_se
     assert record.replans == 1 and record.initialised == 1 and len(calls) == 1
     assert calls[0][0].target.name == scenario.scene.target.name and len(calls[0][1]) == 22
     assert record.observations == 2 and record.observation_failures == 0  # at the start and the re-plan
+
+
+def test_a_verified_sequence_on_track_is_kept_and_re_optimised_once_off_track(scenario):
+    sequence = forward(RolloutWorld(scenario).start_positions, 0.0, 1.6)  # the robot holds still
+    positions = np.array([[o.x, o.y, 0.8] for o in scenario.scene.objects])
+
+    def verified(offset: float, *, passed: bool = True) -> RolloutOutcome:
+        shifted = positions + [offset, 0.0, 0.0]
+        prediction = Prediction(np.array([0.0, 2.0]), np.stack([shifted, shifted]), np.zeros((2, 3)))
+        check = RolloutOutcome(1.0, {}, passed, None, 0.0, prediction=prediction)
+        return RolloutOutcome(1.0, {}, True, None, 0.0, prediction=prediction, verification=check)
+
+    record, desired, _ = run_controller(scenario, sequence, 1.0, outcome=verified(0.0))
+    assert (record.on_track, record.replans, record.rollouts) == (2, 0, 0)  # at 0.4 s and 0.8 s
+    assert record.sequence is not None and record.t0 == 0.0 and record.to_dict()["on_track"] == 2
+    np.testing.assert_allclose(desired[:11], sequence.to_trajectory().value(1.0).ravel())
+    off = 2 * scenario.closed_loop.track_distance  # every object 1 cm from where it was verified
+    for outcome in (verified(off), verified(0.0, passed=False)):
+        record, _, _ = run_controller(scenario, sequence, 1.0, outcome=outcome)
+        assert (record.on_track, record.replans) == (0, 2) and record.track is None
+    always = scenario.updated("closed_loop: {track_distance: 0.0}\n")
+    record, _, _ = run_controller(always, sequence, 1.0, outcome=verified(0.0))
+    assert (record.on_track, record.replans) == (0, 2)

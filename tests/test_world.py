@@ -131,6 +131,9 @@ def test_a_scenarios_scene_is_read_whole_in_the_scene_file_format(tmp_path):
         ("planner: {kind: astar}\n", "planner.kind: expected one of hlp, sto, got 'astar'"),
         ("scene: {table: 3}\n", "scene.table: expected a mapping"),
         ("grasp: {lift_s: 0.0}\n", "grasp.lift_s"),
+        ("closed_loop: {replan_period: 0.0}\n", "closed_loop.replan_period must be > 0, got 0.0"),
+        ("closed_loop: {rollouts: 0}\n", "closed_loop.rollouts must be between 1 and 1000000, got 0"),
+        ("closed_loop: {track_distance: -0.01}\n", "closed_loop.track_distance must be >= 0"),
     ],
 )
 def test_bad_scenario_file_raises_one_line_hlp_errors_naming_the_file_and_field(tmp_path, text, problem):

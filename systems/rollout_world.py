@@ -240,11 +240,14 @@ class RolloutWorld:
         }
 
     def advance_to(self, t: float) -> str | None:
-        """Simulate up to time ``t``; why the solver failed (None if it did not)."""
+        """Simulate up to time ``t``; why the solver failed (None if it did not), a state that is not
+        finite at the end counting as a failure (every later query of it would fail in Drake)."""
         try:
             self._simulator.AdvanceTo(float(t))
         except (RuntimeError, SystemExit) as error:
             return f"the solver failed at t = {self._context.get_time():.2f} s: {simulation_failure(error)}"
+        if not np.all(np.isfinite(self.plant.GetPositionsAndVelocities(self._plant_context))):
+            return f"the solver diverged: the state is not finite at t = {self._context.get_time():.2f} s"
         return None
 
     def time(self) -> float:

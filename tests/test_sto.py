@@ -218,6 +218,9 @@ def test_a_drake_internal_check_failing_mid_rollout_is_a_failure_and_the_world_g
     clean = RolloutWorld(on(scene)).rollout(sequence)
     again = world.rollout(sequence)
     assert (again.cost, again.success, again.fallen) == (clean.cost, clean.success, clean.fallen)
+    world.begin(sequence)  # a solver that diverged without failing: the state is not finite after it
+    state.SetFromVector(x)
+    assert world.advance_to(0.0) == "the solver diverged: the state is not finite at t = 0.00 s"
 
 
 def test_only_drake_failures_count_as_simulation_failures():

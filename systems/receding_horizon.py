@@ -26,10 +26,10 @@ re-optimisations do not verify on the execution model: the execution itself goes
 While the initial sequence passed its verification on the execution model and every observed object
 is within ``closed_loop.track_distance`` of where that verification had it (the plan is on track:
 the world is the model it was verified on), the controller keeps it and does not re-optimise; from
-the first re-plan off track on it re-optimises at every period. When an observed object is farther than ``closed_loop.replan_distance`` from where the current
-sequence's rollout put it (objects matched by name), and an ``initialiser`` is given, its sequence
-for the observed scene from the robot's measured state (e.g. the planner's) is optimised instead,
-the remainder its alternative. An observed scene without a target (a failed frame) is not used: the
+the first re-plan off track on it re-optimises at every period. When an observed object is farther
+than ``closed_loop.replan_distance`` from where the current sequence's rollout put it (objects
+paired by position), and an ``initialiser`` is given, its sequence for the observed scene from the
+robot's measured state (e.g. the planner's) is optimised instead, the remainder its alternative. An observed scene without a target (a failed frame) is not used: the
 last good one is kept and the reason counted. The commanded sequence, the scene its rollout
 predicted and the counts live in the context's abstract state (``ControllerRecord``).
 """
@@ -70,8 +70,8 @@ Initialiser = Callable[[Scene, np.ndarray], "ControlSequence | None"]
 class ControllerRecord:
     """The controller's state: the commanded ``sequence`` (started at simulated time ``t0``), the
     prediction of its last rollout and the ``scene`` that rollout was on, the verified initial
-    sequence's prediction on the execution model while the plan is on track (``track``, from
-    ``track_t0``), the last good observed scene, and what the re-optimisations and observations did
+    sequence's prediction on the execution model while the plan is on track (``track``; the
+    sequence is then the initial one, from ``t0``), the last good observed scene, and what the re-optimisations and observations did
     (``on_track``: re-plans skipped on track)."""
 
     sequence: ControlSequence | None = None
@@ -88,7 +88,6 @@ class ControllerRecord:
     observation_failures: int = 0
     observation_reason: str | None = None
     track: Prediction | None = None
-    track_t0: float = 0.0
     on_track: int = 0
 
     def to_dict(self) -> dict:
@@ -211,7 +210,6 @@ class RecedingHorizonController(LeafSystem):
                 prediction=prediction,
                 scene=record.observed,
                 track=track,
-                track_t0=float(context.get_time()),
             )
         )
 
@@ -274,32 +272,30 @@ class RecedingHorizonController(LeafSystem):
             )
         )
 
+    @staticmethod
+    def _off_by(prediction: Prediction | None, record: ControllerRecord, t: float) -> float | None:
+        """How far the observed object that moved most is at ``t`` from where ``prediction`` (of
+        the sequence commanded from ``record.t0``) had it, infinite if one appeared or went (the
+        objects paired by position, ``largest_displacement``: a perceived scene's names follow the
+        objects' order on the table, which a frame's noise may swap); None without a prediction."""
+        expected = None if prediction is None else prediction.at(t - record.t0)
+        if expected is None:
+            return None
+        observed = np.array([o.position for o in record.observed.objects])
+        return largest_displacement(expected[0], observed)
+
     def _on_track(self, record: ControllerRecord, t: float) -> bool:
         """Whether every observed object is within ``closed_loop.track_distance`` of where the
-        verified initial sequence's run on the execution model had it at ``t`` (paired by
-        position, ``largest_displacement``)."""
+        verified initial sequence's run on the execution model had it at ``t``."""
         distance = self._scenario.closed_loop.track_distance
-        if record.track is None or distance <= 0:
-            return False
-        expected = record.track.at(t - record.track_t0)
-        if expected is None:
-            return False
-        observed = np.array([o.position for o in record.observed.objects])
-        return largest_displacement(expected[0], observed) <= distance
+        off = self._off_by(record.track, record, t) if distance > 0 else None
+        return off is not None and off <= distance
 
     def _moved_far(self, record: ControllerRecord, t: float) -> bool:
         """Whether an observed object is farther than ``closed_loop.replan_distance`` from where the
-        commanded sequence's rollout put it at ``t``, or one appeared or went (the objects paired
-        by position, ``largest_displacement``: a perceived scene's names follow the objects' order
-        on the table, which a frame's noise may swap)."""
-        if record.prediction is None or record.scene is None:
-            return False
-        expected = record.prediction.at(t - record.t0)
-        if expected is None:
-            return False
-        positions, _ = expected
-        observed = np.array([o.position for o in record.observed.objects])
-        return largest_displacement(positions, observed) > self._scenario.closed_loop.replan_distance
+        commanded sequence's rollout put it at ``t``, or one appeared or went."""
+        off = None if record.scene is None else self._off_by(record.prediction, record, t)
+        return off is not None and off > self._scenario.closed_loop.replan_distance
 
     def _calc_desired(self, context: Context, output) -> None:
         record: ControllerRecord = context.get_abstract_state(int(self._record)).get_value()

@@ -298,8 +298,6 @@ class RolloutWorld:
         problem = None
         sto = self.scenario.optimiser
         table = self.scene.table
-        if not (np.all(np.isfinite(positions)) and np.all(np.isfinite(tcp))):
-            return Reading(positions, tcp, max_force, table_contact, "a position is not finite")
         # Objects pushed off the edge fall freely (a legitimate outcome); only objects over the table
         # are checked for impossible speeds and for sinking into it.
         over = over_table_mask(positions, table)

@@ -4,8 +4,8 @@ Columns (in this order): the paper's ``scene, objects, planner, success, failure
 optimise_s, total_s, rollouts, objects_moved, objects_dropped``, then ``seed, iterations,
 verifications, rejected, verify_s, passed_then_failed, replans, replan_rollouts, execute_s``
 (``rollouts`` counts the optimiser's rollouts, ``verifications`` its checks on the execution model, of
-which ``rejected`` failed there, ``verify_s`` the seconds they took, part of ``optimise_s``; ``passed_then_failed``: the optimiser accepted a sequence and the
-execution failed; ``replans`` and ``replan_rollouts``: the closed-loop controller's).
+which ``rejected`` failed there, ``verify_s`` the seconds they took, part of ``optimise_s``;
+``passed_then_failed``: the optimiser accepted a sequence and the execution failed; ``replans`` and ``replan_rollouts``: the closed-loop controller's).
 Times are seconds; ``init_s`` = plan + IK, ``total_s`` = init + optimise (planning time: the simulated
 execution, ``execute_s``, is excluded); ``objects_moved`` and ``objects_dropped`` are counts.
 Booleans are ``true``/``false``; a missing failure reason is an empty field.

@@ -2,8 +2,10 @@
 
 ``plan_and_execute(scenario, pool=...)`` builds one diagram: the world (the scenario's plant at its
 own time step), the scene source feeding the planning diagram (``SceneFromPlant`` on the world's
-body poses, or with ``perception.source: camera`` ``ScenePerception`` on its cameras: the planner,
-IK and optimiser then work on the perceived scene while the world simulates the true one), and
+body poses, or with ``perception.source: camera`` the perceived scene: the planner, IK and
+optimiser then work on it while the world simulates the true one; open loop one frame of the
+world's cameras at the start, ``perceive_world``, so the executed world renders nothing; closed
+loop ``ScenePerception`` on the executed world's cameras), and
 what drives the robot: open loop a trajectory source, closed loop (``scenario.closed_loop.enabled``)
 a ``RecedingHorizonController`` re-optimising on the measured state and the scene source's scene
 (re-perceived at every re-plan with cameras). It evaluates the plan, the
@@ -46,7 +48,7 @@ from hlp_drake.systems.rollout_cost import FinalState, pregrasp_check, reach_pro
 from hlp_drake.systems.rollout_pool import RolloutPool
 from hlp_drake.systems.rollout_world import simulation_failure
 from hlp_drake.systems.scene_models import fallen_objects, object_body, object_planar_poses
-from hlp_drake.systems.scene_perception import add_scene_perception
+from hlp_drake.systems.scene_perception import add_scene_perception, perceive_world
 from hlp_drake.systems.scene_source import SCENE_PORT, SceneFromPlant
 from hlp_drake.systems.start_pose import tcp_keypoint_height
 from hlp_drake.systems.world import (
@@ -182,22 +184,27 @@ def plan_and_execute(
     listener = listener or RunListener()
     scene = scenario.scene
     camera = scenario.perception.source == "camera"
+    watching = camera and execution == "closed"  # cameras in the executed world, re-perceived at re-plans
     error = sample_model_error(scenario.uncertainty, scene) if scenario.uncertainty.enabled else None
+    perception, perceive_s = None, 0.0
+    if camera and not watching:  # one frame, in a world of its own: the executed one renders nothing
+        perception, perceive_s = perceive_world(scenario, model_error=error)
+        listener.perceived(perception, perceive_s)
     builder = DiagramBuilder()
     world = builder.AddSystem(
         make_world_diagram(
-            scenario, meshcat=meshcat, contact_forces=contact_forces, cameras=camera, model_error=error
+            scenario, meshcat=meshcat, contact_forces=contact_forces, cameras=watching, model_error=error
         )
     )
     plant, robot = world_plant(world)
     started = time.perf_counter()
     planning = builder.AddNamedSystem("planning", make_planning_diagram(scenario, pool=pool, models=models))
-    if camera:  # the planners see what the cameras see of the (true) world
+    if watching:  # the planners see what the cameras see of the (true) world
         source = add_scene_perception(builder, world, scenario)
     else:  # the plant's poses (of the believed objects, under model error)
         source = builder.AddNamedSystem("scene_from_plant", SceneFromPlant(plant, scene))
         builder.Connect(world.GetOutputPort("body_poses"), source.get_body_poses_input_port())
-    if camera or error is None:  # else the planners plan on the believed scene (fixed below)
+    if watching or (error is None and not camera):  # else a fixed scene (below)
         builder.Connect(source.get_scene_output_port(), planning.GetInputPort(SCENE_PORT))
     if execution == "closed":  # it observes the scene through the same source at every re-plan
         replanner = ObservedScenePlanner(scenario, models=models)  # when objects have moved far
@@ -217,8 +224,7 @@ def plan_and_execute(
         hold = ControlSequence(np.array([0.0, 1.0]), np.vstack([start, start]))
         trajectory_source = add_position_trajectory(builder, world, hold.to_trajectory())
     simulator = Simulator(builder.Build())
-    perception, perceive_s = None, 0.0
-    if camera:  # rendering and perception, timed apart from the planner
+    if watching:  # rendering and perception, timed apart from the planner
         seen = time.perf_counter()
         perception = source.get_perception_output_port().Eval(
             source.GetMyContextFromRoot(simulator.get_context())
@@ -226,11 +232,13 @@ def plan_and_execute(
         perceive_s = time.perf_counter() - seen
         listener.perceived(perception, perceive_s)
     context = planning.GetMyContextFromRoot(simulator.get_mutable_context())
-    if error is not None and not camera:  # the scene the planners believe in
+    if camera and not watching:  # the scene the cameras saw
+        planning.GetInputPort(SCENE_PORT).FixValue(context, perception.scene)
+    elif error is not None and not camera:  # the scene the planners believe in
         planning.GetInputPort(SCENE_PORT).FixValue(context, scene)
     plan: HighLevelPlan = planning.GetOutputPort("plan").Eval(context)
     planned = time.perf_counter()
-    listener.planned(plan, planned - started - perceive_s)
+    listener.planned(plan, planned - started - (perceive_s if watching else 0.0))
     keyframes: Keyframes = planning.GetOutputPort("keyframes").Eval(context)
     trajectory = planning.GetOutputPort("trajectory").Eval(context)
     solved = time.perf_counter()
@@ -243,7 +251,8 @@ def plan_and_execute(
         planning.GetOutputPort("robot_plan").Eval(context),
         execution=execution,
     )
-    result.timings = {"plan_s": planned - started - perceive_s, "ik_s": solved - planned, "optimise_s": 0.0}
+    plan_s = planned - started - (perceive_s if watching else 0.0)
+    result.timings = {"plan_s": plan_s, "ik_s": solved - planned, "optimise_s": 0.0}
     if camera:
         result.perception = perception_record(scene, perception)
         result.timings["perceive_s"] = perceive_s

@@ -7,6 +7,7 @@ block to a world's cameras.
 
 from __future__ import annotations
 
+import time
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -20,8 +21,10 @@ from hlp_drake.systems.cameras import camera_info
 from hlp_drake.systems.depth_points import CameraView
 from hlp_drake.systems.perception import Perception, perceive, unperceived_scene
 from hlp_drake.systems.scene_source import MODEL_SCENE, SCENE_PORT
+from hlp_drake.systems.world import make_world_diagram
 
 if TYPE_CHECKING:
+    from hlp_drake.systems.model_error import ModelError
     from hlp_drake.systems.scenario import Scenario
 
 CAMERA_PORTS = ("depth_image", "label_image", "camera_pose")
@@ -145,4 +148,17 @@ def add_scene_perception(builder: DiagramBuilder, world: Diagram, scenario: Scen
     return block
 
 
-__all__ = ["CAMERA_PORTS", "ScenePerception", "add_scene_perception", "perception_cloud"]
+def perceive_world(scenario: Scenario, *, model_error: ModelError | None = None) -> tuple[Perception, float]:
+    """One frame of ``scenario``'s cameras on its world at the start (``model_error``: the world's
+    own differences from the scenario) and the seconds its rendering and perception took; the
+    world is built for this frame only, so a world executed open loop need not carry the cameras."""
+    builder = DiagramBuilder()
+    world = builder.AddSystem(make_world_diagram(scenario, cameras=True, model_error=model_error))
+    block = add_scene_perception(builder, world, scenario)
+    context = builder.Build().CreateDefaultContext()
+    started = time.perf_counter()
+    perception = block.get_perception_output_port().Eval(block.GetMyContextFromRoot(context))
+    return perception, time.perf_counter() - started
+
+
+__all__ = ["CAMERA_PORTS", "ScenePerception", "add_scene_perception", "perceive_world", "perception_cloud"]

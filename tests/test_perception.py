@@ -14,10 +14,11 @@ from pydrake.systems.sensors import ImageDepth32F, ImageLabel16I
 from hlp_drake.scene.model import Scene, SceneObject, Table
 from hlp_drake.systems.cameras import ROBOT_LABEL, TABLE_LABEL, TARGET_LABEL, DepthNoise, camera_pose
 from hlp_drake.systems.depth_points import view_points
+from hlp_drake.systems.model_error import ModelError, ObjectError
 from hlp_drake.systems.perception_config import CameraSettings, PerceptionConfig
 from hlp_drake.systems.perception_errors import perception_record
 from hlp_drake.systems.scenario import Scenario, load_scenario
-from hlp_drake.systems.scene_perception import ScenePerception, add_scene_perception
+from hlp_drake.systems.scene_perception import ScenePerception, add_scene_perception, perceive_world
 from hlp_drake.systems.world import make_world_diagram, world_plant
 
 CAMERA = CameraSettings(width=320, height=240, depth_noise=0.001, dropout=0.01, seed=4)
@@ -328,6 +329,18 @@ def test_the_perceived_scene_follows_an_object_moved_in_the_plant():
     plant.SetFreeBodyPose(plant_context, body, pose)
     moved = next(o for o in block.get_scene_output_port().Eval(mine).obstacles if o.shape == "cylinder")
     assert moved.x - can.x == pytest.approx(0.05, abs=0.002) and moved.y == pytest.approx(can.y, abs=0.002)
+
+
+def test_perceive_world_sees_the_true_world_not_the_believed_scene():
+    """The one frame an open-loop run plans on: the world's cameras at the start, with its model error."""
+    error = ModelError({"can": ObjectError(dx=0.04, dy=-0.03, dyaw=0.0, mass_scale=1.0, friction_scale=1.0)})
+    believed, _ = perceive_world(SCENARIO)
+    true, seconds = perceive_world(SCENARIO, model_error=error)
+    assert believed.ok and true.ok and seconds > 0.0
+    can = [next(o for o in p.scene.obstacles if o.shape == "cylinder") for p in (believed, true)]
+    assert (can[1].x - can[0].x, can[1].y - can[0].y) == pytest.approx((0.04, -0.03), abs=0.002)
+    assert can[0].x == pytest.approx(0.3, abs=0.003) and can[0].y == pytest.approx(0.2, abs=0.003)
+    assert perceive_rendered(SCENARIO)[1] == believed.scene  # the same frame as the world's own ports
 
 
 def test_off_axis_objects_are_located_without_the_pixel_grids_bias():

@@ -48,7 +48,7 @@ from hlp_drake.systems.scene_models import (
     scene_from_plant,
     set_object_poses,
 )
-from hlp_drake.systems.scene_perception import ScenePerception, add_scene_perception
+from hlp_drake.systems.scene_perception import ScenePerception, add_scene_perception, perceive_world
 from hlp_drake.systems.scene_rollouts import SceneRollouts
 from hlp_drake.systems.scene_source import SceneFromPlant
 from hlp_drake.systems.start_pose import robot_base_pose, robot_position_names, start_configuration
@@ -130,6 +130,7 @@ __all__ = [
     "object_planar_poses",
     "optimise",
     "perceive",
+    "perceive_world",
     "perception_record",
     "plan_and_execute",
     "push_rules",

@@ -181,6 +181,8 @@ class ClosedLoopConfig:
         track_distance: while every observed object is within this of where the initial sequence's
             verification on the execution model had it, that verified sequence is on track and is
             kept without re-optimising (0: always re-optimise), m.
+        max_rollouts: the re-optimisations' rollouts in all, so an execution the controller cannot
+            rescue ends: once spent, the commanded sequence plays to its end without re-optimising.
     """
 
     enabled: bool = False
@@ -189,3 +191,4 @@ class ClosedLoopConfig:
     rollouts: int = 9
     replan_distance: float = 0.05
     track_distance: float = 0.005
+    max_rollouts: int = 300

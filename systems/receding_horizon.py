@@ -20,7 +20,8 @@ unrestricted update: the simulation waits for it), the controller reads the meas
 observed scene, cuts its commanded sequence there (the warm start: its remainder, starting where the
 robot is commanded now) and runs ``optimise`` from the measured state (``RolloutStart``; objects
 not measured start at rest where the observed scene has them) with the budget of
-``closed_loop.iterations`` and ``closed_loop.rollouts``; the result's sequence is commanded from then
+``closed_loop.iterations`` and ``closed_loop.rollouts`` (and within ``closed_loop.max_rollouts`` in
+all: once those are spent, no more re-optimisation); the result's sequence is commanded from then
 on (the optimiser's acceptance is monotone: the remainder unless a candidate is cheaper or passes;
 re-optimisations do not verify on the execution model: the execution itself goes on from there).
 While the initial sequence passed its verification on the execution model and every observed object
@@ -89,6 +90,7 @@ class ControllerRecord:
     observation_reason: str | None = None
     track: Prediction | None = None
     on_track: int = 0
+    budget_spent: bool = False
 
     def to_dict(self) -> dict:
         return {
@@ -101,6 +103,7 @@ class ControllerRecord:
             "observations": self.observations,
             "observation_failures": self.observation_failures,
             "observation_reason": self.observation_reason,
+            "budget_spent": self.budget_spent,
         }
 
 
@@ -215,7 +218,7 @@ class RecedingHorizonController(LeafSystem):
 
     def _replan(self, context: Context, state: State) -> None:
         record: ControllerRecord = context.get_abstract_state(int(self._record)).get_value()
-        if record.sequence is None or record.reason == "commanded":
+        if record.sequence is None or record.reason == "commanded" or record.budget_spent:
             return
         t = float(context.get_time())
         rest = remainder(record.sequence, t - record.t0)
@@ -235,6 +238,10 @@ class RecedingHorizonController(LeafSystem):
         scene = record.scene if measured and record.scene is not None else record.observed
         closed = self._scenario.closed_loop
         sto = self._scenario.optimiser
+        left = closed.max_rollouts - record.rollouts
+        if left <= 0:  # the closed loop's budget is spent: the sequence plays to its end
+            state.get_mutable_abstract_state(int(self._record)).set_value(replace(record, budget_spent=True))
+            return
         initial, alternatives, initialised = rest, None, False
         if self._initialiser is not None and self._moved_far(record, t):
             fresh = self._initialiser(record.observed, states[ROBOT_MODEL_NAME])
@@ -243,8 +250,8 @@ class RecedingHorizonController(LeafSystem):
         budget = Budget(
             sto.samples,
             closed.iterations,
-            closed.rollouts,
-            alternatives=1 if initialised else 0,
+            min(closed.rollouts, left),
+            alternatives=1 if initialised and left > 1 else 0,
             seed=sto.seed + 1 + record.replans,
         )
         result = optimise(

@@ -133,6 +133,7 @@ def scenario_problems(scenario: Scenario) -> list[str]:
     positive("closed_loop.replan_period", closed.replan_period)
     count("closed_loop.iterations", closed.iterations, 0, 10_000)
     count("closed_loop.rollouts", closed.rollouts, 1, 1_000_000)
+    count("closed_loop.max_rollouts", closed.max_rollouts, 1, 100_000_000)
     positive("closed_loop.replan_distance", closed.replan_distance)
     positive("closed_loop.track_distance", closed.track_distance, zero_ok=True)
     for name in ("close_s", "lift_s", "held_height"):

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from closed_loop_support import run_controller
 
+from hlp_drake.errors import HlpError
 from hlp_drake.run_scene import DEFAULT_SCENE
 from hlp_drake.scene.io import load_scene
 from hlp_drake.systems.control_sequence import ControlSequence
@@ -59,6 +60,20 @@ def test_the_controller_re_optimises_every_period_within_its_budget_and_the_robo
     assert abs(q[0] - desired[0]) < 0.01  # the base follows the command
     again, _, _ = run_controller(scenario, sequence, 1.0)  # the same seed, the same commands
     np.testing.assert_array_equal(again.sequence.knots, record.sequence.knots)
+
+
+def test_the_closed_loops_rollout_budget_ends_the_re_optimisations(scenario):
+    """An execution the controller cannot rescue ends: once ``max_rollouts`` are spent the
+    commanded sequence plays to its end."""
+    start = RolloutWorld(scenario).start_positions
+    sequence = forward(start, 0.05, 1.6)
+    capped = scenario.updated("closed_loop: {max_rollouts: 1}\n")
+    record, desired, _ = run_controller(capped, sequence, 1.3)  # periods at 0.4, 0.8 and 1.2 s
+    assert (record.replans, record.rollouts, record.budget_spent) == (1, 1, True)
+    assert record.t0 == pytest.approx(0.4) and record.to_dict()["budget_spent"] is True
+    np.testing.assert_allclose(desired[:11], record.sequence.to_trajectory().value(1.3 - 0.4).ravel())
+    with pytest.raises(HlpError, match="closed_loop.max_rollouts"):
+        scenario.updated("closed_loop: {max_rollouts: 0}\n")
 
 
 def test_model_error_is_seeded_per_scene_and_changes_the_world(scenario):

@@ -26,7 +26,6 @@ import numpy as np
 from pydrake.geometry import Meshcat
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, EventStatus
-from pydrake.trajectories import PiecewisePolynomial
 
 from hlp_drake.learners.models import DecisionModels
 from hlp_drake.planner import HighLevelPlan
@@ -38,7 +37,6 @@ from hlp_drake.systems.meshcat_view import draw_perception, draw_plan, frame_tab
 from hlp_drake.systems.model_error import sample_model_error
 from hlp_drake.systems.observed_planning import ObservedScenePlanner
 from hlp_drake.systems.optimiser import StoResult
-from hlp_drake.systems.perception import Perception
 from hlp_drake.systems.perception_errors import perception_record
 from hlp_drake.systems.planning_diagram import make_planning_diagram
 from hlp_drake.systems.receding_horizon import RecedingHorizonController
@@ -47,6 +45,7 @@ from hlp_drake.systems.robot_command import ClosedLoopCommand, OpenLoopCommand
 from hlp_drake.systems.rollout_cost import FinalState, pregrasp_check, reach_problem
 from hlp_drake.systems.rollout_pool import RolloutPool
 from hlp_drake.systems.rollout_world import simulation_failure
+from hlp_drake.systems.run_listener import RunListener
 from hlp_drake.systems.scene_models import fallen_objects, object_body, object_planar_poses
 from hlp_drake.systems.scene_perception import add_scene_perception, perceive_world
 from hlp_drake.systems.scene_source import SCENE_PORT, SceneFromPlant
@@ -65,34 +64,6 @@ if TYPE_CHECKING:
 SETTLE_S = EXECUTION_SETTLE_S  # simulated time after the trajectory ends, before objects are checked
 MOVED_TOLERANCE = 0.01  # m: an object displaced further than this counts as moved
 RECORDING_FPS = 32.0  # frames per second of a MeshCat recording
-
-
-class RunListener:
-    """Hears of a run's stages as they happen (every method does nothing here; override what you need)."""
-
-    def perceived(self, perception: Perception, seconds: float) -> None:
-        """The cameras' frame is perceived (``seconds`` with the rendering; ``perception_s`` without)."""
-
-    def planned(self, plan: HighLevelPlan, seconds: float) -> None:
-        """The planner's plan is ready."""
-
-    def solved(self, keyframes: Keyframes, trajectory: PiecewisePolynomial, seconds: float) -> None:
-        """The robot plan's keyframes (IK) and the initial trajectory are ready."""
-
-    def optimising(self) -> None:
-        """The optimiser starts (its rollouts arrive through the pool's ``on_rollout``)."""
-
-    def optimised(self, result: StoResult) -> None:
-        """The optimiser is done."""
-
-    def executing(self, duration: float) -> None:
-        """The execution starts: ``duration`` simulated seconds (reach, settling, grasp)."""
-
-    def simulated(self, t: float) -> None:
-        """The execution has reached simulated time ``t``."""
-
-    def finished(self, result: ExecutionResult) -> None:
-        """The run is over."""
 
 
 @dataclass
@@ -186,10 +157,13 @@ def plan_and_execute(
     camera = scenario.perception.source == "camera"
     watching = camera and execution == "closed"  # cameras in the executed world, re-perceived at re-plans
     error = sample_model_error(scenario.uncertainty, scene) if scenario.uncertainty.enabled else None
-    perception, perceive_s = None, 0.0
+    perception, perceive_s, fixed = None, 0.0, None  # fixed: the planners' scene, if not the source's
     if camera and not watching:  # one frame, in a world of its own: the executed one renders nothing
         perception, perceive_s = perceive_world(scenario, model_error=error)
         listener.perceived(perception, perceive_s)
+        fixed = perception.scene
+    elif error is not None and not camera:  # the scene the planners believe in
+        fixed = scene
     builder = DiagramBuilder()
     world = builder.AddSystem(
         make_world_diagram(
@@ -204,7 +178,7 @@ def plan_and_execute(
     else:  # the plant's poses (of the believed objects, under model error)
         source = builder.AddNamedSystem("scene_from_plant", SceneFromPlant(plant, scene))
         builder.Connect(world.GetOutputPort("body_poses"), source.get_body_poses_input_port())
-    if watching or (error is None and not camera):  # else a fixed scene (below)
+    if fixed is None:
         builder.Connect(source.get_scene_output_port(), planning.GetInputPort(SCENE_PORT))
     if execution == "closed":  # it observes the scene through the same source at every re-plan
         replanner = ObservedScenePlanner(scenario, models=models)  # when objects have moved far
@@ -232,13 +206,12 @@ def plan_and_execute(
         perceive_s = time.perf_counter() - seen
         listener.perceived(perception, perceive_s)
     context = planning.GetMyContextFromRoot(simulator.get_mutable_context())
-    if camera and not watching:  # the scene the cameras saw
-        planning.GetInputPort(SCENE_PORT).FixValue(context, perception.scene)
-    elif error is not None and not camera:  # the scene the planners believe in
-        planning.GetInputPort(SCENE_PORT).FixValue(context, scene)
+    if fixed is not None:
+        planning.GetInputPort(SCENE_PORT).FixValue(context, fixed)
     plan: HighLevelPlan = planning.GetOutputPort("plan").Eval(context)
     planned = time.perf_counter()
-    listener.planned(plan, planned - started - (perceive_s if watching else 0.0))
+    plan_s = planned - started - (perceive_s if watching else 0.0)  # open loop it was perceived before
+    listener.planned(plan, plan_s)
     keyframes: Keyframes = planning.GetOutputPort("keyframes").Eval(context)
     trajectory = planning.GetOutputPort("trajectory").Eval(context)
     solved = time.perf_counter()
@@ -251,7 +224,6 @@ def plan_and_execute(
         planning.GetOutputPort("robot_plan").Eval(context),
         execution=execution,
     )
-    plan_s = planned - started - (perceive_s if watching else 0.0)
     result.timings = {"plan_s": plan_s, "ik_s": solved - planned, "optimise_s": 0.0}
     if camera:
         result.perception = perception_record(scene, perception)

@@ -220,6 +220,10 @@ class RecedingHorizonController(LeafSystem):
         record: ControllerRecord = context.get_abstract_state(int(self._record)).get_value()
         if record.sequence is None or record.reason == "commanded" or record.budget_spent:
             return
+        left = self._scenario.closed_loop.max_rollouts - record.rollouts
+        if left <= 0:  # the closed loop's budget is spent: the sequence plays to its end, unobserved
+            state.get_mutable_abstract_state(int(self._record)).set_value(replace(record, budget_spent=True))
+            return
         t = float(context.get_time())
         rest = remainder(record.sequence, t - record.t0)
         if rest is None:
@@ -238,10 +242,6 @@ class RecedingHorizonController(LeafSystem):
         scene = record.scene if measured and record.scene is not None else record.observed
         closed = self._scenario.closed_loop
         sto = self._scenario.optimiser
-        left = closed.max_rollouts - record.rollouts
-        if left <= 0:  # the closed loop's budget is spent: the sequence plays to its end
-            state.get_mutable_abstract_state(int(self._record)).set_value(replace(record, budget_spent=True))
-            return
         initial, alternatives, initialised = rest, None, False
         if self._initialiser is not None and self._moved_far(record, t):
             fresh = self._initialiser(record.observed, states[ROBOT_MODEL_NAME])

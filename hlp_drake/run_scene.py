@@ -54,9 +54,11 @@ def summary(result) -> str:
     grasp = {None: "not attempted", True: "held", False: "did not hold"}[result.grasp_held]
     verified = (result.optimisation or {}).get("verifications", 0)
     if verified:
+        displaced = result.optimisation.get("displaced_checks", 0)
         optimiser += (
-            f", {verified} verified on the execution model ({result.optimisation['rejected']} rejected, "
-            f"{result.optimisation.get('verify_s', 0.0):.1f} s of it)"
+            f", {verified} verified on the execution model"
+            + (f" and in {displaced} displaced worlds" if displaced else "")
+            + f" ({result.optimisation['rejected']} rejected, {result.optimisation.get('verify_s', 0.0):.1f} s of it)"
         )
     loop = result.closed_loop
     if loop:

@@ -105,4 +105,15 @@ def sample_model_error(config: UncertaintyConfig, scene: Scene) -> ModelError:
     return ModelError(errors)
 
 
-__all__ = ["ModelError", "ObjectError", "UncertaintyConfig", "sample_model_error"]
+def displaced_scenes(scene: Scene, count: int, position_sigma: float, yaw_sigma: float) -> list[Scene]:
+    """``count`` copies of ``scene`` with every object displaced (``sample_model_error`` with seeds
+    1 ... count, positions and yaw only: masses and friction as believed)."""
+    return [
+        sample_model_error(
+            UncertaintyConfig(True, seed, position_sigma, yaw_sigma, (1.0, 1.0), (1.0, 1.0)), scene
+        ).true_scene(scene)
+        for seed in range(1, count + 1)
+    ]
+
+
+__all__ = ["ModelError", "ObjectError", "UncertaintyConfig", "displaced_scenes", "sample_model_error"]

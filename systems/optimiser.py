@@ -8,7 +8,9 @@ the noise, w_k = exp(-h (c_k - c_min) / (c_max - c_min)) ("mppi", rolled out onc
 replaces the current sequence only if its cost is lower (monotone acceptance). A rollout that passes
 the success test (target in the pre-grasp region, nothing fell) is simulated again on the execution
 model (``verify``); the optimisation succeeds when it passes there too, else that outcome replaces
-the rollout's and it goes on. The budget counts rollouts and iterations (``max_rollouts``,
+the rollout's and it goes on; with ``displaced_checks`` it must also pass in copies of the scene
+with every object displaced by about ``displaced_sigma`` (a push that only works to a fraction of
+a millimetre is rejected). The budget counts rollouts and iterations (``max_rollouts``,
 ``max_iterations``), so a result does not depend on the machine's speed or load; seconds
 (``time_budget_s``) are only an optional safety cap. Beyond the paper: when the initial sequence's
 rollout fails and the planner has alternatives (the HLP's next candidate plans), they are rolled
@@ -28,6 +30,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from hlp_drake.systems.control_sequence import ControlSequence
+from hlp_drake.systems.model_error import displaced_scenes
 from hlp_drake.systems.optimiser_config import BaseNoise, StoConfig
 from hlp_drake.systems.rollout_cost import RolloutOutcome
 from hlp_drake.systems.rollout_pool import RolloutPool
@@ -55,7 +58,10 @@ class StoResult:
         start: which sequence the result grew from: 0 the initial one, i >= 1 the i-th alternative.
         verifications: passing rollouts simulated again on the execution model (not in ``rollouts``).
         rejected: of those, how many failed there (their rollout passed, the execution model's did not).
-        verify_s: wall-clock time of the verifications, s (part of ``optimise_s``).
+        verify_s: wall-clock time of the verifications, s (part of ``optimise_s``; the displaced
+            worlds' included).
+        displaced_checks: simulations on the execution model in worlds with the objects displaced
+            (``StoConfig.displaced_checks`` per verification).
     """
 
     sequence: ControlSequence
@@ -71,6 +77,7 @@ class StoResult:
     verifications: int = 0
     rejected: int = 0
     verify_s: float = 0.0
+    displaced_checks: int = 0
 
     def to_dict(self) -> dict:
         return {
@@ -84,6 +91,7 @@ class StoResult:
             "verifications": self.verifications,
             "rejected": self.rejected,
             "verify_s": self.verify_s,
+            "displaced_checks": self.displaced_checks,
             "final_cost": self.outcome.cost if self.outcome is not None else None,
             "cost_terms": dict(self.outcome.terms) if self.outcome is not None else {},
             "costs": list(self.costs),
@@ -134,6 +142,8 @@ class Budget:
         verify: verify a passing rollout on the execution model before declaring success.
         max_verifications: verifications at most.
         seed: seed of the noise.
+        displaced_checks: worlds with displaced objects a verified sequence must pass in too
+            (``StoConfig.displaced_checks``; 0: none).
     """
 
     samples: int
@@ -144,6 +154,7 @@ class Budget:
     verify: bool = False
     max_verifications: int = 0
     seed: int = 0
+    displaced_checks: int = 0
 
     @classmethod
     def of(cls, sto: StoConfig) -> Budget:
@@ -156,6 +167,7 @@ class Budget:
             sto.verify,
             sto.max_verifications,
             sto.seed,
+            sto.displaced_checks,
         )
 
 
@@ -166,8 +178,21 @@ class _Run:
         self, scenario: Scenario, pool: RolloutPool, budget: Budget, start: RolloutStart | None
     ) -> None:
         self.scenario, self.pool, self.budget, self.start = scenario, pool, budget, start
-        self.rollouts = self.verifications = self.rejected = 0
+        self.rollouts = self.verifications = self.rejected = self.displaced = 0
         self.verify_s = 0.0
+        self._displaced: list[Scenario] | None = None
+
+    def displaced_scenarios(self) -> list[Scenario]:
+        """The scenario with its objects displaced, ``budget.displaced_checks`` times (none from a
+        measured start: the closed loop's re-optimisations see where the objects are)."""
+        if self._displaced is None:
+            sto = self.scenario.optimiser
+            count = self.budget.displaced_checks if self.start is None else 0
+            scenes = displaced_scenes(
+                self.scenario.scene, count, sto.displaced_sigma, sto.displaced_yaw_sigma
+            )
+            self._displaced = [replace(self.scenario, scene=scene) for scene in scenes]
+        return self._displaced
 
     def roll(self, sequences: list[ControlSequence]) -> list[RolloutOutcome]:
         """The rollouts of ``sequences`` (on the rollout model, from the run's start)."""
@@ -192,16 +217,31 @@ class _Run:
                 )
                 continue
             started = time.perf_counter()
-            (verified,) = self.pool.rollouts(self.scenario, [sequences[i]], start=self.start, verify=True)
+            displaced = self.displaced_scenarios()
+            verified, *moved = self.pool.verifications(
+                [self.scenario, *displaced], sequences[i], start=self.start
+            )
             self.verify_s += time.perf_counter() - started
             self.verifications += 1
-            if verified.success:
+            self.displaced += len(displaced)
+            failed = next((k for k, o in enumerate(moved) if not o.success), None)
+            if verified.success and failed is None:
                 outcomes[i] = replace(outcomes[i], verification=verified)
                 return
             self.rejected += 1
-            outcomes[i] = replace(
-                verified,
-                failure_reason=f"passed its rollout, failed its verification: {verified.failure_reason}",
+            outcomes[i] = (
+                replace(
+                    verified,
+                    failure_reason=f"passed its rollout, failed its verification: {verified.failure_reason}",
+                )
+                if not verified.success
+                else replace(
+                    moved[failed],
+                    failure_reason=(
+                        f"passed its verification, failed with the objects displaced ({failed + 1} of "
+                        f"{len(moved)}): {moved[failed].failure_reason}"
+                    ),
+                )
             )
 
 
@@ -306,6 +346,7 @@ def optimise(
     if not result.success and result.iterations >= budget.max_iterations and result.failure_reason:
         result.failure_reason = f"{result.failure_reason} (after {result.iterations} iterations)"
     result.rollouts, result.verifications, result.rejected = run.rollouts, run.verifications, run.rejected
+    result.displaced_checks = run.displaced
     result.verify_s = run.verify_s
     result.optimise_s = time.perf_counter() - started
     return result

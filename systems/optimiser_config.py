@@ -11,6 +11,7 @@ In a scenario file it sits under ``optimiser:``::
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -137,6 +138,14 @@ class StoConfig:
         alternatives: when the initial sequence's rollout fails, roll out the planner's next this
             many distinct candidate plans once (the HLP's, by expected arm collision; the straight
             line has none) and go on from the best of them all (0: never).
+        displaced_checks: a sequence that passes its verification counts only if it also passes
+            on the execution model in this many worlds with every object displaced (seeded
+            Gaussian offsets of ``displaced_sigma`` per axis and ``displaced_yaw_sigma``): a push
+            whose outcome hinges on where an object stands to a fraction of a millimetre, as a
+            perceived scene cannot promise, is rejected (0: off; the initial optimisation only,
+            not the closed loop's re-optimisations).
+        displaced_sigma: see ``displaced_checks``, m.
+        displaced_yaw_sigma: see ``displaced_checks``, rad.
     """
 
     samples: int = 8
@@ -165,6 +174,9 @@ class StoConfig:
     verify: bool = True
     max_verifications: int = 4
     alternatives: int = 3
+    displaced_checks: int = 0
+    displaced_sigma: float = 0.001
+    displaced_yaw_sigma: float = math.radians(0.5)
 
 
 @dataclass(frozen=True)

@@ -25,8 +25,9 @@ if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
     from hlp_drake.systems.scene_rollouts import SceneRollouts
 
-WORLDS_KEPT = 2
-"""Scenarios whose rollout worlds a pool (or a worker process) keeps."""
+WORLDS_KEPT = 4
+"""Scenarios whose rollout worlds a pool (or a worker process) keeps: a scene and the displaced
+copies of it that ``optimiser.displaced_checks`` verifies on (each world built on first use)."""
 
 
 class _Worlds:
@@ -121,14 +122,26 @@ class RolloutPool:
     ) -> list[RolloutOutcome]:
         """The ``RolloutOutcome`` of every sequence, in order, from ``start`` (default: the scene's
         start); with ``verify`` on the execution model (``SceneRollouts.verify``)."""
+        return self._simulate([(scenario, s) for s in sequences], start, verify)
+
+    def verifications(
+        self, scenarios: list[Scenario], sequence: ControlSequence, *, start: RolloutStart | None = None
+    ) -> list[RolloutOutcome]:
+        """The execution model's ``RolloutOutcome`` of ``sequence`` on each scenario's scene, in
+        order (all at once on the workers)."""
+        return self._simulate([(scenario, sequence) for scenario in scenarios], start, True)
+
+    def _simulate(
+        self, jobs: list[tuple[Scenario, ControlSequence]], start: RolloutStart | None, verify: bool
+    ) -> list[RolloutOutcome]:
         if self._executor is None:
-            world = self.world(scenario)
-            simulate = world.verify if verify else world.rollout
-            return [self._arrived(simulate(sequence, start), verify) for sequence in sequences]
-        key, text = scenario.key, scenario.yaml
+            return [
+                self._arrived((self.world(c).verify if verify else self.world(c).rollout)(s, start), verify)
+                for c, s in jobs
+            ]
         futures = [
-            self._executor.submit(_rollout_task, key, text, s.times, s.knots, start, verify)
-            for s in sequences
+            self._executor.submit(_rollout_task, c.key, c.yaml, s.times, s.knots, start, verify)
+            for c, s in jobs
         ]
         return [self._arrived(future.result(), verify) for future in futures]
 

@@ -10,6 +10,7 @@ covers every object. ``verify`` rolls a sequence out on the execution model inst
 
 from __future__ import annotations
 
+from functools import cached_property
 from typing import TYPE_CHECKING
 
 from hlp_drake.systems.control_sequence import ControlSequence
@@ -25,16 +26,23 @@ if TYPE_CHECKING:
 class SceneRollouts:
     """Rollouts on one scene: on the rollout model's world, with ``sto.reduced_model`` its objects
     asleep while nothing comes near them (see the module's docstring); verification on the
-    execution model's (built on first use).
+    execution model's (each world built on first use).
 
     A rollout's outcome is a pure function of the scene, the configuration, the start and the sequence.
     """
 
     def __init__(self, scenario: Scenario) -> None:
-        self.full = RolloutWorld(scenario)
         self.scenario = scenario
-        self._sweep = Sweep(self.full) if scenario.optimiser.reduced_model else None
         self._execution: RolloutWorld | None = None
+
+    @cached_property
+    def full(self) -> RolloutWorld:
+        """The rollout model's world (built on first use: a world only verified on needs none)."""
+        return RolloutWorld(self.scenario)
+
+    @cached_property
+    def _sweep(self) -> Sweep | None:
+        return Sweep(self.full) if self.scenario.optimiser.reduced_model else None
 
     @property
     def start_collisions(self) -> tuple[str, ...]:

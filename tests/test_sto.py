@@ -387,3 +387,32 @@ def test_a_pool_keeps_its_worlds_by_scenario_until_it_is_closed(scene):
         assert pool.world(on(scene, "optimiser: {samples: 3}")) is not kept
     with RolloutPool(1) as other:  # worlds belong to their pool
         assert other.world(on(scene)) is not kept
+
+
+def test_displaced_scenes_move_every_object_by_about_sigma_and_are_seeded(scene):
+    from hlp_drake.systems.model_error import displaced_scenes
+
+    a, b = displaced_scenes(scene, 2, 0.001, 0.01), displaced_scenes(scene, 2, 0.001, 0.01)
+    assert a == b and len(a) == 2 and a[0] != a[1]
+    for moved in a:
+        pairs = list(zip(scene.objects, moved.objects))
+        assert all(o.name == m.name and o.size == m.size for o, m in pairs)
+        offsets = np.array([np.hypot(m.x - o.x, m.y - o.y) for o, m in pairs])
+        assert 0.0 < offsets.max() < 0.006  # a few sigma, every object displaced by a different amount
+        assert len(set(np.round(offsets, 9))) == len(offsets)
+    assert displaced_scenes(scene, 1, 0.0, 0.0) == [scene]
+
+
+def test_a_verified_sequence_counts_only_if_it_passes_with_the_objects_displaced(scene, trajectories):
+    reaching = ControlSequence.from_trajectory(trajectories["hlp"], 0.5)  # passes, verified too
+    settings = "optimiser: {{max_rollouts: 1, samples: 1, displaced_checks: 1, displaced_sigma: {}}}"
+    with RolloutPool(2) as pool:
+        kept = optimise(on(scene, settings.format(0.001)), reaching, pool)
+        moved = optimise(on(scene, settings.format(0.05)), reaching, pool)  # the target 5 cm off and more
+    assert kept.success and (kept.verifications, kept.displaced_checks, kept.rejected) == (1, 1, 0)
+    assert kept.outcome.verification is not None and kept.to_dict()["displaced_checks"] == 1
+    assert not moved.success and (moved.verifications, moved.displaced_checks, moved.rejected) == (1, 1, 1)
+    assert "passed its verification, failed with the objects displaced (1 of 1)" in moved.failure_reason
+    assert "rollout budget of 1 spent" in moved.failure_reason
+    with pytest.raises(HlpError, match=r"optimiser\.displaced_checks must be between 0 and 100"):
+        on(scene, "optimiser: {displaced_checks: -1}")

@@ -496,3 +496,19 @@ def test_gen2_on_perceived_scenes_with_the_real_planners(tmp_path):
     for row in rows:
         assert not row["failure_reason"].startswith(("crashed", "perception failed")), row["failure_reason"]
     assert "perception: camera" in (out / "summary.md").read_text()
+
+
+def process_of(job: Job) -> int:
+    """The id of the process that ran ``job``."""
+    return os.getpid()
+
+
+def test_local_pool_workers_are_renewed_every_jobs_per_worker_jobs(monkeypatch):
+    from hlp_drake.experiments import executors
+
+    jobs = [Job("gen2", seed, 3, f"gen2-3-{seed}", "hlp", "") for seed in range(6)]
+    monkeypatch.setattr(executors, "JOBS_PER_WORKER", 2)
+    pids = [pid for _, pid in executors.run_jobs(process_of, jobs, workers=2)]
+    assert len(pids) == 6 and os.getpid() not in pids
+    chunks = [set(pids[:4]), set(pids[4:])]  # 2 jobs per worker, 2 workers: fresh ones after 4 jobs
+    assert not chunks[0] & chunks[1]

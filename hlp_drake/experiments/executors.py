@@ -40,6 +40,11 @@ def connect(distributed: ModuleType, scheduler: str):
         raise HlpError(f"cannot connect to the dask scheduler at {scheduler}: {error}") from None
 
 
+JOBS_PER_WORKER = 10
+"""Jobs a local worker process runs before a fresh one takes its place (bounds the memory that
+pydrake's diagrams with Python systems keep: ~80 MB per job on perceived scenes)."""
+
+
 def check_executor(executor: str, scheduler: str | None) -> None:
     """Fail now, before anything is written, if dask is missing or its scheduler is unreachable."""
     if executor != "dask":
@@ -77,6 +82,15 @@ def run_jobs(
 def _in_process_pool(
     job_function: JobFunction, jobs: Sequence[Job], workers: int
 ) -> Iterator[tuple[Job, Row]]:
+    """The jobs in fresh pools of ``JOBS_PER_WORKER`` jobs per worker: pydrake never frees a
+    diagram that holds a Python system (a perceived job's cameras, about 80 MB), so a long-lived
+    process grows with every job."""
+    chunk = workers * JOBS_PER_WORKER
+    for start in range(0, len(jobs), chunk):
+        yield from _in_one_pool(job_function, jobs[start : start + chunk], workers)
+
+
+def _in_one_pool(job_function: JobFunction, jobs: Sequence[Job], workers: int) -> Iterator[tuple[Job, Row]]:
     pool = worker_pool(min(workers, len(jobs)))  # spawned: never fork a process holding Drake
     try:
         with interrupts_held():  # the workers start here

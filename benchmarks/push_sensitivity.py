@@ -20,9 +20,8 @@ import time
 import numpy as np
 
 from hlp_drake.scene.generators import generate_scene
-from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.model_error import displaced_scenes
-from hlp_drake.systems.planning_diagram import make_planning_diagram
+from hlp_drake.systems.planning_diagram import initial_sequence
 from hlp_drake.systems.scenario import Scenario
 from hlp_drake.systems.scene_perception import perceive_world
 from hlp_drake.systems.scene_rollouts import SceneRollouts
@@ -54,11 +53,9 @@ def main() -> None:
     args = parser.parse_args()
     scene = generate_scene("gen2", args.seed, args.objects)
     scenario = Scenario(scene=scene).updated(f"planner: {{kind: {args.planner}}}")
-    diagram = make_planning_diagram(scenario)
-    context = diagram.CreateDefaultContext()
-    diagram.GetInputPort("scene").FixValue(context, scene)
-    trajectory = diagram.GetOutputPort("trajectory").Eval(context)
-    sequence = ControlSequence.from_trajectory(trajectory, scenario.optimiser.step_duration)
+    sequence = initial_sequence(scenario)
+    if sequence is None:
+        sys.exit(f"{scene.name}: the {args.planner} planner gives no initial trajectory")
     rows = []
     for name, variant in variants(scene, scenario).items():
         started = time.perf_counter()

@@ -178,7 +178,7 @@ class _Run:
         self, scenario: Scenario, pool: RolloutPool, budget: Budget, start: RolloutStart | None
     ) -> None:
         self.scenario, self.pool, self.budget, self.start = scenario, pool, budget, start
-        self.rollouts = self.verifications = self.rejected = self.displaced = 0
+        self.rollouts = self.verifications = self.rejected = 0
         self.verify_s = 0.0
         self._displaced: list[Scenario] | None = None
 
@@ -223,7 +223,6 @@ class _Run:
             )
             self.verify_s += time.perf_counter() - started
             self.verifications += 1
-            self.displaced += len(displaced)
             failed = next((k for k, o in enumerate(moved) if not o.success), None)
             if verified.success and failed is None:
                 outcomes[i] = replace(outcomes[i], verification=verified)
@@ -346,7 +345,7 @@ def optimise(
     if not result.success and result.iterations >= budget.max_iterations and result.failure_reason:
         result.failure_reason = f"{result.failure_reason} (after {result.iterations} iterations)"
     result.rollouts, result.verifications, result.rejected = run.rollouts, run.verifications, run.rejected
-    result.displaced_checks = run.displaced
+    result.displaced_checks = run.verifications * len(run.displaced_scenarios())
     result.verify_s = run.verify_s
     result.optimise_s = time.perf_counter() - started
     return result

@@ -31,7 +31,7 @@ import numpy as np
 
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.model_error import displaced_scenes
-from hlp_drake.systems.optimiser_config import BaseNoise, StoConfig
+from hlp_drake.systems.optimiser_config import PERCEIVED_CHECKS, BaseNoise, StoConfig
 from hlp_drake.systems.rollout_cost import RolloutOutcome
 from hlp_drake.systems.rollout_pool import RolloutPool
 
@@ -128,9 +128,18 @@ def mppi_weights(costs: np.ndarray, temperature: float) -> np.ndarray:
     return weights / np.sum(weights)
 
 
+def displaced_checks(scenario: Scenario) -> int:
+    """``optimiser.displaced_checks``, or when it is None ``PERCEIVED_CHECKS`` on a perceived scene
+    (``perception.source: camera``) and 0 on the true one."""
+    checks = scenario.optimiser.displaced_checks
+    if checks is not None:
+        return checks
+    return PERCEIVED_CHECKS if scenario.perception.source == "camera" else 0
+
+
 @dataclass(frozen=True)
 class Budget:
-    """How much one optimisation may do (``Budget.of(scenario.optimiser)`` by default; the
+    """How much one optimisation may do (``Budget.of(scenario)`` by default; the
     receding-horizon controller gives its replans smaller ones).
 
     Attributes:
@@ -143,7 +152,7 @@ class Budget:
         max_verifications: verifications at most.
         seed: seed of the noise.
         displaced_checks: worlds with displaced objects a verified sequence must pass in too
-            (``StoConfig.displaced_checks``; 0: none).
+            (``displaced_checks(scenario)``; 0: none).
     """
 
     samples: int
@@ -157,7 +166,9 @@ class Budget:
     displaced_checks: int = 0
 
     @classmethod
-    def of(cls, sto: StoConfig) -> Budget:
+    def of(cls, scenario: Scenario) -> Budget:
+        """The budget ``scenario.optimiser`` sets."""
+        sto = scenario.optimiser
         return cls(
             sto.samples,
             sto.max_iterations,
@@ -167,7 +178,7 @@ class Budget:
             sto.verify,
             sto.max_verifications,
             sto.seed,
-            sto.displaced_checks,
+            displaced_checks(scenario),
         )
 
 
@@ -261,12 +272,12 @@ def optimise(
         alternatives: returns the planner's other initial sequences, best first; called only if
             the initial rollout fails and the budget has alternatives (the first that many are used).
         progress: called as ``progress(iteration, cost)`` after every iteration.
-        budget: what the optimisation may spend (default: ``Budget.of(scenario.optimiser)``).
+        budget: what the optimisation may spend (default: ``Budget.of(scenario)``).
         start: roll out from this state rather than the scene's (the receding-horizon controller's
             measured state; the robot's start is then not checked for collisions: it may be pushing).
     """
     sto: StoConfig = scenario.optimiser
-    budget = budget or Budget.of(sto)
+    budget = budget or Budget.of(scenario)
     started = time.perf_counter()
     collisions = () if start is not None else pool.world(scenario).start_collisions
     if collisions:

@@ -16,6 +16,9 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 UPDATES = ("greedy", "mppi")
+PERCEIVED_CHECKS = 2
+"""``StoConfig.displaced_checks`` when it is None and the scene is perceived (``perception.source:
+camera``): the 100-scene Table III at 9 objects, docs/perception.md."""
 
 
 @dataclass(frozen=True)
@@ -142,8 +145,9 @@ class StoConfig:
             on the execution model in this many worlds with every object displaced (seeded
             Gaussian offsets of ``displaced_sigma`` per axis and ``displaced_yaw_sigma``): a push
             whose outcome hinges on where an object stands to a fraction of a millimetre, as a
-            perceived scene cannot promise, is rejected (0: off; the initial optimisation only,
-            not the closed loop's re-optimisations).
+            perceived scene cannot promise, is rejected (0: off; None, the default:
+            ``PERCEIVED_CHECKS`` on a perceived scene, ``perception.source: camera``, else 0; the
+            initial optimisation only, not the closed loop's re-optimisations).
         displaced_sigma: see ``displaced_checks``, m.
         displaced_yaw_sigma: see ``displaced_checks``, rad.
     """
@@ -174,7 +178,7 @@ class StoConfig:
     verify: bool = True
     max_verifications: int = 4
     alternatives: int = 3
-    displaced_checks: int = 0
+    displaced_checks: int | None = None
     displaced_sigma: float = 0.001
     displaced_yaw_sigma: float = math.radians(0.5)
 

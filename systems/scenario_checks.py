@@ -97,7 +97,8 @@ def scenario_problems(scenario: Scenario) -> list[str]:
     count("optimiser.workers", sto.workers, 1, MAX_WORKERS)
     count("optimiser.alternatives", sto.alternatives, 0, 100)
     count("optimiser.max_verifications", sto.max_verifications, 0, 1000)
-    count("optimiser.displaced_checks", sto.displaced_checks, 0, 100)
+    if sto.displaced_checks is not None:
+        count("optimiser.displaced_checks", sto.displaced_checks, 0, 100)
     positive("optimiser.displaced_sigma", sto.displaced_sigma, zero_ok=True, upper=0.1)
     positive("optimiser.displaced_yaw_sigma", sto.displaced_yaw_sigma, zero_ok=True, upper=math.pi)
     count("optimiser.seed", sto.seed, 0, MAX_SEED)

@@ -15,7 +15,8 @@ from hlp_drake.errors import HlpError
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import SceneObject
 from hlp_drake.systems.control_sequence import ControlSequence
-from hlp_drake.systems.optimiser import mppi_weights, optimise, sample_base_noise
+from hlp_drake.systems.optimiser import Budget, mppi_weights, optimise, sample_base_noise
+from hlp_drake.systems.optimiser_config import PERCEIVED_CHECKS
 from hlp_drake.systems.optimiser_system import StochasticTrajectoryOptimiser
 from hlp_drake.systems.planning_diagram import make_planning_diagram
 from hlp_drake.systems.rollout_cost import BLOWN_UP_COST, RolloutSamples, rollout_cost
@@ -416,3 +417,17 @@ def test_a_verified_sequence_counts_only_if_it_passes_with_the_objects_displaced
     assert "rollout budget of 1 spent" in moved.failure_reason
     with pytest.raises(HlpError, match=r"optimiser\.displaced_checks must be between 0 and 100"):
         on(scene, "optimiser: {displaced_checks: -1}")
+
+
+def test_perceived_scenes_get_displaced_checks_unless_the_scenario_sets_them(scene, trajectories):
+    camera = "perception: {source: camera}"
+    assert Budget.of(on(scene)).displaced_checks == 0
+    assert Budget.of(on(scene, camera)).displaced_checks == PERCEIVED_CHECKS == 2
+    assert Budget.of(on(scene, camera).updated("optimiser: {displaced_checks: 0}")).displaced_checks == 0
+    assert Budget.of(on(scene, "optimiser: {displaced_checks: 3}")).displaced_checks == 3
+    reaching = ControlSequence.from_trajectory(trajectories["hlp"], 0.5)
+    with RolloutPool(2) as pool:
+        result = optimise(
+            on(scene, camera).updated("optimiser: {max_rollouts: 1, samples: 1}"), reaching, pool
+        )
+    assert result.success and (result.verifications, result.displaced_checks) == (1, PERCEIVED_CHECKS)

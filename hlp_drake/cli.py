@@ -16,8 +16,10 @@ from typing import NoReturn
 
 from hlp_drake import __version__
 from hlp_drake.errors import HlpError
+from hlp_drake.processes import Terminated, terminations_raised
 
 EXIT_USER_ERROR = 2
+EXIT_TERMINATED = 143  # 128 + SIGTERM
 
 
 def plain(text: str) -> str:
@@ -109,13 +111,18 @@ def add_conditions(parser: argparse.ArgumentParser) -> None:
 
 
 def run_cli(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | None = None) -> int:
-    """Run ``main(argv)``; print each problem of an ``HlpError`` as ``error: ...`` and return 2."""
+    """Run ``main(argv)``; print each problem of an ``HlpError`` as ``error: ...`` and return 2; a
+    Ctrl-C prints "interrupted" and returns 130, a SIGTERM "terminated" and 143 (its workers stopped)."""
     try:
-        return main(argv)
+        with terminations_raised():
+            return main(argv)
     except HlpError as error:
         for problem in error.problems:
             print(f"error: {problem}", file=sys.stderr)
         return EXIT_USER_ERROR
+    except Terminated:
+        print("terminated", file=sys.stderr)
+        return EXIT_TERMINATED
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130

@@ -5,7 +5,9 @@ A worker that took it as a KeyboardInterrupt would print its own traceback; inst
 spawned with SIGINT blocked (the mask is inherited, so even a worker still starting up cannot see
 it), then ignore it and unblock it before their first task. The parent alone turns it into a
 KeyboardInterrupt (``cli.run_cli``: one line, exit 130) and stops the workers
-(``terminate_workers``).
+(``terminate_workers``). A SIGTERM to the command (``kill``, a batch scheduler's time limit) takes
+the same way out as ``Terminated``, a KeyboardInterrupt (exit 143), so no worker is left behind;
+the workers keep SIGTERM's default, which is how they are stopped.
 """
 
 from __future__ import annotations
@@ -16,6 +18,27 @@ import signal
 import threading
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
+
+
+class Terminated(KeyboardInterrupt):
+    """A SIGTERM, raised in the main thread by ``terminations_raised`` so the interrupt's cleanup runs."""
+
+
+@contextlib.contextmanager
+def terminations_raised() -> Iterator[None]:
+    """Inside the block a SIGTERM raises ``Terminated`` in the main thread (elsewhere: nothing changes)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def terminated(signum: int, frame: object) -> None:
+        raise Terminated
+
+    previous = signal.signal(signal.SIGTERM, terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def ignore_interrupts() -> None:

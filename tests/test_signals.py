@@ -1,7 +1,8 @@
 """Ctrl-C to the whole process group (what a terminal sends) during ``run_scene`` with rollout workers.
 
 Expected at any moment: exit status 130, stderr the one line "interrupted" (no worker's
-KeyboardInterrupt traceback), no output file, and no process of the group left behind.
+KeyboardInterrupt traceback), no output file, and no process of the group left behind. A SIGTERM
+to the command alone (``kill PID``, a scheduler's time limit): the same with 143 and "terminated".
 """
 
 from __future__ import annotations
@@ -18,7 +19,16 @@ import pytest
 _READY = "rollout workers ready"
 
 
-def _interrupt(tmp_path, *, after: str | None, delay: float) -> None:
+def _interrupt(
+    tmp_path,
+    *,
+    after: str | None,
+    delay: float,
+    signum: int = signal.SIGINT,
+    group: bool = True,
+    status: int = 130,
+    message: str = "interrupted",
+) -> None:
     out = tmp_path / "run.json"
     process = subprocess.Popen(
         [sys.executable, "-m", "hlp_drake.run_scene", "--workers", "2", "--quiet", "--json", str(out)],
@@ -38,10 +48,10 @@ def _interrupt(tmp_path, *, after: str | None, delay: float) -> None:
                 seen += process.stdout.readline()
         assert after in seen, seen
     time.sleep(delay)
-    os.killpg(process.pid, signal.SIGINT)
+    (os.killpg if group else os.kill)(process.pid, signum)
     stdout, stderr = process.communicate(timeout=120)
-    assert process.returncode == 130, (seen + stdout, stderr)
-    assert stderr == "interrupted\n", stderr
+    assert process.returncode == status, (seen + stdout, stderr)
+    assert stderr == f"{message}\n", stderr
     assert not out.exists() and not list(tmp_path.glob(".run.json.*"))
     deadline = time.monotonic() + 10  # the workers are gone too (reaped by init once the command exits)
     while _group_alive(process.pid) and time.monotonic() < deadline:
@@ -59,6 +69,18 @@ def _group_alive(group: int) -> bool:
 
 def test_ctrl_c_while_optimising_is_one_line_and_exit_130(tmp_path):
     _interrupt(tmp_path, after=_READY, delay=1.5)
+
+
+def test_sigterm_to_the_command_alone_stops_its_workers_one_line_and_exit_143(tmp_path):
+    _interrupt(
+        tmp_path,
+        after=_READY,
+        delay=1.5,
+        signum=signal.SIGTERM,
+        group=False,
+        status=143,
+        message="terminated",
+    )
 
 
 @pytest.mark.slow

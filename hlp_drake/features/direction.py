@@ -12,7 +12,6 @@ from hlp_drake.segmentation.modes import Mode, is_faithful
 from hlp_drake.taskspace import (
     DIRECTIONS,
     TaskSpace,
-    block_array,
     direction_of,
     free_fractions,
     rect_array,
@@ -67,8 +66,9 @@ class DirectionTable:
 
     def __init__(self, space: TaskSpace, names: Sequence[str], *, mode: Mode, training: bool = False) -> None:
         self.faithful = is_faithful(mode)
-        self._rects = space.obstacle_bounds[[space.obstacle_index[n] for n in names]].reshape(-1, 4)
-        self._alpha = space.alpha
+        positions = [space.obstacle_index[n] for n in names]
+        self._rects = space.obstacle_bounds[positions].reshape(-1, 4)
+        self._blocks = space.obstacle_blocks[positions].reshape(-1, 8, 4)
         if self.faithful and training:
             self._occluders = space.occluder_bounds()
         elif self.faithful:
@@ -82,7 +82,7 @@ class DirectionTable:
     def _compute(self, index: np.ndarray) -> np.ndarray:
         """(k, 11) per obstacle of ``index``: 8 free fractions, origin (x, y), direction class to the target."""
         rects = self._rects[index]
-        free = free_fractions(block_array(rects, self._alpha), self._occluders)
+        free = free_fractions(self._blocks[index], self._occluders)
         origins = corner_origin(rects) if self.faithful else rect_centres(rects)
         to_target = [
             direction_index(direction_of(*(self._target_origin - o), faithful=self.faithful)) for o in origins

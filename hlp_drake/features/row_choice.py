@@ -19,9 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from hlp_drake.lazy import LazyRows
-from hlp_drake.taskspace import TaskSpace, block_array, free_fractions, rect_array
+from hlp_drake.taskspace import TaskSpace, free_fractions, rect_array
 from hlp_drake.taskspace.model import table_walls
-from hlp_drake.taskspace.routes import FreeRoutes, segment_inside
+from hlp_drake.taskspace.routes import FreeRoutes, lengths, segment_inside
 
 HUMAN_HAND_WIDTH = 0.05  # m: the VR study's hand (the original's hand_width)
 CAP = 10.0  # lengths in hand widths saturate here: a gap ten hands wide is as open as a wider one
@@ -85,7 +85,7 @@ def _passage(y_min: np.ndarray, y_max: np.ndarray, line: np.ndarray, width: floa
     fits = y_max - y_min >= width
     low = np.where(fits, y_min + width / 2.0, (y_min + y_max) / 2.0)
     high = np.where(fits, y_max - width / 2.0, low)
-    return np.clip(line, low, high)
+    return np.minimum(np.maximum(line, low), high)  # np.clip's values, at half its cost
 
 
 def _corridor_overlap(y_min: np.ndarray, y_max: np.ndarray, line: np.ndarray, width: float) -> np.ndarray:
@@ -143,10 +143,8 @@ def free_space(space: TaskSpace) -> LazyRows:
     the table's diagonal)."""
     walls = rect_array(list(table_walls(space.scene.table.bounds, space.scene.table.diagonal).values()))
     occluders = np.vstack([space.obstacle_bounds, rect_array([space.target]), walls])
-    bounds, alpha = space.obstacle_bounds, space.alpha
-    return LazyRows(
-        len(bounds), lambda index: free_fractions(block_array(bounds[index], alpha), occluders).reshape(-1, 8)
-    )
+    blocks = space.obstacle_blocks
+    return LazyRows(len(blocks), lambda index: free_fractions(blocks[index], occluders).reshape(-1, 8))
 
 
 def _nearest(
@@ -200,6 +198,9 @@ class RowChoiceScene:
             space.obstacle_bounds[ids], ids, space.scene.table.bounds, hand_width, self.goal
         )
         self._free = free_space(space)
+        self._grown = (
+            space.obstacle_bounds + np.array([-hand_width, -hand_width, hand_width, hand_width]) / 2.0
+        )
         self._rows: dict[int, _RowGeometry] = {}
 
     def row(self, index: int) -> _RowGeometry:
@@ -256,7 +257,7 @@ class RowChoiceScene:
         X[:, :, 1] = np.minimum(np.concatenate([gb[:, 3] - gb[:, 1], ob[:, 3] - ob[:, 1]]) / w, CAP)
         X[:, n_gaps:, 2] = np.minimum((ob[:, 2] - ob[:, 0]) / w, CAP)
         X[:, :, 3] = np.minimum(np.abs(lateral) / w, CAP)
-        X[:, :, 4] = np.clip((-1.0 if mirror else 1.0) * lateral / w, -CAP, CAP)
+        X[:, :, 4] = np.minimum(np.maximum((-1.0 if mirror else 1.0) * lateral / w, -CAP), CAP)
         X[:, :, 5] = np.arctan2(np.abs(lateral), depth)
         X[:, :n_gaps, 6] = np.minimum(
             np.maximum(np.abs(lateral[:, :n_gaps]) - best_offset[:, None], 0.0) / w, CAP
@@ -279,8 +280,10 @@ class RowChoiceScene:
             next_offset, _, next_block = self.row(row + 1).best(points, goal, w)
             X[:, :, 21], X[:, :, 22] = np.minimum(next_offset / w, CAP), np.minimum(next_block / w, CAP)
         X[:, :, 23] = np.minimum((geometry.x - hands[:, 0]) / w, CAP)[:, None]
-        X[:, :, 24] = np.minimum(np.linalg.norm(points - hands[:, None], axis=2) / w, CAP)
-        X[:, :, 25] = np.clip((-1.0 if mirror else 1.0) * (points[..., 1] - goal[1]) / w, -CAP, CAP)
+        X[:, :, 24] = np.minimum(lengths(points - hands[:, None]) / w, CAP)
+        X[:, :, 25] = np.minimum(
+            np.maximum((-1.0 if mirror else 1.0) * (points[..., 1] - goal[1]) / w, -CAP), CAP
+        )
         X[:, :, 26] = np.minimum((goal[0] - geometry.x) / w, CAP)
         self._route_features(X, hands, points, members, n_gaps, removed)
 
@@ -320,13 +323,14 @@ class RowChoiceScene:
         candidate inside the obstacles grown by half the hand's width, in hand widths (not counting
         the candidate's own obstacle, nor the ones moved away)."""
         B, n = points.shape[:2]
-        w = self.width
-        grown = self.space.obstacle_bounds + np.array([-w, -w, w, w]) / 2.0
-        inside = segment_inside(np.repeat(hands, n, axis=0), points.reshape(-1, 2), grown).reshape(B, n, -1)
+        inside = segment_inside(np.repeat(hands, n, axis=0), points.reshape(-1, 2), self._grown).reshape(
+            B, n, -1
+        )
         for b, gone in enumerate(removed):
-            inside[b, :, list(gone)] = 0.0
+            if gone:
+                inside[b, :, list(gone)] = 0.0
         inside[:, np.arange(n_gaps, n), members] = 0.0
-        return inside.sum(axis=2) / w
+        return inside.sum(axis=2) / self.width
 
     def _route_features(
         self,
@@ -347,7 +351,6 @@ class RowChoiceScene:
             np.vstack([hands, gap_points]), pairs=(np.repeat(hands, G, axis=0), gap_points)
         )
         straight = np.maximum(np.hypot(*(self.goal - hands).T), w)
-        route_index = {int(k): i for i, k in enumerate(routes.ids)}
         for gone in set(removed):
             group = np.array([b for b in range(B) if removed[b] == gone])
             shortest = routes.to_goal(sight, group, gone)
@@ -361,7 +364,7 @@ class RowChoiceScene:
                 ).reshape(len(group), G)
                 X[group, :G, 12] = np.minimum(via / shortest[:, None], ROUTE_CAP)
             for k, obstacle in enumerate(members):  # moved away: the route from the hands it stands before
-                r = route_index.get(int(obstacle))
+                r = routes.position.get(int(obstacle))
                 if r is None or int(obstacle) in gone:
                     continue
                 before = np.flatnonzero(sight.goal_hits[group, r])
@@ -369,4 +372,6 @@ class RowChoiceScene:
                     continue
                 without = routes.to_goal_without(sight, group[before], gone, int(obstacle))
                 without = np.where(np.isfinite(without), without, ROUTE_CAP * straight[group[before]])
-                X[group[before], G + k, 13] = np.clip((shortest[before] - without) / w, 0.0, CAP)
+                X[group[before], G + k, 13] = np.minimum(
+                    np.maximum((shortest[before] - without) / w, 0.0), CAP
+                )

@@ -7,7 +7,6 @@ from functools import cached_property
 
 import numpy as np
 
-from hlp_drake.lazy import LazyRows
 from hlp_drake.scene.geometry import footprint_bounds
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.rows import Row, find_rows
@@ -199,13 +198,18 @@ class TaskSpace:
         return rect_centres(self.obstacle_bounds)
 
     @cached_property
-    def relocated(self) -> LazyRows:
-        """Per obstacle (scene order), the (8, 4) regions it is pushed into, per direction
-        (``relocation.relocated_array``), each obstacle's computed when first asked for."""
+    def obstacle_blocks(self) -> np.ndarray:
+        """(n_obstacles, 8, 4) the direction blocks of the obstacles (``block_array``), in scene order
+        (a few array operations for all of them, however many)."""
+        return block_array(self.obstacle_bounds, self.alpha)
+
+    @cached_property
+    def relocated(self) -> np.ndarray:
+        """(n_obstacles, 8, 4) per obstacle (scene order) the regions it is pushed into, per
+        direction (``relocation.relocated_array``)."""
         from hlp_drake.taskspace.relocation import relocated_array  # relocation builds on this module
 
-        bounds, alpha = self.obstacle_bounds, self.alpha
-        return LazyRows(len(bounds), lambda index: relocated_array(bounds[index], alpha))
+        return relocated_array(self.obstacle_bounds, self.alpha, blocks=self.obstacle_blocks)
 
     @cached_property
     def obstacle_index(self) -> dict[str, int]:

@@ -14,12 +14,15 @@ CARDINAL_SHIFT = 0.2  # sideways shift of cardinal moves, fraction of the object
 _SHIFTS = np.array([(d in ("LL", "RR"), d in ("FF", "BB")) for d in DIRECTIONS], dtype=float)
 
 
-def relocated_array(rects: np.ndarray, alpha: float = ALPHA) -> np.ndarray:
+def relocated_array(
+    rects: np.ndarray, alpha: float = ALPHA, *, blocks: np.ndarray | None = None
+) -> np.ndarray:
     """(n, 8, 4): the region each of the (n, 4) rectangles is pushed into, per direction (order
     ``DIRECTIONS``): its direction block, cardinal ones shifted sideways by 0.2 of the object's
-    size so the moved object does not stay aligned with the row."""
+    size so the moved object does not stay aligned with the row. ``blocks``: the rectangles'
+    ``block_array``, where known."""
     r = np.asarray(rects, dtype=float).reshape(-1, 4)
-    blocks = block_array(r, alpha)
+    blocks = block_array(r, alpha) if blocks is None else blocks
     size = np.column_stack([r[:, 2] - r[:, 0], r[:, 3] - r[:, 1]])  # (depth, width)
     shift = CARDINAL_SHIFT * size[:, None, :] * _SHIFTS[None]  # (n, 8, 2)
     return blocks + np.concatenate([shift, shift], axis=2)

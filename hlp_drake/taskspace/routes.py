@@ -66,6 +66,12 @@ def segment_hits(p0: np.ndarray, p1: np.ndarray, rects: np.ndarray) -> np.ndarra
     return hits
 
 
+def lengths(d: np.ndarray) -> np.ndarray:
+    """Euclidean lengths of the vectors along the last axis of ``d``: ``np.linalg.norm(d, axis=-1)``
+    to the bit, without its overhead (the planner takes thousands of them per plan)."""
+    return np.sqrt((d * d).sum(axis=-1))
+
+
 REACH_MARGIN = 1e-9  # m: rectangles this far from every segment's bounding box are not clipped
 
 
@@ -83,7 +89,7 @@ def segment_inside(p0: np.ndarray, p1: np.ndarray, rects: np.ndarray) -> np.ndar
     hi = np.maximum(a.max(axis=0), b.max(axis=0)) + REACH_MARGIN
     near = np.flatnonzero((r[:, 0] <= hi[0]) & (r[:, 2] >= lo[0]) & (r[:, 1] <= hi[1]) & (r[:, 3] >= lo[1]))
     low, high = _clip(a, b, r[near])
-    inside[:, near] = np.maximum(high - low, 0.0) * np.linalg.norm(b - a, axis=1)[:, None]
+    inside[:, near] = np.maximum(high - low, 0.0) * lengths(b - a)[:, None]
     return inside
 
 
@@ -169,12 +175,14 @@ class FreeRoutes:
         self._edge_hits = np.zeros((n, n, len(g)), dtype=bool)
         self._edge_hits[upper] = segment_hits(self.corners[upper[0]], self.corners[upper[1]], self.grown)
         self._edge_hits |= self._edge_hits.transpose(1, 0, 2)
-        self._edge_length = np.linalg.norm(self.corners[:, None] - self.corners[None], axis=2)
+        self._edge_length = lengths(self.corners[:, None] - self.corners[None])
         # The corners' straight ways to the goal: which grown obstacles they pass through, their lengths.
         self._goal_hits = segment_hits(
             self.corners, np.broadcast_to(self.goal, self.corners.shape), self.grown
         )
-        self._goal_length = np.linalg.norm(self.corners - self.goal, axis=1)
+        self._goal_length = lengths(self.corners - self.goal)
+        self._ends = np.vstack([self.corners, self.goal[None]])  # what ``sight`` looks at
+        self.position = {int(k): i for i, k in enumerate(self.ids)}  # an id's obstacle, in ``grown``
         self._tables: dict[frozenset[int], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
     def kept(self, removed: Collection[int]) -> np.ndarray:
@@ -199,13 +207,13 @@ class FreeRoutes:
         One segment test for all."""
         points = np.asarray(points, float).reshape(-1, 2)
         c, m = len(self.corners), len(self.grown)
-        ends = np.vstack([self.corners, self.goal[None]])
+        ends = self._ends
         starts, stops = np.repeat(points, c + 1, axis=0), np.tile(ends, (len(points), 1))
         if pairs is not None:
             starts, stops = np.vstack([starts, pairs[0]]), np.vstack([stops, pairs[1]])
         hits = segment_hits(starts, stops, self.grown)
         seen = hits[: len(points) * (c + 1)].reshape(len(points), c + 1, m)
-        length = np.linalg.norm(points[:, None] - ends[None], axis=2)
+        length = lengths(points[:, None] - ends[None])
         sight = Sight(points, seen[:, :c], length[:, :c], seen[:, c], length[:, c])
         return sight if pairs is None else (sight, hits[len(points) * (c + 1) :])
 
@@ -229,7 +237,7 @@ class FreeRoutes:
         it standing and a corner (or the goal) it reaches the goal from."""
         kept, distances, to_goal = self.tables(removed)
         base = self.to_goal(sight, rows, removed)
-        r = int(np.flatnonzero(self.ids == obstacle)[0])
+        r = self.position[int(obstacle)]
         if not kept[r]:
             return base
         others = kept.copy()
@@ -263,7 +271,7 @@ class FreeRoutes:
         """Route lengths from the points ``sources`` to the points ``targets`` of ``sight``, pair
         by pair; ``direct_hits`` (pairs, m): which grown obstacles each straight way passes through."""
         kept, distances, _ = self.tables(removed)
-        straight = np.linalg.norm(sight.points[sources] - sight.points[targets], axis=1)
+        straight = lengths(sight.points[sources] - sight.points[targets])
         direct = np.where(direct_hits[:, kept].any(axis=1), np.inf, straight)
         if len(self.corners) == 0:
             return direct

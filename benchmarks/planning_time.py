@@ -1,7 +1,7 @@
 """Planning time of the human-like planner with its bundled models, beside another release's.
 
     python benchmarks/planning_time.py [--dataset PATH] [--scenes 50] [--rounds 3]
-        [--baseline CHECKOUT] [--json OUT] [--png OUT]
+        [--baseline CHECKOUT] [--stages] [--json OUT] [--png OUT]
 
 Scene groups: the VR structured scenes of 5 held-out subjects (one 19/5 split), every unstructured
 VR scene, seeded Generalization II scenes with 6, 12, 25 and 50 objects (sizes the generator
@@ -12,11 +12,15 @@ previous release) once in one of the baseline; the order alternates between roun
 the same machine load. A scene's time is its fastest over the rounds. Prints the median, p95 and
 p99 per group and planner, and the ratio of the medians, on the wall clock and in CPU time (the
 planning thread's: what other jobs on a shared machine disturb least); writes JSON and a PNG.
+With --stages, also where this checkout's plan spends its CPU time: each scene planned once more
+in this process with the planner's stages (``STAGES``) timed, their mean ms per plan per group.
 """
 
 from __future__ import annotations
 
 import argparse
+import functools
+import importlib
 import json
 import pickle
 import platform
@@ -57,6 +61,18 @@ def timed(scene):
 json.dump({name: [timed(s) for s in scenes] for name, scenes in groups.items()}, open(sys.argv[2], "w"))
 """
 CLOCKS = ("wall", "cpu")
+STAGES = {  # label: (module, attribute); none runs inside another. set-up: the route graph and tables
+    "validation": ("hlp_drake.planner.hlp", "scene_problems"),
+    "task space": ("hlp_drake.planner.hlp", "TaskSpace"),
+    "set-up": ("hlp_drake.planner.row_plan", "_Expander"),
+    "row features": ("hlp_drake.features.row_choice", "RowChoiceScene.candidates"),
+    "Cr": ("hlp_drake.learners.choice", "RowChoiceClassifier.predict_proba"),
+    "Cr novelty": ("hlp_drake.learners.choice", "RowChoiceClassifier.novelty"),
+    "Cd": ("hlp_drake.planner.row_plan", "_Expander.moves"),
+    "arm Ra": ("hlp_drake.planner.row_plan", "arm_configurations"),
+    "arm sweeps": ("hlp_drake.planner.row_plan", "expected_collisions"),
+    "segments": ("hlp_drake.planner.row_plan", "plans_segment_collisions"),
+}
 
 
 def two_row_scene(objects: int, seed: int) -> Scene:
@@ -127,6 +143,45 @@ def time_rounds(groups: dict[str, list[Scene]], pythons: dict[str, str], rounds:
     return {name: {g: _stats(t) for g, t in per_group.items()} for name, per_group in best.items()}
 
 
+def stage_times(groups: dict[str, list[Scene]]) -> dict[str, dict[str, float]]:
+    """Per group, the mean CPU ms per plan of each of this checkout's ``STAGES`` and of the rest
+    ("other"), each scene planned once (after a warm-up) with the stages wrapped in timers."""
+    from hlp_drake.learners.bundled import default_models
+    from hlp_drake.planner import plan
+
+    spent: dict[str, float] = {}
+
+    def timed(label: str, function):
+        @functools.wraps(function)
+        def wrapper(*args, **kwargs):
+            started = time.thread_time()
+            try:
+                return function(*args, **kwargs)
+            finally:
+                spent[label] = spent.get(label, 0.0) + time.thread_time() - started
+
+        return wrapper
+
+    targets = []  # every owner looked up before any is wrapped (a class's methods, then the class)
+    for label, (module, path) in STAGES.items():
+        *parents, name = path.split(".")
+        targets.append((label, functools.reduce(getattr, parents, importlib.import_module(module)), name))
+    for label, owner, name in targets:
+        setattr(owner, name, timed(label, getattr(owner, name)))
+    models, result = default_models(), {}
+    for group, scenes in groups.items():
+        for scene in scenes[:3]:
+            plan(scene, models)
+        spent.clear()
+        started = time.thread_time()
+        for scene in scenes:
+            plan(scene, models)
+        total = time.thread_time() - started
+        result[group] = {label: spent.get(label, 0.0) * 1e3 / len(scenes) for label in STAGES}
+        result[group]["other"] = (total - sum(spent.values())) * 1e3 / len(scenes)
+    return result
+
+
 def _stats(times: np.ndarray) -> dict:
     """Median, p95 and p99 (ms) of (scenes, 2) wall and CPU times."""
     stats: dict = {"scenes": len(times)}
@@ -184,6 +239,7 @@ def main() -> None:
         "--rounds", type=int, default=3, help="plan every scene this often, keep its fastest time"
     )
     parser.add_argument("--baseline", type=Path, help="a checkout with its own .venv to time beside this one")
+    parser.add_argument("--stages", action="store_true", help="also time this checkout's planner stages")
     parser.add_argument("--json")
     parser.add_argument("--png")
     args = parser.parse_args()
@@ -203,6 +259,12 @@ def main() -> None:
     }
     for clock in CLOCKS:
         print_table(report, list(pythons), clock)
+    if args.stages:
+        report["stages_ms"] = stage_times(groups)
+        labels = [*STAGES, "other"]
+        print("CPU ms per plan   " + " ".join(f"{label[:12]:>12s}" for label in labels))
+        for group, stages in report["stages_ms"].items():
+            print(f"{group:18s}" + " ".join(f"{stages[label]:12.2f}" for label in labels))
     for g, reason in failed.items():
         print(f"{g}: not generated ({reason})")
     if args.json:

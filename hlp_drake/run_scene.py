@@ -142,9 +142,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         scene=scene or scenario.scene,
         planner=replace(scenario.planner, kind=args.planner or scenario.planner.kind),
         optimiser=replace(scenario.optimiser, workers=args.workers or scenario.optimiser.workers),
-        perception=replace(scenario.perception, source=args.perception or scenario.perception.source),
     )
-    scenario = with_conditions(scenario, execution=args.execution, uncertainty=args.uncertainty)
+    scenario = with_conditions(
+        scenario, execution=args.execution, uncertainty=args.uncertainty, perception=args.perception
+    )
     if scene is None:
         _print(
             f"scene {scenario.scene.name}: {len(scenario.scene.obstacles)} obstacles, "

@@ -37,7 +37,7 @@ from hlp_drake.systems.depth_points import (
     valid_depth,
     view_points,
 )
-from hlp_drake.systems.object_fit import Cluster, boundaries, cluster_points, fit_object
+from hlp_drake.systems.object_fit import Cluster, boundaries, cluster_points, fit_object, linked_sample
 
 if TYPE_CHECKING:
     from hlp_drake.systems.perception_config import PerceptionConfig
@@ -204,7 +204,8 @@ def _perceive(
     x, y = high.xyz[:, 0], high.xyz[:, 1]
     object_points = high.subset((x >= x0) & (x <= x1) & (y >= y0) & (y <= y1))
     radius = max(config.cluster_radius, 1.5 * table.pixel)
-    groups = cluster_points(object_points, radius=radius, min_points=config.min_points)
+    linked = linked_sample(views, object_points, radius)
+    groups = cluster_points(object_points, radius=radius, min_points=config.min_points, linked=linked)
     clusters = boundaries(views, object_points, groups, config.border_margin, table)
     classes = []  # the display's classes per pixel (``Perception.cloud_class``)
     clustered = np.zeros(len(object_points), bool)

@@ -161,17 +161,31 @@ def load_scenario(
 
 
 def with_conditions(
-    scenario: Scenario, *, execution: str | None = None, uncertainty: int | None = None
+    scenario: Scenario,
+    *,
+    execution: str | None = None,
+    uncertainty: int | None = None,
+    perception: str | None = None,
 ) -> Scenario:
     """``scenario`` executed ``execution`` ("open" or "closed"; None: as it says), with seeded
-    model error of seed ``uncertainty`` (None: as it says), the ``--execution`` and
-    ``--uncertainty`` options of ``run_scene`` and the experiments."""
+    model error of seed ``uncertainty`` (None: as it says), its scene from ``perception`` ("truth" or
+    "camera"; None: as it says): the ``--execution``, ``--uncertainty`` and ``--perception`` options
+    of ``run_scene`` and the experiments.
+
+    Raises:
+        HlpError: the settings do not fit together so (e.g. a camera source without a camera).
+    """
     if execution is not None:
         scenario = replace(scenario, closed_loop=replace(scenario.closed_loop, enabled=execution == "closed"))
     if uncertainty is not None:
         scenario = replace(
             scenario, uncertainty=replace(scenario.uncertainty, enabled=True, seed=int(uncertainty))
         )
+    if perception is not None:
+        scenario = replace(scenario, perception=replace(scenario.perception, source=perception))
+    problems = scenario_problems(scenario)
+    if problems:
+        raise HlpError(*problems)
     return scenario
 
 

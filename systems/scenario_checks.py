@@ -7,7 +7,10 @@ from typing import TYPE_CHECKING
 
 from hlp_drake.planner.config import planner_config_problems
 from hlp_drake.scene.generators import MAX_SEED
+from hlp_drake.scene.validation import name_problem
+from hlp_drake.systems.cameras import CLIPPING, camera_pose
 from hlp_drake.systems.optimiser_config import StoCost
+from hlp_drake.systems.perception_config import PERCEPTION_SOURCES
 from hlp_drake.systems.transfer_geometry import TransferConfig
 
 if TYPE_CHECKING:
@@ -17,6 +20,21 @@ MAX_SETTING = 1e9
 """Largest value of any number in the settings (a stiffness of 1e6 N/m is typical)."""
 MAX_TIME_STEP = 0.1
 """s: the largest plant and rollout time step."""
+MIN_TIME_STEP = 1e-4
+"""s: the smallest plant and rollout time step (a simulated second then takes 10,000 steps)."""
+MIN_PERIOD = 1e-3
+"""s: the shortest control step, sampling and re-planning period (each one is work per period)."""
+MAX_DURATION = 60.0
+"""s: the longest segment, settling, grasp phase or period: the simulated time of a run stays bounded."""
+MIN_SPEED = 0.01
+"""m/s: the slowest tcp speed (with MAX_DURATION per segment, a run's trajectory stays bounded)."""
+MAX_PIXELS = 4096
+"""The widest and tallest camera image, pixels; its square is the most pixels of all cameras together
+(memory per frame grows with them)."""
+MAX_CAMERAS = 8
+"""Most cameras in a world."""
+MAX_SCALE = 100.0
+"""The largest factor of ``uncertainty``'s mass and friction ranges."""
 MAX_WORKERS = 64
 """Most rollout processes."""
 SAP_APPROXIMATIONS = ("sap", "lagged", "similar")
@@ -29,9 +47,13 @@ def scenario_problems(scenario: Scenario) -> list[str]:
     validated on its own, by ``validate_scene``)."""
     problems: list[str] = [f"planner.hlp.{p}" for p in planner_config_problems(scenario.planner.hlp)]
 
-    def positive(where: str, value: float, *, zero_ok: bool = False, upper: float = MAX_SETTING) -> None:
+    def positive(
+        where: str, value: float, *, zero_ok: bool = False, lower: float = 0.0, upper: float = MAX_SETTING
+    ) -> None:
         if not math.isfinite(value) or value < 0 or (value == 0 and not zero_ok):
             problems.append(f"{where} must be {'>= 0' if zero_ok else '> 0'}, got {value}")
+        elif value < lower:
+            problems.append(f"{where} must be between {lower:g} and {upper:g}, got {value:g}")
         elif value > upper:
             problems.append(f"{where} must be <= {upper:g}, got {value:g}")
 
@@ -40,7 +62,7 @@ def scenario_problems(scenario: Scenario) -> list[str]:
             problems.append(f"{where} must be between {low} and {high}, got {value}")
 
     plant = scenario.plant
-    positive("plant.time_step", plant.time_step, upper=MAX_TIME_STEP)
+    positive("plant.time_step", plant.time_step, lower=MIN_TIME_STEP, upper=MAX_TIME_STEP)
     if plant.discrete_contact_approximation not in SAP_APPROXIMATIONS:
         problems.append(
             f"plant.discrete_contact_approximation must be one of {', '.join(SAP_APPROXIMATIONS)} "
@@ -86,10 +108,11 @@ def scenario_problems(scenario: Scenario) -> list[str]:
         positive(f"ik.{name}", getattr(ik, name), zero_ok=True)
     count("ik.max_iterations", ik.max_iterations, 1, 100_000)
     count("ik.attempts", ik.attempts, 1, 1000)
-    positive("motion.tcp_speed", scenario.motion.tcp_speed)
-    positive("motion.transit_speed", scenario.motion.transit_speed)
-    positive("motion.joint_speed_fraction", scenario.motion.joint_speed_fraction)
-    positive("motion.min_segment_duration", scenario.motion.min_segment_duration)
+    motion = scenario.motion
+    positive("motion.tcp_speed", motion.tcp_speed, lower=MIN_SPEED, upper=10.0)
+    positive("motion.transit_speed", motion.transit_speed, lower=MIN_SPEED, upper=10.0)
+    positive("motion.joint_speed_fraction", motion.joint_speed_fraction, lower=0.01, upper=1.0)
+    positive("motion.min_segment_duration", motion.min_segment_duration, upper=MAX_DURATION)
     sto, grasp = scenario.optimiser, scenario.grasp
     count("optimiser.samples", sto.samples, 1, 1000)
     count("optimiser.max_iterations", sto.max_iterations, 1, 10_000)
@@ -106,19 +129,14 @@ def scenario_problems(scenario: Scenario) -> list[str]:
     if rim < 0 or rim in (1, 2):
         problems.append(f"optimiser.rollout_trims.rim_spheres must be 0 or >= 3, got {rim}")
     positive("optimiser.time_budget_s", sto.time_budget_s, zero_ok=True)
-    for name in (
-        "step_duration",
-        "mppi_temperature",
-        "sample_period",
-        "rollout_sample_period",
-        "max_object_speed",
-        "max_sink",
-    ):
+    for name in ("step_duration", "sample_period", "rollout_sample_period"):
+        positive(f"optimiser.{name}", getattr(sto, name), lower=MIN_PERIOD, upper=MAX_DURATION)
+    for name in ("mppi_temperature", "max_object_speed", "max_sink"):
         positive(f"optimiser.{name}", getattr(sto, name))
-    positive("optimiser.rollout_time_step", sto.rollout_time_step, upper=MAX_TIME_STEP)
-    positive("optimiser.settle_s", sto.settle_s, zero_ok=True)
+    positive("optimiser.rollout_time_step", sto.rollout_time_step, lower=MIN_TIME_STEP, upper=MAX_TIME_STEP)
+    positive("optimiser.settle_s", sto.settle_s, zero_ok=True, upper=MAX_DURATION)
     positive("optimiser.weld_clearance", sto.weld_clearance)
-    positive("optimiser.weld_lookahead", sto.weld_lookahead, zero_ok=True)
+    positive("optimiser.weld_lookahead", sto.weld_lookahead, zero_ok=True, upper=MAX_DURATION)
     positive("optimiser.weld_margin", sto.weld_margin, zero_ok=True)
     positive("optimiser.sleep_speed", sto.sleep_speed, zero_ok=True)
     if sto.weld_margin > sto.weld_clearance:
@@ -134,14 +152,104 @@ def scenario_problems(scenario: Scenario) -> list[str]:
     for name in TransferConfig.__dataclass_fields__:  # every margin may be 0, every length must be > 0
         positive(f"transfer.{name}", getattr(scenario.transfer, name), zero_ok=name.endswith("margin"))
     closed = scenario.closed_loop
-    positive("closed_loop.replan_period", closed.replan_period)
+    positive("closed_loop.replan_period", closed.replan_period, lower=MIN_PERIOD, upper=MAX_DURATION)
     count("closed_loop.iterations", closed.iterations, 0, 10_000)
     count("closed_loop.rollouts", closed.rollouts, 1, 1_000_000)
     count("closed_loop.max_rollouts", closed.max_rollouts, 1, 100_000_000)
     positive("closed_loop.replan_distance", closed.replan_distance)
     positive("closed_loop.track_distance", closed.track_distance, zero_ok=True)
-    for name in ("close_s", "lift_s", "held_height"):
-        positive(f"grasp.{name}", getattr(grasp, name))
-    for name in ("lift_height", "hold_s"):
-        positive(f"grasp.{name}", getattr(grasp, name), zero_ok=True)
+    for name in ("close_s", "lift_s"):
+        positive(f"grasp.{name}", getattr(grasp, name), upper=MAX_DURATION)
+    positive("grasp.held_height", grasp.held_height)
+    positive("grasp.lift_height", grasp.lift_height, zero_ok=True)
+    positive("grasp.hold_s", grasp.hold_s, zero_ok=True, upper=MAX_DURATION)
+    return problems + perception_problems(scenario) + uncertainty_problems(scenario)
+
+
+def perception_problems(scenario: Scenario) -> list[str]:
+    """The reasons ``scenario.perception`` cannot be used: cameras that could not be built or would
+    not bound a frame's memory, and settings out of range (one line each)."""
+    perception, problems = scenario.perception, []
+    if perception.source not in PERCEPTION_SOURCES:
+        problems.append(
+            f"perception.source must be one of {', '.join(PERCEPTION_SOURCES)}, got {perception.source!r}"
+        )
+    cameras = perception.cameras
+    if perception.source == "camera" and not cameras:
+        problems.append(
+            "perception.cameras is empty, but perception.source is camera: the scene needs a camera"
+        )
+    if len(cameras) > MAX_CAMERAS:
+        problems.append(f"perception.cameras: at most {MAX_CAMERAS} cameras, got {len(cameras)}")
+    pixels = sum(camera.width * camera.height for camera in cameras)
+    if pixels > MAX_PIXELS**2:
+        problems.append(f"perception.cameras: at most {MAX_PIXELS**2} pixels in all, got {pixels}")
+    names = [camera.name for camera in cameras]
+    for name in sorted({n for n in names if names.count(n) > 1}):
+        problems.append(f"perception.cameras: two cameras are named {name!r}")
+    for i, camera in enumerate(cameras[:MAX_CAMERAS]):
+        where = f"perception.cameras[{i}]"
+        named = name_problem(camera.name) or ("name is empty" if not camera.name else None)
+        if named:
+            problems.append(f"{where}: {named}")
+        for name in ("width", "height"):
+            value = getattr(camera, name)
+            if not 8 <= value <= MAX_PIXELS:
+                problems.append(f"{where}.{name} must be between 8 and {MAX_PIXELS} pixels, got {value}")
+        if not 1.0 <= camera.fov_y <= 170.0:
+            problems.append(f"{where}.fov_y must be between 1 and 170 degrees, got {camera.fov_y:g}")
+        near, far = CLIPPING
+        if not near <= camera.min_depth < camera.max_depth <= far:
+            problems.append(
+                f"{where}: the depth range must satisfy {near:g} <= min_depth < max_depth <= {far:g} m, "
+                f"got {camera.min_depth:g} and {camera.max_depth:g}"
+            )
+        if not 0.0 <= camera.depth_noise <= 0.1:
+            problems.append(f"{where}.depth_noise must be between 0 and 0.1 m, got {camera.depth_noise:g}")
+        if not 0.0 <= camera.dropout < 1.0:
+            problems.append(f"{where}.dropout must be in [0, 1), got {camera.dropout:g}")
+        if not 0 <= camera.seed <= MAX_SEED:
+            problems.append(f"{where}.seed must be between 0 and {MAX_SEED}, got {camera.seed}")
+        try:
+            camera_pose(camera, scenario.scene)
+        except ValueError as error:
+            problems.append(f"{where}: {error}")
+    for name, value, low, high in (
+        ("table_tolerance", perception.table_tolerance, 1e-5, 0.1),
+        ("min_height", perception.min_height, 1e-4, 1.0),
+        ("cluster_radius", perception.cluster_radius, 0.0, 0.5),
+        ("cylinder_fill", perception.cylinder_fill, 0.5, 1.0),
+        ("table_margin", perception.table_margin, 0.0, 1.0),
+    ):
+        if not low <= value <= high:
+            problems.append(f"perception.{name} must be between {low:g} and {high:g}, got {value:g}")
+    for name, value, low, high in (
+        ("min_points", perception.min_points, 1, 1_000_000),
+        ("border_margin", perception.border_margin, 0, MAX_PIXELS // 2),
+        ("ransac_points", perception.ransac_points, 3, 1_000_000),
+        ("seed", perception.seed, 0, MAX_SEED),
+    ):
+        if not low <= value <= high:
+            problems.append(f"perception.{name} must be between {low} and {high}, got {value}")
+    return problems
+
+
+def uncertainty_problems(scenario: Scenario) -> list[str]:
+    """The reasons ``scenario.uncertainty``'s model error cannot be drawn (one line each)."""
+    uncertainty, problems = scenario.uncertainty, []
+    if not 0 <= uncertainty.seed <= MAX_SEED:
+        problems.append(f"uncertainty.seed must be between 0 and {MAX_SEED}, got {uncertainty.seed}")
+    if not 0.0 <= uncertainty.position_sigma <= 0.5:
+        problems.append(
+            f"uncertainty.position_sigma must be between 0 and 0.5 m, got {uncertainty.position_sigma:g}"
+        )
+    if not 0.0 <= uncertainty.yaw_sigma <= math.pi:
+        problems.append(f"uncertainty.yaw_sigma must be between 0 and pi rad, got {uncertainty.yaw_sigma:g}")
+    for name in ("mass_scale", "friction_scale"):
+        low, high = getattr(uncertainty, name)
+        if not 1.0 / MAX_SCALE <= low <= high <= MAX_SCALE:
+            problems.append(
+                f"uncertainty.{name} must be [low, high] with {1.0 / MAX_SCALE:g} <= low <= high <= "
+                f"{MAX_SCALE:g}, got [{low:g}, {high:g}]"
+            )
     return problems

@@ -106,14 +106,23 @@ def _scenario_texts(draw) -> str:
 
 
 def _check_scenario(text: str) -> None:
+    """Refused in one line per problem, or loaded and then usable: its cameras build (Drake's
+    checks of the intrinsics and depth range pass) and its model error can be drawn."""
+    from hlp_drake.systems.cameras import camera_pose, render_cameras
+    from hlp_drake.systems.model_error import sample_model_error
     from hlp_drake.systems.scenario import load_scenario
 
     STATS["scenario files"] += 1
     try:
-        load_scenario(data=text, where="fuzz.yaml")
+        scenario = load_scenario(data=text, where="fuzz.yaml")
     except HlpError as error:
         check_error(error)
         STATS["scenario files refused"] += 1
+        return
+    for camera in scenario.perception.cameras:
+        camera_pose(camera, scenario.scene)
+        render_cameras(camera)
+    sample_model_error(scenario.uncertainty, scenario.scene)
 
 
 @pytest.mark.parametrize("profile", PROFILES)

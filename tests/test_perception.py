@@ -374,3 +374,36 @@ def test_a_rolled_cameras_table_edges_are_found_without_the_pixel_grids_bias():
     assert perception.ok, perception.reason
     assert scene.table.length == pytest.approx(SCENE.table.length, abs=0.0005)
     assert scene.table.width == pytest.approx(SCENE.table.width, abs=0.0005)
+
+
+def _spy_on_clustering(monkeypatch) -> list[tuple]:
+    """Each call of the perception's clustering: (linked, its clusters, every point linked's clusters)."""
+    from hlp_drake.systems import perception as module
+
+    calls, real = [], module.cluster_points
+
+    def spy(points, *, radius, min_points, linked=None):
+        groups = real(points, radius=radius, min_points=min_points, linked=linked)
+        calls.append((linked, groups, real(points, radius=radius, min_points=min_points)))
+        return groups
+
+    monkeypatch.setattr(module, "cluster_points", spy)
+    return calls
+
+
+def test_a_fine_cameras_points_are_linked_on_a_strided_sample_into_the_same_objects(frame, monkeypatch):
+    calls = _spy_on_clustering(monkeypatch)
+    perceive_fixed(frame["depth_image"], frame["label_image"], frame["camera_pose"])
+    assert calls[-1][0] is None  # a pixel wider than a third of the radius: every point linked
+    fine = replace(CAMERA, width=640, height=480)
+    scenario = replace(
+        SCENARIO, perception=replace(SCENARIO.perception, cameras=(fine,), cluster_radius=0.02)
+    )
+    perception, _ = perceive_rendered(scenario)
+    assert perception.ok, perception.reason
+    assert perception_record(SCENE, perception)["missed"] == []
+    linked, groups, full = calls[-1]
+    assert linked is not None and 0 < linked.sum() <= linked.size / 3  # every second row and column
+    assert len(groups) == len(full) == len(SCENE.objects)
+    for group, whole in zip(sorted(groups, key=min), sorted(full, key=min)):
+        assert set(group) <= set(whole) and len(group) >= 0.99 * len(whole)

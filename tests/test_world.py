@@ -134,6 +134,39 @@ def test_a_scenarios_scene_is_read_whole_in_the_scene_file_format(tmp_path):
         ("closed_loop: {replan_period: 0.0}\n", "closed_loop.replan_period must be > 0, got 0.0"),
         ("closed_loop: {rollouts: 0}\n", "closed_loop.rollouts must be between 1 and 1000000, got 0"),
         ("closed_loop: {track_distance: -0.01}\n", "closed_loop.track_distance must be >= 0"),
+        # Values that loaded and then failed inside Drake, or ran out of memory or time:
+        ("plant: {time_step: 1.0e-9}\n", "plant.time_step must be between 0.0001 and 0.1, got 1e-09"),
+        ("motion: {tcp_speed: 1.0e-9}\n", "motion.tcp_speed must be between 0.01 and 10, got 1e-09"),
+        ("optimiser: {step_duration: 1.0e-9}\n", "optimiser.step_duration must be between 0.001 and 60"),
+        ("grasp: {hold_s: 1.0e+9}\n", "grasp.hold_s must be <= 60, got 1e+09"),
+        (
+            "perception: {cameras: [{width: 100000}]}\n",
+            "perception.cameras[0].width must be between 8 and 4096",
+        ),
+        ("perception: {cameras: [{fov_y: -5}]}\n", "perception.cameras[0].fov_y must be between 1 and 170"),
+        ("perception: {cameras: [{up: [0, 0, 1]}]}\n", "up [0.0, 0.0, 1.0] is parallel to its view"),
+        ("perception: {cameras: [{look_at: [0, 0, 1.6]}]}\n", "look_at is its position"),
+        (
+            "perception: {cameras: [{min_depth: 3, max_depth: 1}]}\n",
+            "min_depth < max_depth <= 10 m, got 3 and 1",
+        ),
+        (
+            "perception: {cameras: [{dropout: 1.0}]}\n",
+            "perception.cameras[0].dropout must be in [0, 1), got 1",
+        ),
+        ("perception: {cameras: [{name: a}, {name: a}]}\n", "two cameras are named 'a'"),
+        ("perception: {cameras: [{name: ''}]}\n", "perception.cameras[0]: name is empty"),
+        (
+            "perception: {source: camera, cameras: []}\n",
+            "perception.cameras is empty, but perception.source is camera",
+        ),
+        ("perception: {ransac_points: 0}\n", "perception.ransac_points must be between 3 and 1000000, got 0"),
+        (
+            "uncertainty: {mass_scale: [-1, 0]}\n",
+            "uncertainty.mass_scale must be [low, high] with 0.01 <= low",
+        ),
+        ("uncertainty: {friction_scale: [2, 0.5]}\n", "got [2, 0.5]"),
+        ("uncertainty: {position_sigma: 10.0}\n", "uncertainty.position_sigma must be between 0 and 0.5 m"),
     ],
 )
 def test_bad_scenario_file_raises_one_line_hlp_errors_naming_the_file_and_field(tmp_path, text, problem):
@@ -386,3 +419,17 @@ def test_meshcat_visualisation_is_optional(monkeypatch):
     simulator = Simulator(world)
     simulator.AdvanceTo(0.05)
     assert meshcat.HasPath("/drake/visualizer") and meshcat.HasPath("/drake/contact_forces")
+
+
+def test_a_camera_source_without_a_camera_is_refused_whichever_way_it_is_asked_for():
+    from hlp_drake.experiments.experiment import scenario_yamls
+    from hlp_drake.systems.scenario import with_conditions
+
+    no_cameras = "perception: {cameras: []}\n"
+    scenario = load_scenario(data=no_cameras)  # fine while the scene comes from the plant
+    assert with_conditions(scenario, perception="truth").perception.cameras == ()
+    expected = "perception.cameras is empty, but perception.source is camera"
+    with pytest.raises(HlpError, match=expected):
+        with_conditions(scenario, perception="camera")
+    with pytest.raises(HlpError, match=expected):
+        scenario_yamls(no_cameras, perception="camera")

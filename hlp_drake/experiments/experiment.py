@@ -104,11 +104,9 @@ def scenario_yamls(
     as the jobs run it (``optimiser.workers = 1`` if ``single_process_rollouts``)."""
     from dataclasses import replace
 
-    from hlp_drake.systems.scenario import load_scenario
+    from hlp_drake.systems.scenario import load_scenario, with_conditions
 
-    scenario = load_scenario(data=text, where="--config")
-    if perception is not None:
-        scenario = replace(scenario, perception=replace(scenario.perception, source=perception))
+    scenario = with_conditions(load_scenario(data=text, where="--config"), perception=perception)
     jobs = (
         replace(scenario, optimiser=replace(scenario.optimiser, workers=1))
         if single_process_rollouts

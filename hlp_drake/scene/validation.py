@@ -53,7 +53,8 @@ def _numbers(value: object, count: int) -> bool:
     return all(map(_is_finite, value))
 
 
-def _name_problem(name: object, limit: int) -> str | None:
+def name_problem(name: object, limit: int = MAX_NAME) -> str | None:
+    """Why ``name`` cannot name an object (or a camera), or None."""
     if not isinstance(name, str):
         return f"name must be text, got {brief(name)}"
     if len(name) > limit:
@@ -75,7 +76,7 @@ def _object_problems(obj: object, role: str, index: int) -> list[str]:
     """What is wrong with one object on its own (its placement is checked with the others)."""
     if not isinstance(obj, SceneObject):
         return [f"{role} {index}: expected a SceneObject, got {brief(obj)}"]
-    named = _name_problem(obj.name, MAX_NAME)
+    named = name_problem(obj.name, MAX_NAME)
     if named is not None:
         return [f"{role} {index}: {named}"]
     if not obj.name:
@@ -177,7 +178,7 @@ def _scene_shape_problems(scene: Scene) -> list[str]:
         problems.append(f"start_yaw must be a finite number, got {brief(scene.start_yaw)}")
     elif abs(scene.start_yaw) > YAW_LIMIT:
         problems.append(f"start_yaw must be within +-2 pi rad, got {scene.start_yaw!r}")
-    named = _name_problem(scene.name, 2 * MAX_NAME)
+    named = name_problem(scene.name, 2 * MAX_NAME)
     if named is not None:
         problems.append(f"scene {named}")
     if not isinstance(scene.obstacles, tuple | list):

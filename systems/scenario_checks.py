@@ -28,6 +28,8 @@ MAX_DURATION = 60.0
 """s: the longest segment, settling, grasp phase or period: the simulated time of a run stays bounded."""
 MIN_SPEED = 0.01
 """m/s: the slowest tcp speed (with MAX_DURATION per segment, a run's trajectory stays bounded)."""
+MIN_TRAVEL_STEP = 1e-4
+"""m: the finest step pushes and ways are measured in (their samples grow as its inverse)."""
 MAX_PIXELS = 4096
 """The widest and tallest camera image, pixels; its square is the most pixels of all cameras together
 (memory per frame grows with them)."""
@@ -151,6 +153,7 @@ def scenario_problems(scenario: Scenario) -> list[str]:
         positive(f"optimiser.cost.{name}", getattr(sto.cost, name), zero_ok=True)
     for name in TransferConfig.__dataclass_fields__:  # every margin may be 0, every length must be > 0
         positive(f"transfer.{name}", getattr(scenario.transfer, name), zero_ok=name.endswith("margin"))
+    positive("transfer.travel_step", scenario.transfer.travel_step, lower=MIN_TRAVEL_STEP, upper=0.1)
     closed = scenario.closed_loop
     positive("closed_loop.replan_period", closed.replan_period, lower=MIN_PERIOD, upper=MAX_DURATION)
     count("closed_loop.iterations", closed.iterations, 0, 10_000)

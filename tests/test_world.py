@@ -140,6 +140,10 @@ def test_a_scenarios_scene_is_read_whole_in_the_scene_file_format(tmp_path):
         ("optimiser: {step_duration: 1.0e-9}\n", "optimiser.step_duration must be between 0.001 and 60"),
         ("grasp: {hold_s: 1.0e+9}\n", "grasp.hold_s must be <= 60, got 1e+09"),
         (
+            "transfer: {travel_step: 1.0e-9}\n",
+            "transfer.travel_step must be between 0.0001 and 0.1, got 1e-09",
+        ),
+        (
             "perception: {cameras: [{width: 100000}]}\n",
             "perception.cameras[0].width must be between 8 and 4096",
         ),

@@ -24,6 +24,7 @@ from hlp_drake.systems.optimiser_system import StochasticTrajectoryOptimiser
 from hlp_drake.systems.robot_transfer import RobotPlanTransfer
 from hlp_drake.systems.rollout_cost import RolloutOutcome
 from hlp_drake.systems.rollout_pool import RolloutPool
+from hlp_drake.systems.scenario_checks import check_scenario
 from hlp_drake.systems.scene_rollouts import SceneRollouts
 from hlp_drake.systems.scene_source import SCENE_PORT
 from hlp_drake.systems.straight_line import StraightLinePlanSystem
@@ -67,7 +68,11 @@ def make_planning_diagram(
         models: the decision models (default: ``scenario_models(scenario)``).
         plan: a person's plan to use instead of the planner block's (written out, or planned
             elsewhere): a constant source feeds it to the transfer, whatever the scene.
+
+    Raises:
+        HlpError: settings that cannot be used (``check_scenario``: a scenario made in Python).
     """
+    check_scenario(scenario)
     kind = "given" if plan is not None else scenario.planner.kind
     builder = DiagramBuilder()
     transfer = builder.AddNamedSystem("robot_plan_transfer", RobotPlanTransfer(scenario))

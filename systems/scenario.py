@@ -37,7 +37,7 @@ from hlp_drake.scene.validation import scene_problems
 from hlp_drake.systems.model_error import UncertaintyConfig
 from hlp_drake.systems.optimiser_config import ClosedLoopConfig, StoConfig
 from hlp_drake.systems.perception_config import PerceptionConfig
-from hlp_drake.systems.scenario_checks import scenario_problems
+from hlp_drake.systems.scenario_checks import check_scenario, scenario_problems
 from hlp_drake.systems.transfer_geometry import TransferConfig
 from hlp_drake.systems.world_settings import (
     BodiesConfig,
@@ -183,10 +183,7 @@ def with_conditions(
         )
     if perception is not None:
         scenario = replace(scenario, perception=replace(scenario.perception, source=perception))
-    problems = scenario_problems(scenario)
-    if problems:
-        raise HlpError(*problems)
-    return scenario
+    return check_scenario(scenario)
 
 
 __all__ = ["PLANNERS", "PlannerSettings", "Scenario", "load_scenario", "with_conditions"]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
+from hlp_drake.errors import HlpError
 from hlp_drake.planner.config import planner_config_problems
 from hlp_drake.scene.generators import MAX_SEED
 from hlp_drake.scene.validation import name_problem
@@ -167,6 +168,19 @@ def scenario_problems(scenario: Scenario) -> list[str]:
     positive("grasp.lift_height", grasp.lift_height, zero_ok=True)
     positive("grasp.hold_s", grasp.hold_s, zero_ok=True, upper=MAX_DURATION)
     return problems + perception_problems(scenario) + uncertainty_problems(scenario)
+
+
+def check_scenario(scenario: Scenario) -> Scenario:
+    """``scenario`` if its settings can be used: the diagram builders' check of a scenario made in
+    Python (a loaded one is checked as it loads, ``load_scenario``).
+
+    Raises:
+        HlpError: one line per problem (``scenario_problems``).
+    """
+    problems = scenario_problems(scenario)
+    if problems:
+        raise HlpError(*problems)
+    return scenario
 
 
 def perception_problems(scenario: Scenario) -> list[str]:

@@ -49,6 +49,7 @@ from pydrake.trajectories import Trajectory
 
 from hlp_drake.systems.cameras import add_cameras, label_classes
 from hlp_drake.systems.robot import ARM_JOINTS, BASE_JOINTS, GRIPPER_JOINTS, ROBOT_MODEL_NAME, add_robot
+from hlp_drake.systems.scenario_checks import check_scenario
 from hlp_drake.systems.scene_models import add_scene
 from hlp_drake.systems.start_pose import robot_position_names, start_configuration
 from hlp_drake.systems.world_settings import ContactConfig, ControlConfig
@@ -208,7 +209,11 @@ def make_world_diagram(
             engine follows every pose).
         model_error: the world differs from the scenario so (``sample_model_error``): its objects
             stand where ``model_error.true_scene`` has them, with its mass and friction factors.
+
+    Raises:
+        HlpError: settings that cannot be used (``check_scenario``: a scenario made in Python).
     """
+    check_scenario(scenario)
     scene = scenario.scene if model_error is None else model_error.true_scene(scenario.scene)
     scales = None if model_error is None else model_error.scales()
     builder = DiagramBuilder()

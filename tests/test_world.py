@@ -437,3 +437,13 @@ def test_a_camera_source_without_a_camera_is_refused_whichever_way_it_is_asked_f
         with_conditions(scenario, perception="camera")
     with pytest.raises(HlpError, match=expected):
         scenario_yamls(no_cameras, perception="camera")
+
+
+def test_a_scenario_made_in_python_is_checked_by_the_diagram_builders():
+    from hlp_drake.systems.perception_config import CameraSettings, PerceptionConfig
+    from hlp_drake.systems.planning_diagram import make_planning_diagram
+
+    bad = Scenario(perception=PerceptionConfig(source="camera", cameras=(CameraSettings(width=0),)))
+    for build in (make_world_diagram, make_planning_diagram):
+        with pytest.raises(HlpError, match=r"perception\.cameras\[0\]\.width must be between 8 and 4096"):
+            build(bad)

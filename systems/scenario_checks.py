@@ -40,6 +40,10 @@ MAX_SCALE = 100.0
 """The largest factor of ``uncertainty``'s mass and friction ranges."""
 MAX_WORKERS = 64
 """Most rollout processes."""
+MAX_WORLD_OBSTACLES = 100
+"""Most obstacles in a simulated world (the planner alone, ``hlp_drake.planner.plan``, takes a scene's
+10,000): 100 on a 2 m table took 0.6 GB and 2 min to plan, verify and execute here; 400, 2.7 GB and
+a minute per simulated second; 2,500, 10 GB before the plan."""
 SAP_APPROXIMATIONS = ("sap", "lagged", "similar")
 """Discrete contact approximations solved by SAP (TAMSI, "tamsi", cannot simulate the mimic finger)."""
 CONTACT_MODELS = ("point", "hydroelastic", "hydroelastic_with_fallback")
@@ -49,6 +53,12 @@ def scenario_problems(scenario: Scenario) -> list[str]:
     """The reasons ``scenario``'s settings cannot be used (empty when they are fine; the scene is
     validated on its own, by ``validate_scene``)."""
     problems: list[str] = [f"planner.hlp.{p}" for p in planner_config_problems(scenario.planner.hlp)]
+    obstacles = getattr(scenario.scene, "obstacles", ())
+    if isinstance(obstacles, tuple | list) and len(obstacles) > MAX_WORLD_OBSTACLES:
+        problems.append(
+            f"scene: {len(obstacles)} obstacles, more than the {MAX_WORLD_OBSTACLES} a simulated world takes "
+            "(hlp_drake.planner.plan alone takes more)"
+        )
 
     def positive(
         where: str, value: float, *, zero_ok: bool = False, lower: float = 0.0, upper: float = MAX_SETTING

@@ -447,3 +447,17 @@ def test_a_scenario_made_in_python_is_checked_by_the_diagram_builders():
     for build in (make_world_diagram, make_planning_diagram):
         with pytest.raises(HlpError, match=r"perception\.cameras\[0\]\.width must be between 8 and 4096"):
             build(bad)
+
+
+def test_a_scene_of_more_obstacles_than_a_world_takes_is_refused_before_any_is_built():
+    from hlp_drake.scene.model import SceneObject
+    from hlp_drake.systems.scenario_checks import MAX_WORLD_OBSTACLES
+
+    scene = load_scenario().scene
+    crowd = tuple(
+        SceneObject(f"o{i}", "box", 0.05 + 0.02 * (i % 30), -0.45 + 0.03 * (i // 30), (0.01, 0.01, 0.05))
+        for i in range(MAX_WORLD_OBSTACLES + 1)
+    )
+    crowded = replace(Scenario(), scene=replace(scene, obstacles=crowd))
+    with pytest.raises(HlpError, match=r"scene: 101 obstacles, more than the 100 a simulated world takes"):
+        make_world_diagram(crowded)

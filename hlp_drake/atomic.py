@@ -39,6 +39,39 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
         tmp.unlink(missing_ok=True)
 
 
+def check_writable(*paths: str | os.PathLike[str] | None) -> None:
+    """Refuse now the outputs a command could not write at its end (None: not asked for): a path
+    that is a folder, or a folder that cannot be made or written (probed with a temporary file in
+    the nearest existing one, removed at once; nothing is created), so no work is lost to them and
+    no output is written while another is refused.
+
+    Raises:
+        HlpError: one line per output that cannot be written.
+    """
+    problems = []
+    for path in paths:
+        if path is None:
+            continue
+        target = Path(path)
+        if target.is_dir():
+            problems.append(f"{target}: cannot write: it is a directory")
+            continue
+        folder = target.parent
+        while not folder.exists() and folder != folder.parent:
+            folder = folder.parent
+        try:
+            if not folder.is_dir():
+                raise NotADirectoryError(0, "not a directory", str(folder))
+            fd, probe = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=folder)
+        except OSError as error:
+            problems.append(f"{target}: cannot write: {_reason(error)}")
+            continue
+        os.close(fd)
+        os.unlink(probe)
+    if problems:
+        raise HlpError(*problems)
+
+
 def _reason(error: OSError) -> str:
     """``error`` in a few words, naming the path it is about (e.g. a parent that is a file)."""
     if isinstance(error, FileExistsError | NotADirectoryError):

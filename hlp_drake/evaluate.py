@@ -23,6 +23,7 @@ from functools import partial
 
 from tqdm import tqdm
 
+from hlp_drake.atomic import check_writable
 from hlp_drake.cli import MAX_SEED, MAX_WORKERS, add_quiet, integer, make_parser, run_cli
 from hlp_drake.dataset.dataset import Dataset
 from hlp_drake.dataset.records import STRUCTURED, UNSTRUCTURED, category_of
@@ -115,6 +116,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.error(
             "the unstructured protocol segments in fixed mode (faithful mode cannot read unstructured rows)"
         )
+    check_writable(args.json, args.csv, args.png)
     started = time.perf_counter()
     models = None
     if args.models:  # before any work: a missing or damaged model file is a usage error

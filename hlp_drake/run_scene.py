@@ -22,7 +22,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import replace
 
-from hlp_drake.atomic import write_text_atomic
+from hlp_drake.atomic import check_writable, write_text_atomic
 from hlp_drake.cli import (
     MAX_SEED,
     MAX_WORKERS,
@@ -126,6 +126,7 @@ def _parser():
 def main(argv: Sequence[str] | None = None) -> int:
     started = time.perf_counter()
     args = _parser().parse_args(argv)
+    check_writable(args.json, args.html)
     scene = None
     if args.kind is not None:
         scene = generate_scene(args.kind, args.seed, args.objects)

@@ -14,7 +14,7 @@ import time
 from collections import Counter
 from collections.abc import Sequence
 
-from hlp_drake.atomic import write_text_atomic
+from hlp_drake.atomic import check_writable, write_text_atomic
 from hlp_drake.cli import add_quiet, make_parser, run_cli
 from hlp_drake.dataset.dataset import Dataset
 from hlp_drake.dataset.records import STRUCTURED, UNSTRUCTURED
@@ -106,6 +106,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.error(
             "unstructured trials are segmented in fixed mode only (the released code reads two rows)"
         )
+    check_writable(args.out, args.json, args.png)
     dataset = Dataset(args.dataset)
     if args.trial is not None:
         if args.trial not in dataset:

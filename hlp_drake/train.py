@@ -12,7 +12,9 @@ from __future__ import annotations
 import time
 from collections import Counter
 from collections.abc import Sequence
+from pathlib import Path
 
+from hlp_drake.atomic import check_writable
 from hlp_drake.cli import add_quiet, make_parser, run_cli
 from hlp_drake.dataset.dataset import Dataset
 from hlp_drake.dataset.records import STRUCTURED, UNSTRUCTURED, category_of
@@ -44,6 +46,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--out", required=True, help="directory for models.json and models.npz")
     add_quiet(parser)
     args = parser.parse_args(argv)
+    check_writable(Path(args.out) / "models.json", Path(args.out) / "models.npz")
     dataset = Dataset(args.dataset)
     if args.subjects:
         unknown = sorted(set(args.subjects) - set(dataset.subjects))

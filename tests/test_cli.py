@@ -11,6 +11,7 @@ import pytest
 
 from hlp_drake import __version__
 from hlp_drake.__main__ import COMMANDS, main
+from hlp_drake.cli import run_cli
 
 MODULES = sorted(set(COMMANDS.values()))
 
@@ -63,3 +64,41 @@ def test_the_console_script_is_installed():
         [str(script), "--version"], capture_output=True, text=True, timeout=60, check=False
     )
     assert result.returncode == 0 and result.stdout.strip() == f"hlp-drake {__version__}"
+
+
+def test_outputs_that_cannot_be_written_are_refused_before_any_work(tmp_path):
+    from hlp_drake.atomic import check_writable
+    from hlp_drake.errors import HlpError
+
+    a_file = tmp_path / "a_file"
+    a_file.write_text("x")
+    check_writable(None, tmp_path / "new" / "er" / "out.json")  # folders made at the end, not now
+    assert sorted(tmp_path.rglob("*")) == [a_file]
+    with pytest.raises(HlpError) as info:
+        check_writable(tmp_path, a_file / "out.json", tmp_path / "fine.json")
+    assert info.value.problems == (
+        f"{tmp_path}: cannot write: it is a directory",
+        f"{a_file / 'out.json'}: cannot write: {a_file} is not a directory",
+    )
+    assert sorted(tmp_path.rglob("*")) == [a_file]  # the probe left nothing
+
+
+@pytest.mark.parametrize(
+    "module, args",
+    [
+        ("hlp_drake.run_scene", ["--json", "{dir}", "--html", "{dir}/x.html"]),
+        ("hlp_drake.evaluate", ["--json", "{dir}/r.json", "--csv", "{dir}"]),
+        ("hlp_drake.train", ["--out", "{file}"]),
+        ("hlp_drake.segment", ["--out", "{dir}"]),
+    ],
+)
+def test_each_command_refuses_an_unwritable_output_first(tmp_path, capsys, module, args):
+    (a_file := tmp_path / "a_file").write_text("x")
+    argv = [a.format(dir=tmp_path, file=a_file) for a in args]
+    entry = importlib.import_module(module).main
+    assert run_cli(entry, argv) == 2
+    out, err = capsys.readouterr()
+    assert (
+        out == "" and err.startswith("error: ") and "cannot write" in err
+    )  # before the dataset or the scene
+    assert sorted(tmp_path.rglob("*")) == [a_file]

@@ -31,6 +31,7 @@ from pydrake.trajectories import PiecewisePolynomial
 from hlp_drake.planner.plan import HighLevelPlan
 from hlp_drake.systems.keyframes import Keyframes
 from hlp_drake.systems.keypoint_solver import KeypointSolver
+from hlp_drake.systems.scenario_checks import check_scenario
 
 if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
@@ -42,6 +43,7 @@ class KeypointIk(LeafSystem):
 
     def __init__(self, scenario: Scenario) -> None:
         super().__init__()
+        check_scenario(scenario)
         solver = KeypointSolver(scenario)
         self._solver = solver
         empty_plan = HighLevelPlan(scene=scenario.scene.name, keypoints=(), reason="no plan given")

@@ -25,6 +25,7 @@ from pydrake.trajectories import PiecewisePolynomial
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser import EMPTY_RESULT, StoResult, optimise
 from hlp_drake.systems.rollout_pool import RolloutPool
+from hlp_drake.systems.scenario_checks import check_scenario
 from hlp_drake.systems.scene_source import declare_scene_input_port, scene_input, with_scene
 
 if TYPE_CHECKING:
@@ -42,6 +43,7 @@ class StochasticTrajectoryOptimiser(LeafSystem):
 
     def __init__(self, scenario: Scenario, pool: RolloutPool) -> None:
         super().__init__()
+        check_scenario(scenario)
         self._scenario = scenario
         self._pool = pool
         self._scene = declare_scene_input_port(self)

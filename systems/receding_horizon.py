@@ -53,6 +53,7 @@ from hlp_drake.systems.perception import Perception
 from hlp_drake.systems.robot import ROBOT_MODEL_NAME
 from hlp_drake.systems.rollout_cost import Prediction
 from hlp_drake.systems.rollout_world import RolloutStart
+from hlp_drake.systems.scenario_checks import check_scenario
 from hlp_drake.systems.scene_source import declare_scene_input_port, scene_input, with_scene
 
 if TYPE_CHECKING:
@@ -139,6 +140,7 @@ class RecedingHorizonController(LeafSystem):
         initialiser: Initialiser | None = None,
     ) -> None:
         super().__init__()
+        check_scenario(scenario)
         self._scenario, self._pool, self._initialiser = scenario, pool, initialiser
         self._plant = plant
         objects = () if scenario.perception.source == "camera" else scenario.scene.objects

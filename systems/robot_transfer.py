@@ -17,6 +17,7 @@ from pydrake.systems.framework import LeafSystem
 
 from hlp_drake.planner import HighLevelPlan
 from hlp_drake.systems.push_transfer import robot_alternatives, robot_plan
+from hlp_drake.systems.scenario_checks import check_scenario
 from hlp_drake.systems.scene_source import declare_scene_input_port, scene_input
 from hlp_drake.systems.transfer_geometry import PushRules, gripper_geometry, push_rules
 
@@ -29,6 +30,7 @@ class RobotPlanTransfer(LeafSystem):
 
     def __init__(self, scenario: Scenario) -> None:
         super().__init__()
+        check_scenario(scenario)
         rules = push_rules(scenario.transfer, gripper_geometry())
         limit = scenario.optimiser.alternatives
         self._rules = rules

@@ -20,6 +20,7 @@ from pydrake.systems.sensors import ImageDepth32F, ImageLabel16I
 from hlp_drake.systems.cameras import camera_info
 from hlp_drake.systems.depth_points import CameraView
 from hlp_drake.systems.perception import Perception, perceive, unperceived_scene
+from hlp_drake.systems.scenario_checks import check_scenario
 from hlp_drake.systems.scene_source import MODEL_SCENE, SCENE_PORT
 from hlp_drake.systems.world import make_world_diagram
 
@@ -55,6 +56,7 @@ class ScenePerception(LeafSystem):
 
     def __init__(self, scenario: Scenario) -> None:
         super().__init__()
+        check_scenario(scenario)
         self._config = scenario.perception
         self._template = scenario.scene
         self._cameras = self._config.cameras

@@ -439,12 +439,25 @@ def test_a_camera_source_without_a_camera_is_refused_whichever_way_it_is_asked_f
         scenario_yamls(no_cameras, perception="camera")
 
 
-def test_a_scenario_made_in_python_is_checked_by_the_diagram_builders():
+def test_a_scenario_made_in_python_is_checked_by_the_builders_and_blocks():
+    from hlp_drake.systems.keypoint_ik import KeypointIk
+    from hlp_drake.systems.optimiser_system import StochasticTrajectoryOptimiser
     from hlp_drake.systems.perception_config import CameraSettings, PerceptionConfig
     from hlp_drake.systems.planning_diagram import make_planning_diagram
+    from hlp_drake.systems.receding_horizon import RecedingHorizonController
+    from hlp_drake.systems.robot_transfer import RobotPlanTransfer
+    from hlp_drake.systems.scene_perception import ScenePerception
 
     bad = Scenario(perception=PerceptionConfig(source="camera", cameras=(CameraSettings(width=0),)))
-    for build in (make_world_diagram, make_planning_diagram):
+    for build in (
+        make_world_diagram,
+        make_planning_diagram,
+        ScenePerception,
+        KeypointIk,
+        RobotPlanTransfer,
+        lambda scenario: StochasticTrajectoryOptimiser(scenario, pool=None),
+        lambda scenario: RecedingHorizonController(scenario, plant=None, pool=None),
+    ):
         with pytest.raises(HlpError, match=r"perception\.cameras\[0\]\.width must be between 8 and 4096"):
             build(bad)
 

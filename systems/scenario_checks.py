@@ -237,10 +237,13 @@ def perception_problems(scenario: Scenario) -> list[str]:
             problems.append(f"{where}.dropout must be in [0, 1), got {camera.dropout:g}")
         if not 0 <= camera.seed <= MAX_SEED:
             problems.append(f"{where}.seed must be between 0 and {MAX_SEED}, got {camera.seed}")
+        for name in ("position", "look_at", "up"):
+            if not all(map(math.isfinite, getattr(camera, name))):
+                problems.append(f"{where}.{name} must be finite, got {list(getattr(camera, name))}")
         try:
             camera_pose(camera, scenario.scene)
-        except ValueError as error:
-            problems.append(f"{where}: {error}")
+        except (ValueError, RuntimeError) as error:  # RuntimeError: Drake's, e.g. a pose of NaN
+            problems.append(f"{where}: {str(error).splitlines()[0]}")
     for name, value, low, high in (
         ("table_tolerance", perception.table_tolerance, 1e-5, 0.1),
         ("min_height", perception.min_height, 1e-4, 1.0),

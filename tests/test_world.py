@@ -460,6 +460,9 @@ def test_a_scenario_made_in_python_is_checked_by_the_builders_and_blocks():
     ):
         with pytest.raises(HlpError, match=r"perception\.cameras\[0\]\.width must be between 8 and 4096"):
             build(bad)
+    nan = Scenario(perception=PerceptionConfig(cameras=(CameraSettings(position=(math.nan, 0.0, 1.6)),)))
+    with pytest.raises(HlpError, match=r"perception\.cameras\[0\]\.position must be finite"):
+        make_world_diagram(nan)  # the loader refuses NaN itself; a scenario made in Python is checked here
 
 
 def test_a_scene_of_more_obstacles_than_a_world_takes_is_refused_before_any_is_built():

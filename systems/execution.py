@@ -322,12 +322,10 @@ def _execute(
                 plant.SetPositionsAndVelocities(state, plant.GetModelInstanceByName(name), x)
             simulator.Initialize()
             listener.simulated(reached.time)
+            settled = reached.time
         else:
             result.reach_reused = False
-            while simulator.get_context().get_time() < end:  # closed loop: a re-plan may move the end
-                simulator.AdvanceTo(end)
-                end = command.end(root)
-            simulator.AdvanceTo(end + SETTLE_S)
+            settled = advance_through_reach(simulator, command)
         after = object_planar_poses(plant, plant_context, names)
         result.objects_moved = [
             n
@@ -348,9 +346,7 @@ def _execute(
         if problem is not None and result.failure_reason is None:
             result.failure_reason = f"in execution: {problem}"
         if problem is None:
-            result.grasp_held = _grasp(
-                simulator, command, end + SETTLE_S, scenario, plant, plant_context, scene
-            )
+            result.grasp_held = _grasp(simulator, command, settled, scenario, plant, plant_context, scene)
     except (RuntimeError, SystemExit) as error:
         failure = simulation_failure(error)
         if result.failure_reason is None:
@@ -361,6 +357,21 @@ def _execute(
         if meshcat is not None:
             meshcat.StopRecording()
             meshcat.PublishRecording()
+
+
+def advance_through_reach(simulator: Simulator, command: OpenLoopCommand | ClosedLoopCommand) -> float:
+    """Simulate to the end of the commanded reach, then ``SETTLE_S`` more; return that time. A closed
+    loop's re-plan may move the end while the simulation goes there: later (it goes on), or earlier
+    than the time already simulated (the robot has held the reach's last pose since; the settling
+    ends no earlier than now: going back would be Drake's "boundary_time >= context time" failure)."""
+    root = simulator.get_mutable_context()
+    end = command.end(root)
+    while root.get_time() < end:
+        simulator.AdvanceTo(end)
+        end = command.end(root)
+    settled = max(end + SETTLE_S, root.get_time())
+    simulator.AdvanceTo(settled)
+    return settled
 
 
 def _grasp(simulator, command, t0, scenario, plant, plant_context, scene) -> bool:

@@ -12,6 +12,7 @@ from hlp_drake.errors import HlpError
 from hlp_drake.run_scene import DEFAULT_SCENE
 from hlp_drake.scene.io import load_scene
 from hlp_drake.systems.control_sequence import ControlSequence
+from hlp_drake.systems.execution import SETTLE_S
 from hlp_drake.systems.model_error import UncertaintyConfig, sample_model_error
 from hlp_drake.systems.observed_planning import ObservedScenePlanner
 from hlp_drake.systems.receding_horizon import remainder
@@ -159,3 +160,32 @@ def test_a_verified_sequence_on_track_is_kept_and_re_optimised_once_off_track(sc
     always = scenario.updated("closed_loop: {track_distance: 0.0}\n")
     record, _, _ = run_controller(always, sequence, 1.0, outcome=verified(0.0))
     assert (record.on_track, record.replans) == (0, 2)
+
+
+class _MovingEnd:
+    """A command whose reach ends at ``ends[k]`` when asked the k-th time (a re-plan moving it)."""
+
+    def __init__(self, *ends: float) -> None:
+        self._ends = list(ends)
+
+    def end(self, root_context) -> float:
+        return self._ends.pop(0) if len(self._ends) > 1 else self._ends[0]
+
+
+@pytest.mark.parametrize(
+    "ends, settled",
+    [
+        ((1.0,), 1.0 + SETTLE_S),  # open loop: the end stays
+        ((1.0, 1.5), 1.5 + SETTLE_S),  # a re-plan made the reach longer: simulated on to its end
+        ((2.0, 0.2), 2.0),  # shorter, ending before the time simulated (gen2-9-33 with model error)
+    ],
+)
+def test_the_reach_is_simulated_to_its_end_wherever_a_re_plan_moves_it(ends, settled):
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.primitives import ConstantVectorSource
+
+    from hlp_drake.systems.execution import advance_through_reach
+
+    simulator = Simulator(ConstantVectorSource([0.0]))
+    assert advance_through_reach(simulator, _MovingEnd(*ends)) == pytest.approx(settled)
+    assert simulator.get_context().get_time() == pytest.approx(settled)

@@ -193,6 +193,19 @@ def check_scenario(scenario: Scenario) -> Scenario:
     return scenario
 
 
+def _range_problem(where: str, value: float, low: float, high: float, unit: str = "") -> str | None:
+    """ "``where`` must be between ``low`` and ``high``" if ``value`` lies outside them (or is NaN)."""
+    if low <= value <= high:
+        return None
+
+    def text(number: float) -> str:
+        return str(number) if isinstance(number, int) else f"{number:g}"
+
+    return (
+        f"{where} must be between {text(low)} and {text(high)}{' ' + unit if unit else ''}, got {text(value)}"
+    )
+
+
 def perception_problems(scenario: Scenario) -> list[str]:
     """The reasons ``scenario.perception`` cannot be used: cameras that could not be built or would
     not bound a frame's memory, and settings out of range (one line each)."""
@@ -214,29 +227,27 @@ def perception_problems(scenario: Scenario) -> list[str]:
     names = [camera.name for camera in cameras]
     for name in sorted({n for n in names if names.count(n) > 1}):
         problems.append(f"perception.cameras: two cameras are named {name!r}")
+    ranges = []  # (where, value, low, high, unit)
     for i, camera in enumerate(cameras[:MAX_CAMERAS]):
         where = f"perception.cameras[{i}]"
         named = name_problem(camera.name) or ("name is empty" if not camera.name else None)
         if named:
             problems.append(f"{where}: {named}")
-        for name in ("width", "height"):
-            value = getattr(camera, name)
-            if not 8 <= value <= MAX_PIXELS:
-                problems.append(f"{where}.{name} must be between 8 and {MAX_PIXELS} pixels, got {value}")
-        if not 1.0 <= camera.fov_y <= 170.0:
-            problems.append(f"{where}.fov_y must be between 1 and 170 degrees, got {camera.fov_y:g}")
+        ranges += [
+            (f"{where}.width", camera.width, 8, MAX_PIXELS, "pixels"),
+            (f"{where}.height", camera.height, 8, MAX_PIXELS, "pixels"),
+            (f"{where}.fov_y", camera.fov_y, 1.0, 170.0, "degrees"),
+            (f"{where}.depth_noise", camera.depth_noise, 0.0, 0.1, "m"),
+            (f"{where}.seed", camera.seed, 0, MAX_SEED, ""),
+        ]
         near, far = CLIPPING
         if not near <= camera.min_depth < camera.max_depth <= far:
             problems.append(
                 f"{where}: the depth range must satisfy {near:g} <= min_depth < max_depth <= {far:g} m, "
                 f"got {camera.min_depth:g} and {camera.max_depth:g}"
             )
-        if not 0.0 <= camera.depth_noise <= 0.1:
-            problems.append(f"{where}.depth_noise must be between 0 and 0.1 m, got {camera.depth_noise:g}")
         if not 0.0 <= camera.dropout < 1.0:
             problems.append(f"{where}.dropout must be in [0, 1), got {camera.dropout:g}")
-        if not 0 <= camera.seed <= MAX_SEED:
-            problems.append(f"{where}.seed must be between 0 and {MAX_SEED}, got {camera.seed}")
         for name in ("position", "look_at", "up"):
             if not all(map(math.isfinite, getattr(camera, name))):
                 problems.append(f"{where}.{name} must be finite, got {list(getattr(camera, name))}")
@@ -244,37 +255,28 @@ def perception_problems(scenario: Scenario) -> list[str]:
             camera_pose(camera, scenario.scene)
         except (ValueError, RuntimeError) as error:  # RuntimeError: Drake's, e.g. a pose of NaN
             problems.append(f"{where}: {str(error).splitlines()[0]}")
-    for name, value, low, high in (
-        ("table_tolerance", perception.table_tolerance, 1e-5, 0.1),
-        ("min_height", perception.min_height, 1e-4, 1.0),
-        ("cluster_radius", perception.cluster_radius, 0.0, 0.5),
-        ("cylinder_fill", perception.cylinder_fill, 0.5, 1.0),
-        ("table_margin", perception.table_margin, 0.0, 1.0),
-    ):
-        if not low <= value <= high:
-            problems.append(f"perception.{name} must be between {low:g} and {high:g}, got {value:g}")
-    for name, value, low, high in (
-        ("min_points", perception.min_points, 1, 1_000_000),
-        ("border_margin", perception.border_margin, 0, MAX_PIXELS // 2),
-        ("ransac_points", perception.ransac_points, 3, 1_000_000),
-        ("seed", perception.seed, 0, MAX_SEED),
-    ):
-        if not low <= value <= high:
-            problems.append(f"perception.{name} must be between {low} and {high}, got {value}")
-    return problems
+    ranges += [
+        ("perception.table_tolerance", perception.table_tolerance, 1e-5, 0.1, ""),
+        ("perception.min_height", perception.min_height, 1e-4, 1.0, ""),
+        ("perception.cluster_radius", perception.cluster_radius, 0.0, 0.5, ""),
+        ("perception.cylinder_fill", perception.cylinder_fill, 0.5, 1.0, ""),
+        ("perception.table_margin", perception.table_margin, 0.0, 1.0, ""),
+        ("perception.min_points", perception.min_points, 1, 1_000_000, ""),
+        ("perception.border_margin", perception.border_margin, 0, MAX_PIXELS // 2, ""),
+        ("perception.ransac_points", perception.ransac_points, 3, 1_000_000, ""),
+        ("perception.seed", perception.seed, 0, MAX_SEED, ""),
+    ]
+    return problems + [p for p in (_range_problem(*r) for r in ranges) if p]
 
 
 def uncertainty_problems(scenario: Scenario) -> list[str]:
     """The reasons ``scenario.uncertainty``'s model error cannot be drawn (one line each)."""
-    uncertainty, problems = scenario.uncertainty, []
-    if not 0 <= uncertainty.seed <= MAX_SEED:
-        problems.append(f"uncertainty.seed must be between 0 and {MAX_SEED}, got {uncertainty.seed}")
-    if not 0.0 <= uncertainty.position_sigma <= 0.5:
-        problems.append(
-            f"uncertainty.position_sigma must be between 0 and 0.5 m, got {uncertainty.position_sigma:g}"
-        )
-    if not 0.0 <= uncertainty.yaw_sigma <= math.pi:
-        problems.append(f"uncertainty.yaw_sigma must be between 0 and pi rad, got {uncertainty.yaw_sigma:g}")
+    uncertainty = scenario.uncertainty
+    problems = [
+        _range_problem("uncertainty.seed", uncertainty.seed, 0, MAX_SEED),
+        _range_problem("uncertainty.position_sigma", uncertainty.position_sigma, 0.0, 0.5, "m"),
+        _range_problem("uncertainty.yaw_sigma", uncertainty.yaw_sigma, 0.0, math.pi, "rad"),
+    ]
     for name in ("mass_scale", "friction_scale"):
         low, high = getattr(uncertainty, name)
         if not 1.0 / MAX_SCALE <= low <= high <= MAX_SCALE:
@@ -282,4 +284,4 @@ def uncertainty_problems(scenario: Scenario) -> list[str]:
                 f"uncertainty.{name} must be [low, high] with {1.0 / MAX_SCALE:g} <= low <= high <= "
                 f"{MAX_SCALE:g}, got [{low:g}, {high:g}]"
             )
-    return problems
+    return [p for p in problems if p]

@@ -194,7 +194,7 @@ def check_scenario(scenario: Scenario) -> Scenario:
 
 
 def _range_problem(where: str, value: float, low: float, high: float, unit: str = "") -> str | None:
-    """ "``where`` must be between ``low`` and ``high``" if ``value`` lies outside them (or is NaN)."""
+    """The message that ``where`` must lie in [``low``, ``high``] if ``value`` does not (NaN does not), else None."""
     if low <= value <= high:
         return None
 

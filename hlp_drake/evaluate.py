@@ -39,12 +39,21 @@ from hlp_drake.segmentation import DEFAULT_MODE, MODES, segment_dataset
 
 TRAIN_SIZES = (3, 7, 11, 15, 19, 23)
 PROTOCOLS = ("80_20", "num_subjects", "unstructured")
+MIN_SUBJECTS = {"80_20": 3, "num_subjects": TRAIN_SIZES[0] + 1}
+"""Participants with structured trials a protocol needs: every split then tests someone."""
 
 
 def _jobs(
-    args, subjects: list[str], unstructured_subjects: list[str]
+    args, subjects: list[str], everyone: list[str], unstructured_subjects: list[str]
 ) -> list[tuple[str, list[str], list[str], str]]:
-    """(label, train subjects, test subjects, transfer setting) of every split or fold."""
+    """(label, train subjects, test subjects, transfer setting) of every split or fold: Table I's
+    and the learning curve's of the participants with structured trials (``subjects``), the
+    unstructured protocol's of ``unstructured_subjects`` (trained on ``everyone`` else)."""
+    if args.protocol != "unstructured" and len(subjects) < MIN_SUBJECTS[args.protocol]:
+        raise HlpError(
+            f"the {args.protocol} protocol needs usable structured trials of at least "
+            f"{MIN_SUBJECTS[args.protocol]} participants; the dataset has {len(subjects)}"
+        )
     if args.protocol == "80_20":
         n = round(0.8 * len(subjects))
         return [
@@ -65,7 +74,7 @@ def _jobs(
         )
     folds = transfer_folds(unstructured_subjects, folds=args.folds, seed=args.seed)
     return [
-        (setting, [s for s in subjects if s not in test], test, setting)
+        (setting, [s for s in everyone if s not in test], test, setting)
         for setting in args.settings
         for test in folds
     ]
@@ -126,14 +135,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     segmentation = segment_dataset(dataset, mode=args.mode, categories=categories, progress=not args.quiet)
     demonstrations = segmentation.demonstrations
     if models is not None:
+        if not any(category_of(d.trial) == args.category for d in demonstrations):
+            raise HlpError(f"the dataset has no usable {args.category} trials to plan (--category)")
         results = {args.category: [evaluate_models(models, demonstrations, category=args.category)]}
         return write_report(args, results, demonstrations, time.perf_counter() - started)
     data = training_data(demonstrations, mode=args.mode)
-    subjects = sorted({d.subject for d in demonstrations})
     structured = [d for d in demonstrations if category_of(d.trial) == STRUCTURED]
     unstructured = [d for d in demonstrations if category_of(d.trial) == UNSTRUCTURED]
     unstructured_subjects = sorted({d.subject for d in unstructured})
-    jobs = _jobs(args, subjects, unstructured_subjects)
+    subjects = {d.subject for d in demonstrations}
+    jobs = _jobs(args, sorted({d.subject for d in structured}), sorted(subjects), unstructured_subjects)
     workers = max(1, min(args.workers or os.cpu_count() or 1, len(jobs)))
     results: dict[str, list] = {}
     with worker_pool(workers, method=None) if workers > 1 else nullcontext() as pool:

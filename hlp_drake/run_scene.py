@@ -86,13 +86,13 @@ def _parser():
     )
     source.add_argument("--kind", choices=KINDS, help="generate a scene of this kind (with --seed)")
     parser.add_argument(
-        "--seed", type=integer(0, MAX_SEED), default=0, help="seed of the generated scene (default 0)"
+        "--seed", type=integer(0, MAX_SEED), help="seed of the generated scene (with --kind; default 0)"
     )
     parser.add_argument(
         "--objects",
         type=integer(1, MAX_GENERATED),
         metavar="K",
-        help="number of obstacles (gen2, unstructured)",
+        help="number of obstacles of the generated scene (with --kind gen2 or unstructured)",
     )
     parser.add_argument(
         "--planner",
@@ -125,11 +125,14 @@ def _parser():
 
 def main(argv: Sequence[str] | None = None) -> int:
     started = time.perf_counter()
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args = parser.parse_args(argv)
+    if args.kind is None and (args.seed is not None or args.objects is not None):
+        parser.error("--seed and --objects describe a generated scene: give its --kind too")
     check_writable(args.json, args.html)
     scene = None
     if args.kind is not None:
-        scene = generate_scene(args.kind, args.seed, args.objects)
+        scene = generate_scene(args.kind, args.seed or 0, args.objects)
     elif args.scene is not None or args.config is None:
         scene = load_scene(args.scene or DEFAULT_SCENE)
     if scene is not None:

@@ -110,6 +110,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     dataset = Dataset(args.dataset)
     if args.trial is not None:
         if args.trial not in dataset:
+            left_out = [q for q in dataset.problems if f"{args.trial}/" in q["path"].replace("\\", "/")]
+            if left_out:
+                raise HlpError(f"{args.trial} was left out of the dataset: {left_out[0]['reason']}")
             raise HlpError(f"no trial {args.trial!r} in the dataset (expected e.g. sub_01/T050)")
         try:
             demo = segment_trial(dataset.trial(args.trial), mode=args.mode)
@@ -125,6 +128,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     seconds = time.perf_counter() - started
     agreement = log_agreement(dataset, result)
     total = len(result.demonstrations) + len(result.rejections)
+    if total == 0:
+        raise HlpError(f"the dataset has no successful {args.category} trials to segment (--category)")
     write_text_atomic(args.out, demonstrations_csv(result))
     if args.json:
         summary = {

@@ -175,6 +175,48 @@ def test_a_nan_sample_leaves_its_trial_out_with_the_file_and_line(folder, tmp_pa
     assert ds.problems == [{"path": str(path), "reason": "line 4: non-finite value"}]
 
 
+def test_a_value_beyond_any_vr_room_leaves_its_trial_out(folder, tmp_path):
+    path = folder / "sub_01" / "T010" / "movement" / "HandTracker_movement_T010.csv"
+    lines = path.read_text().splitlines()
+    fields = lines[2].split(",")
+    fields[1] = "1e308"
+    lines[2] = ",".join(fields)
+    path.write_text("\n".join(lines) + "\n")
+    ds = load(folder, tmp_path)
+    assert "sub_01/T010" not in ds and "sub_01/T011" in ds
+    assert ds.problems == [{"path": str(path), "reason": "line 3: a value beyond +-1e+06"}]
+
+
+def test_an_oversized_file_is_left_out_unread(folder, tmp_path, monkeypatch):
+    from hlp_drake.dataset import source
+
+    path = folder / "sub_01" / "T011" / "movement" / "HandTracker_movement_T011.csv"
+    monkeypatch.setattr(source, "MAX_FILE_BYTES", path.stat().st_size - 1)
+    ds = load(folder, tmp_path)
+    reasons = {p["path"]: p["reason"] for p in ds.problems}
+    assert "sub_01/T011" not in ds and "larger than" in reasons[str(path)]
+
+
+def test_a_trial_listed_twice_in_the_results_is_left_out_with_both_lines(folder, tmp_path):
+    results = folder / "sub_01" / "trial_results.csv"
+    lines = results.read_text().splitlines()
+    (twice,) = [line for line in lines[1:] if line.split(",")[lines[0].split(",").index("trial_num")] == "10"]
+    results.write_text("\n".join([*lines, twice]) + "\n")
+    ds = load(folder, tmp_path)
+    assert "sub_01/T010" not in ds and "sub_01/T011" in ds
+    reasons = [p["reason"] for p in ds.problems if p["path"].endswith("trial_results.csv")]
+    assert len(reasons) == 2 and all("trial 10 is listed more than once" in r for r in reasons)
+
+
+def test_an_unusable_cache_folder_is_one_line_before_parsing(folder, tmp_path, monkeypatch, capsys):
+    afile = tmp_path / "a-file"
+    afile.write_text("not a folder")
+    monkeypatch.setenv("HLP_CACHE", str(afile))
+    with pytest.raises(DatasetError, match="cannot write the dataset cache in .*a-file.*HLP_CACHE"):
+        Dataset(folder, progress=True)
+    assert "reading VR dataset" not in capsys.readouterr().err
+
+
 def test_overlapping_objects_in_a_layout_reject_the_trial(folder, tmp_path):
     layout = folder / "sub_01" / "T010" / "scene" / "grid_objects_layout_T010.csv"
     layout.write_text(layout.read_text().replace("0.2575", "0.1375"))
@@ -237,3 +279,65 @@ def test_summary_cli_reports_problems_and_counts(folder, tmp_path):
     assert summary["categories"]["practice"] == {"trials": 1, "successes": 1}
     assert summary["categories"]["structured"] == {"trials": 1, "successes": 1}
     assert len(summary["problems"]) == 1
+
+
+@pytest.mark.parametrize(
+    ("arguments", "expected"),
+    [
+        (["--category", "unstructured", "--out", "{tmp}/d.csv"], "no successful unstructured trials"),
+        (
+            ["--trial", "sub_01/T010", "--png", "{tmp}/t.png"],
+            "sub_01/T010 was left out of the dataset: line 3",
+        ),
+    ],
+)
+def test_segment_with_nothing_to_segment_is_one_line_and_writes_nothing(
+    folder, tmp_path, arguments, expected
+):
+    path = folder / "sub_01" / "T010" / "movement" / "HandTracker_movement_T010.csv"
+    lines = path.read_text().splitlines()
+    lines[2] = ",".join(["nan", *lines[2].split(",")[1:]])  # its trial is left out: line 3
+    path.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "out"
+    out.mkdir()
+    argv = [a.format(tmp=out) for a in arguments]
+    result = run_module(
+        "hlp_drake.segment", "--dataset", str(folder), *argv, env={"HLP_CACHE": str(tmp_path / "cache")}
+    )
+    assert result.returncode == 2 and "Traceback" not in result.stderr, result.stderr
+    (line,) = [x for x in result.stderr.splitlines() if x.startswith("error: ")]
+    assert expected in line, result.stderr
+    assert list(out.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("arguments", "expected"),
+    [
+        (["--models", "bundled"], "no usable unstructured trials to plan"),
+        (["--protocol", "80_20"], "80_20 protocol needs usable structured trials of at least 3 participants"),
+        (
+            ["--protocol", "num_subjects"],
+            "num_subjects protocol needs usable structured trials of at least 4",
+        ),
+        (
+            ["--protocol", "unstructured", "--mode", "fixed"],
+            "needs at least 4 participants with unstructured",
+        ),
+    ],
+)
+def test_evaluate_with_nothing_to_score_is_one_line_and_writes_nothing(folder, tmp_path, arguments, expected):
+    out = tmp_path / "out"
+    out.mkdir()
+    result = run_module(
+        "hlp_drake.evaluate",
+        "--dataset",
+        str(folder),
+        *arguments,
+        "--json",
+        str(out / "e.json"),
+        "--quiet",
+        env={"HLP_CACHE": str(tmp_path / "cache")},
+    )
+    assert result.returncode == 2 and "Traceback" not in result.stderr, result.stderr
+    assert result.stderr.strip().splitlines() == [f"error: {result.stderr.strip()[7:]}"]
+    assert expected in result.stderr and list(out.iterdir()) == []

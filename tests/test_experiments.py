@@ -268,6 +268,49 @@ def test_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, capsys, argv)
     assert err.startswith("error: ") and err.count("\n") == 1 and not out.exists()
 
 
+def _bad_row(text: str, field: str, value: str) -> str:
+    """``text`` (a results.csv) with ``field`` of its first row set to ``value``."""
+    lines = text.splitlines()
+    row = lines[1].split(",")
+    row[COLUMNS.index(field)] = value
+    return "\n".join([lines[0], ",".join(row), *lines[2:]]) + "\n"
+
+
+@pytest.mark.parametrize(
+    ("name", "damage", "expected"),
+    [
+        ("results.csv", lambda t: t.encode() + b"\xff\xfe\n", "unreadable"),
+        ("results.csv", lambda t: t + "x" * 200_000 + "\n", "unreadable"),
+        ("results.csv", lambda t: _bad_row(t, "total_s", "nan"), "total_s nan"),
+        ("results.csv", lambda t: _bad_row(t, "init_s", "-1e308"), "init_s"),
+        ("results.csv", lambda t: _bad_row(t, "rollouts", "-3"), "rollouts -3"),
+        ("results.csv", lambda t: _bad_row(t, "planner", "magic"), "planner 'magic'"),
+        ("results.csv", lambda t: _bad_row(t, "scene", "gen2-9-10"), "not the gen1 scene"),
+        ("results.csv", None, "unreadable"),  # a directory
+        ("run.json", lambda t: '{"earlier_runs": 5}', "earlier_runs"),
+        ("run.json", lambda t: '{"earlier_runs": "abc"}', "earlier_runs"),
+        ("run.json", lambda t: "{not json", "unreadable"),
+        ("config.json", lambda t: "[1, 2]", "not a JSON object"),
+        ("config.json", lambda t: " " * (17 << 20), "larger than"),
+    ],
+)
+def test_a_damaged_run_directory_is_refused_and_left_as_it_was(tmp_path, capsys, name, damage, expected):
+    run_experiment(settings(), tmp_path, job=cheap_job)
+    path = tmp_path / name
+    if damage is None:
+        path.unlink()
+        path.mkdir()
+    else:
+        text = damage(path.read_text())
+        path.write_bytes(text) if isinstance(text, bytes) else path.write_text(text)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()}
+    argv = ["gen1", "--scenes", "3", "--seed", "10", "--workers", "1", "--quiet", "--out", str(tmp_path)]
+    assert run_cli(lambda a: main(a, job=never_called), argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and expected in err and "--fresh" in err, err
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()} == before
+
+
 def test_dask_not_installed_says_how_to_install_it(tmp_path, capsys, monkeypatch):
     monkeypatch.setitem(__import__("sys").modules, "distributed", None)  # makes "import distributed" fail
     out = tmp_path / "out"

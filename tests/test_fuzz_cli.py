@@ -136,6 +136,8 @@ _PROCESS_CASES = [
     ("run_scene", "--config", "{number}"),
     ("run_scene", "--config", "{samples}"),
     ("run_scene", "--seed", "-1"),
+    ("run_scene", "--seed", "4"),  # without --kind: not silently the default scene
+    ("run_scene", "--objects", "4"),
     ("scene", "generate", "--kind", "gen2", "--seed", "1", "--out", "{afile}/x.yaml"),
 ]
 

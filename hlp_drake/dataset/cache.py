@@ -15,7 +15,7 @@ import re
 import shutil
 import sys
 import tempfile
-from collections import defaultdict
+from collections import Counter, defaultdict
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -37,7 +37,8 @@ from hlp_drake.dataset.records import TRACKERS, category_of, trial_key
 from hlp_drake.dataset.source import PARTICIPANTS_FILE, Source
 from hlp_drake.errors import HlpError, short
 
-CACHE_VERSION = 4  # 4: the track array holds the kept trials' tracks only, in index order
+CACHE_VERSION = 5  # 5: values beyond parse.MAX_VALUE, files beyond source.MAX_FILE_BYTES and trials
+# listed twice are left out (4: the track array holds the kept trials' tracks only, in index order)
 COVERAGE_TOLERANCE = 0.1  # s: a track may start or end this much inside its trial (the data: <= 12 ms)
 INDEX_DIGEST = "index.sha256"  # beside index.json: a cache whose index was edited or damaged is rebuilt
 CACHE_ENV_VAR = "HLP_CACHE"
@@ -123,6 +124,14 @@ class _Collector:
             self.rows += len(block)
 
 
+def _trial_number(row: dict[str, str]) -> int | None:
+    """A trial_results row's trial number (None if it is not a number)."""
+    try:
+        return int(row["trial_num"])
+    except (KeyError, TypeError, ValueError):
+        return None
+
+
 def _assemble(collector: _Collector) -> list[dict[str, Any]]:
     """Join trial_results rows with their trial folders; every rejected trial becomes a problem."""
     participants = collector.participants
@@ -141,8 +150,9 @@ def _assemble(collector: _Collector) -> list[dict[str, Any]]:
         handedness = (participants.get(subject, {}).get("handedness") or "unknown").strip().lower()
         if subject not in participants and collector.participants is not None:
             collector.problem(PARTICIPANTS_FILE, f"no row for {subject}: handedness unknown")
+        where = f"{subject}/{RESULTS_FILE}"
+        listings = Counter(_trial_number(row) for row in collector.results[subject])
         for line, row in enumerate(collector.results[subject], start=2):
-            where = f"{subject}/{RESULTS_FILE}"
             try:
                 number = int(row["trial_num"])
                 category = category_of(number)
@@ -155,6 +165,9 @@ def _assemble(collector: _Collector) -> list[dict[str, Any]]:
                 continue
             key = (subject, number)
             listed.add(key)
+            if listings[number] > 1:  # which row is the trial's is unknown: neither is kept
+                collector.problem(where, f"line {line}: trial {number} is listed more than once: left out")
+                continue
             entry = _trial_entry(collector, key, category, handedness, row, times)
             if entry is not None:
                 trials.append(entry)

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from hlp_drake.dataset.cache import (
+    CACHE_ENV_VAR,
     CACHE_VERSION,
     INDEX_DIGEST,
     build_cache,
@@ -68,7 +69,14 @@ class Dataset:
                 except ValueError as error:
                     if self.cache_path.exists():
                         print(f"rebuilding the dataset cache at {self.cache_path} ({error})", file=sys.stderr)
-                    build_cache(self.source, self.cache_path, progress=progress)
+                    try:
+                        root.mkdir(parents=True, exist_ok=True)  # before parsing: a bad path fails fast
+                        build_cache(self.source, self.cache_path, progress=progress)
+                    except OSError as error:
+                        raise DatasetError(
+                            f"cannot write the dataset cache in {root} ({error.strerror or error}); "
+                            f"set {CACHE_ENV_VAR} to a writable folder"
+                        ) from None
                     try:
                         index, tracks = load_cache(self.cache_path)
                     except ValueError as again:

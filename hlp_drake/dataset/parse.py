@@ -12,6 +12,8 @@ from hlp_drake.errors import short
 
 MOVEMENT_COLUMNS = 7  # time, pos_x, pos_y, pos_z, rot_x, rot_y, rot_z
 MIN_SAMPLES = 2  # a track of fewer samples has no motion
+MAX_VALUE = 1e6
+"""A track, layout or log value beyond this (m, degrees or s) is not a VR room's: the file is damaged."""
 LAYOUT_HEADER = ["object", "x", "y", "z", "width", "height", "depth"]
 LOG_HEADER = ["start_time", "end_time", "dominant_object", "non_dominant_object", "interaction_type"]
 
@@ -67,6 +69,9 @@ def check_track(values: np.ndarray) -> np.ndarray:
     bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1))
     if len(bad):
         raise ValueError(f"line {bad[0] + 2}: non-finite value")
+    bad = np.flatnonzero(np.any(np.abs(values) > MAX_VALUE, axis=1))
+    if len(bad):
+        raise ValueError(f"line {bad[0] + 2}: a value beyond +-{MAX_VALUE:g}")
     back = np.flatnonzero(np.diff(values[:, 0]) <= 0)
     if len(back):
         raise ValueError(
@@ -84,6 +89,8 @@ def parse_layout(data: bytes) -> list[list]:
         values = [_float(v, f"line {i}") for v in row[1:]]
         if not all(math.isfinite(v) for v in values):
             raise ValueError(f"line {i}: non-finite value in {row!r}")
+        if any(abs(v) > MAX_VALUE for v in values):
+            raise ValueError(f"line {i}: a value beyond +-{MAX_VALUE:g} in {row!r}")
         parsed.append([row[0].strip(), *values])
     return parsed
 
@@ -98,6 +105,8 @@ def parse_interactions(data: bytes) -> list[list]:
         end = _float(row[1], f"line {i}") if row[1].strip() else None
         if not math.isfinite(start) or (end is not None and not math.isfinite(end)):
             raise ValueError(f"line {i}: non-finite time in {row[:2]!r}")
+        if max(abs(start), abs(end or 0.0)) > MAX_VALUE:
+            raise ValueError(f"line {i}: a time beyond +-{MAX_VALUE:g} s in {row[:2]!r}")
         if end is not None and end < start:
             raise ValueError(f"line {i}: ends ({end!r}) before it starts ({start!r})")
         parsed.append([start, end, row[2].strip(), row[3].strip(), row[4].strip()])

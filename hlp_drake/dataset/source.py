@@ -43,6 +43,14 @@ def dataset_relative_path(name: str) -> str | None:
     return None
 
 
+MAX_FILE_BYTES = 16 << 20
+"""A dataset file larger than this is reported and left out unread (the largest is about 0.3 MB)."""
+
+
+def _too_large() -> OSError:
+    return OSError(f"larger than {MAX_FILE_BYTES >> 20} MiB, not a file of the dataset")
+
+
 @dataclass(frozen=True)
 class SourcePart:
     """One readable copy of (part of) the dataset.
@@ -88,6 +96,12 @@ class SourcePart:
             return
         for relative, full in list(self._walk()):
             try:
+                size = os.path.getsize(full)
+                if size > MAX_FILE_BYTES:
+                    if progress is not None:
+                        progress.update(size)
+                    yield relative, _too_large()
+                    continue
                 content = Path(full).read_bytes()
             except OSError as error:
                 yield relative, error
@@ -105,6 +119,9 @@ class SourcePart:
                         progress.update(done + raw.tell() - progress.n)
                     relative = dataset_relative_path(member.name)
                     if relative is None or not member.isfile():
+                        continue
+                    if member.size > MAX_FILE_BYTES:
+                        yield relative, _too_large()
                         continue
                     handle = archive.extractfile(member)
                     yield relative, handle.read() if handle else OSError("not a regular file")

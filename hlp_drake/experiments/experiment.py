@@ -24,7 +24,7 @@ from hlp_drake.errors import HlpError
 from hlp_drake.experiments.executors import EXECUTORS, check_executor, run_jobs
 from hlp_drake.experiments.metadata import git_commit, machine_info, software_versions, utc_now
 from hlp_drake.experiments.plots import write_plots
-from hlp_drake.experiments.results import ResultsFile, read_results, row_key
+from hlp_drake.experiments.results import START_OVER, ResultsFile, read_results, row_key
 from hlp_drake.experiments.runner import KINDS, Job, JobFunction, make_jobs, run_job
 from hlp_drake.experiments.summary import summarise, write_summary
 
@@ -33,8 +33,9 @@ if TYPE_CHECKING:
 
 RESULTS, CONFIG, RUN = "results.csv", "config.json", "run.json"
 DERIVED = ("summary.md", "summary.json", "success.png", "times.png")
+MAX_RECORD_BYTES = 16 << 20
+"""A larger ``config.json`` or ``run.json`` is refused (a run's are a few kB to a few MB)."""
 IDENTITY_LABELS = {"kind": "kind", "seed": "seed", "scenario": "scenario"}
-START_OVER = "use --fresh to start over or choose another --out"
 
 
 @dataclass(frozen=True)
@@ -123,12 +124,7 @@ def _check_directory(out: Path, identity: dict[str, Any], fresh: bool) -> None:
         return
     config = out / CONFIG
     if config.exists():
-        try:
-            earlier = json.loads(config.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            raise HlpError(f"{config} is unreadable; {START_OVER}") from None
-        if not isinstance(earlier, dict):
-            earlier = {}
+        earlier = _read_record(config)
         differs = [label for key, label in IDENTITY_LABELS.items() if earlier.get(key) != identity[key]]
         if differs:
             raise HlpError(
@@ -140,17 +136,37 @@ def _check_directory(out: Path, identity: dict[str, Any], fresh: bool) -> None:
         raise HlpError(f"{out / RESULTS} exists without {CONFIG}; {START_OVER}")
 
 
-def _earlier_runs(out: Path, fresh: bool) -> list[dict[str, Any]]:
-    """The records of the directory's earlier runs (from its ``run.json``), oldest first."""
-    if fresh:
-        return []
+def _read_record(path: Path) -> dict[str, Any]:
+    """The JSON object of the directory's ``path`` (``config.json``, ``run.json``).
+
+    Raises:
+        HlpError: it is unreadable, too large or not a JSON object.
+    """
     try:
-        previous = json.loads((out / RUN).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        if path.stat().st_size > MAX_RECORD_BYTES:
+            raise ValueError(f"larger than {MAX_RECORD_BYTES >> 20} MiB")
+        record = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as error:
+        raise HlpError(f"{path} is unreadable ({error}); {START_OVER}") from None
+    if not isinstance(record, dict):
+        raise HlpError(f"{path} is unreadable (not a JSON object); {START_OVER}")
+    return record
+
+
+def _earlier_runs(out: Path, fresh: bool) -> list[dict[str, Any]]:
+    """The records of the directory's earlier runs (from its ``run.json``), oldest first.
+
+    Raises:
+        HlpError: ``run.json`` is unreadable or its ``earlier_runs`` is not a list of records
+            (resuming would lose that history).
+    """
+    if fresh or not (out / RUN).exists():
         return []
-    if not isinstance(previous, dict):
-        return []
-    return [*previous.pop("earlier_runs", []), previous]
+    previous = _read_record(out / RUN)
+    earlier = previous.pop("earlier_runs", [])
+    if not isinstance(earlier, list) or not all(isinstance(run, dict) for run in earlier):
+        raise HlpError(f"{out / RUN}: earlier_runs is not a list of run records; {START_OVER}")
+    return [*earlier, previous]
 
 
 def _measured_on(machine: dict[str, Any], settings: ExperimentSettings) -> str:
@@ -264,7 +280,7 @@ def run_experiment(
     )
     identity = {"kind": settings.kind, "seed": settings.seed, "scenario": config_yaml}
     _check_directory(out, identity, settings.fresh)
-    results = ResultsFile(out / RESULTS, [] if settings.fresh else read_results(out / RESULTS))
+    results = ResultsFile(out / RESULTS, [] if settings.fresh else read_results(out / RESULTS, settings.kind))
     earlier = _earlier_runs(out, settings.fresh)
 
     started = time.perf_counter()

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import csv
 import io
+import math
 import os
 from collections.abc import Iterable
 from pathlib import Path
@@ -22,7 +23,7 @@ from typing import Any
 
 from hlp_drake.atomic import atomic_path
 from hlp_drake.errors import HlpError
-from hlp_drake.experiments.runner import Row
+from hlp_drake.experiments.runner import PLANNERS, Row
 
 COLUMNS = (
     "scene",
@@ -52,6 +53,12 @@ BOOL_COLUMNS = frozenset({"success", "passed_then_failed"})
 FLOAT_COLUMNS = frozenset({"init_s", "optimise_s", "total_s", "verify_s", "execute_s"})
 INT_COLUMNS = frozenset(COLUMNS) - BOOL_COLUMNS - FLOAT_COLUMNS - {"scene", "planner", "failure_reason"}
 BOOLEANS = {"true": True, "false": False}
+MAX_RESULTS_BYTES = 64 << 20
+"""A larger ``results.csv`` is refused (a run of thousands of jobs writes a few MB)."""
+MAX_SECONDS = 1e7
+"""A time column beyond this (about 4 months) is not a job's."""
+START_OVER = "use --fresh to start over or choose another --out"
+"""How to get past a directory that cannot be resumed."""
 
 
 def row_key(row: Row) -> tuple[str, str]:
@@ -94,33 +101,65 @@ def results_csv(rows: Iterable[Row]) -> str:
     return out.getvalue()
 
 
-def read_results(path: Path) -> list[Row]:
+def read_results(path: Path, kind: str | None = None) -> list[Row]:
     """The rows of ``path`` (none when it does not exist; ``verify_s`` NaN in an ``EARLIER_COLUMNS`` file).
 
+    Args:
+        kind: the run's scene generator ("gen1", "gen2"): every row's scene must be one of its
+            (the name its seed and object count give); None: any.
+
     Raises:
-        HlpError: the file has other columns or a malformed row (one line, naming the file and line).
+        HlpError: the file is unreadable, too large, has other columns or a malformed row (one
+            line, naming the file and line).
     """
     if not path.exists():
         return []
-    with path.open(newline="", encoding="utf-8") as file:
-        reader = csv.reader(file)
-        header = tuple(next(reader, ()))
-        if header not in (COLUMNS, EARLIER_COLUMNS):
-            raise HlpError(
-                f"{path}: not an experiment results file (unexpected columns); use --fresh to start over"
-            )
-        rows = []
-        for record in reader:
-            try:
-                if len(record) != len(header):
-                    raise ValueError(f"{len(record)} fields")
-                row = {"verify_s": float("nan")} | {c: _parse(c, text) for c, text in zip(header, record)}
-                rows.append({column: row[column] for column in COLUMNS})
-            except (KeyError, ValueError) as error:
-                raise HlpError(
-                    f"{path}: line {reader.line_num}: malformed row ({error}); use --fresh to start over"
-                ) from None
+    try:
+        if path.stat().st_size > MAX_RESULTS_BYTES:
+            raise HlpError(f"{path}: larger than {MAX_RESULTS_BYTES >> 20} MiB, not an experiment's results")
+        with path.open(newline="", encoding="utf-8") as file:
+            reader = csv.reader(file)
+            header = tuple(next(reader, ()))
+            if header not in (COLUMNS, EARLIER_COLUMNS):
+                raise HlpError(f"{path}: not an experiment results file (unexpected columns); {START_OVER}")
+            rows = []
+            for record in reader:
+                try:
+                    rows.append(_row(header, record, kind))
+                except (KeyError, ValueError) as error:
+                    raise HlpError(
+                        f"{path}: line {reader.line_num}: malformed row ({error}); {START_OVER}"
+                    ) from None
+    except (OSError, UnicodeDecodeError, csv.Error) as error:
+        reason = error.strerror if isinstance(error, OSError) and error.strerror else str(error)
+        raise HlpError(f"{path}: unreadable ({reason}); {START_OVER}") from None
     return rows
+
+
+def _row(header: tuple[str, ...], record: list[str], kind: str | None) -> Row:
+    """The row of one CSV ``record`` under ``header``; ValueError or KeyError names what is wrong."""
+    if len(record) != len(header):
+        raise ValueError(f"{len(record)} fields")
+    row = {"verify_s": float("nan")} | {c: _parse(c, text) for c, text in zip(header, record)}
+    if row["planner"] not in PLANNERS:
+        raise ValueError(f"planner {row['planner']!r}")
+    for column in INT_COLUMNS:
+        if row[column] < 0:
+            raise ValueError(f"{column} {row[column]}")
+    for column in FLOAT_COLUMNS:  # verify_s is NaN (unknown) in the rows of an earlier file
+        value = row[column]
+        if not (math.isfinite(value) and 0.0 <= value <= MAX_SECONDS) and not (
+            column == "verify_s" and math.isnan(value)
+        ):
+            raise ValueError(f"{column} {value}")
+    if kind is not None and row["scene"] != scene_name(kind, row["seed"], row["objects"]):
+        raise ValueError(f"scene {row['scene']!r} is not the {kind} scene of its seed and object count")
+    return {column: row[column] for column in COLUMNS}
+
+
+def scene_name(kind: str, seed: int, objects: int) -> str:
+    """The name of the ``kind`` scene of ``seed`` with ``objects`` obstacles (``generate_scene``'s)."""
+    return f"{kind}-{seed}" if kind == "gen1" else f"{kind}-{objects}-{seed}"
 
 
 def write_durable(path: Path, text: str) -> None:

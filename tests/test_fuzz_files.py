@@ -168,6 +168,12 @@ def _edited_models(folder: Path, how: str) -> None:
     arrays, meta = dict(_bundled_arrays()), json.loads((BUNDLED_DIRECTORY / "models.json").read_text())
     if how == "subjects: 5":
         meta["subjects"] = 5
+    elif how == "n_estimators: -5":
+        meta["settings"]["n_estimators"] = -5
+    elif how == "faithful rows models":
+        meta["mode"] = "faithful"
+    elif how == "an extra field":
+        meta["extra"] = 1
     elif how == "row.learner.feature as float":
         arrays["row.learner.feature"] = arrays["row.learner.feature"].astype(float)
     elif how == "row.novelty.points of 3 features":
@@ -188,6 +194,9 @@ def _edited_models(folder: Path, how: str) -> None:
     ("how", "problem"),
     [
         ("subjects: 5", "models.json: subjects: expected a list"),
+        ("n_estimators: -5", "models.json: settings.n_estimators: expected 1 to 10000, got -5"),
+        ("faithful rows models", "models.json: mode: the rows planner's models are trained in fixed mode"),
+        ("an extra field", "models.json: top level: unknown field 'extra'"),
         ("10^12 elements", "array 'arm.train' has shape (1000000, 1000000)"),
         (
             "row.learner.feature as float",

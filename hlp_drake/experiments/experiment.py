@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 from tqdm import tqdm
 
-from hlp_drake.atomic import write_text_atomic
+from hlp_drake.atomic import check_writable, write_text_atomic
 from hlp_drake.errors import HlpError
 from hlp_drake.experiments.executors import EXECUTORS, check_executor, run_jobs
 from hlp_drake.experiments.metadata import git_commit, machine_info, software_versions, utc_now
@@ -280,6 +280,7 @@ def run_experiment(
     )
     identity = {"kind": settings.kind, "seed": settings.seed, "scenario": config_yaml}
     _check_directory(out, identity, settings.fresh)
+    check_writable(*(out / name for name in (RESULTS, CONFIG, RUN, *DERIVED)))
     results = ResultsFile(out / RESULTS, [] if settings.fresh else read_results(out / RESULTS, settings.kind))
     earlier = _earlier_runs(out, settings.fresh)
 

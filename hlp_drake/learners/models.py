@@ -113,6 +113,20 @@ class ModelDescription:
     sha256: str
 
 
+SETTING_RANGES = {
+    "n_estimators": (1, 10_000),
+    "max_depth": (1, 64),
+    "learning_rate": (1e-6, 10.0),
+    "structured_weight": (1e-6, 1e6),
+    "C": (1e-9, 1e9),
+    "kernel_scale": (1e-9, 1e9),
+    "segment_max_per_class": (1, 10_000_000),
+    "arm_max_samples": (1, 10_000_000),
+    "random_state": (0, 2**32 - 1),
+}
+"""The range of each numeric learner setting a model file may state (its arrays were trained so)."""
+
+
 def _settings(meta: Any, where: Path) -> LearnerSettings:
     """The learner settings of the ``models.json`` document ``meta``, once every field is checked."""
     if not isinstance(meta, dict) or meta.get("format") != FORMAT:
@@ -121,7 +135,7 @@ def _settings(meta: Any, where: Path) -> LearnerSettings:
         raise ModelError(
             f"{where}: model format version {brief(meta.get('version'))}, this hlp_drake reads {VERSION}"
         )
-    problems = document_problems(ModelDescription, meta, top="models.json")
+    problems = document_problems(ModelDescription, meta, top="top level")
     settings = meta.get("settings") if isinstance(meta.get("settings"), dict) else {}
     if settings.get("planner", "paper") not in PLANNERS:
         problems.append(
@@ -131,6 +145,14 @@ def _settings(meta: Any, where: Path) -> LearnerSettings:
         problems.append(
             f"settings.row_learner: expected one of {', '.join(ROW_LEARNERS)}, "
             f"got {brief(settings['row_learner'])}"
+        )
+    for name, (low, high) in SETTING_RANGES.items():
+        value = settings.get(name)
+        if isinstance(value, int | float) and not isinstance(value, bool) and not low <= value <= high:
+            problems.append(f"settings.{name}: expected {low:g} to {high:g}, got {value!r}")
+    if settings.get("planner") == "rows" and meta.get("mode", "fixed") != "fixed":
+        problems.append(
+            f"mode: the rows planner's models are trained in fixed mode, got {brief(meta['mode'])}"
         )
     subjects = meta.get("subjects")
     if isinstance(subjects, list) and (

@@ -48,7 +48,7 @@ def check_writable(*paths: str | os.PathLike[str] | None) -> None:
     Raises:
         HlpError: one line per output that cannot be written.
     """
-    problems = []
+    problems, refused = [], set()
     for path in paths:
         if path is None:
             continue
@@ -59,12 +59,15 @@ def check_writable(*paths: str | os.PathLike[str] | None) -> None:
         folder = target.parent
         while not folder.exists() and folder != folder.parent:
             folder = folder.parent
+        if folder in refused:  # one line for the outputs of a folder that cannot take any
+            continue
         try:
             if not folder.is_dir():
                 raise NotADirectoryError(0, "not a directory", str(folder))
             fd, probe = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=folder)
         except OSError as error:
             problems.append(f"{target}: cannot write: {_reason(error)}")
+            refused.add(folder)
             continue
         os.close(fd)
         os.unlink(probe)

@@ -75,11 +75,11 @@ def test_outputs_that_cannot_be_written_are_refused_before_any_work(tmp_path):
     check_writable(None, tmp_path / "new" / "er" / "out.json")  # folders made at the end, not now
     assert sorted(tmp_path.rglob("*")) == [a_file]
     with pytest.raises(HlpError) as info:
-        check_writable(tmp_path, a_file / "out.json", tmp_path / "fine.json")
+        check_writable(tmp_path, a_file / "out.json", tmp_path / "fine.json", a_file / "out.npz")
     assert info.value.problems == (
         f"{tmp_path}: cannot write: it is a directory",
         f"{a_file / 'out.json'}: cannot write: {a_file} is not a directory",
-    )
+    )  # once for the folder that cannot take out.json and out.npz
     assert sorted(tmp_path.rglob("*")) == [a_file]  # the probe left nothing
 
 

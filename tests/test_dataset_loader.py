@@ -163,28 +163,25 @@ def test_unreadable_and_non_numeric_files_are_reported(folder, tmp_path):
     assert [r.key for r in ds.records] == ["sub_01/T005"]
 
 
-def test_a_nan_sample_leaves_its_trial_out_with_the_file_and_line(folder, tmp_path):
-    path = folder / "sub_01" / "T010" / "movement" / "HandTracker_movement_T010.csv"
+def set_sample(path, line: int, value: str) -> None:
+    """Set the x position of line ``line`` (counting the header as 1) of the track ``path`` to ``value``."""
     lines = path.read_text().splitlines()
-    fields = lines[3].split(",")
-    fields[1] = "NaN"
-    lines[3] = ",".join(fields)
+    fields = lines[line - 1].split(",")
+    fields[1] = value
+    lines[line - 1] = ",".join(fields)
     path.write_text("\n".join(lines) + "\n")
-    ds = load(folder, tmp_path)
-    assert "sub_01/T010" not in ds and "sub_01/T005" in ds
-    assert ds.problems == [{"path": str(path), "reason": "line 4: non-finite value"}]
 
 
-def test_a_value_beyond_any_vr_room_leaves_its_trial_out(folder, tmp_path):
+@pytest.mark.parametrize(
+    ("line", "value", "reason"),
+    [(4, "NaN", "line 4: non-finite value"), (3, "1e308", "line 3: a value beyond +-1e+06")],
+)
+def test_a_bad_sample_leaves_its_trial_out_with_the_file_and_line(folder, tmp_path, line, value, reason):
     path = folder / "sub_01" / "T010" / "movement" / "HandTracker_movement_T010.csv"
-    lines = path.read_text().splitlines()
-    fields = lines[2].split(",")
-    fields[1] = "1e308"
-    lines[2] = ",".join(fields)
-    path.write_text("\n".join(lines) + "\n")
+    set_sample(path, line, value)
     ds = load(folder, tmp_path)
-    assert "sub_01/T010" not in ds and "sub_01/T011" in ds
-    assert ds.problems == [{"path": str(path), "reason": "line 3: a value beyond +-1e+06"}]
+    assert "sub_01/T010" not in ds and "sub_01/T005" in ds and "sub_01/T011" in ds
+    assert ds.problems == [{"path": str(path), "reason": reason}]
 
 
 def test_an_oversized_file_is_left_out_unread(folder, tmp_path, monkeypatch):
@@ -295,9 +292,7 @@ def test_segment_with_nothing_to_segment_is_one_line_and_writes_nothing(
     folder, tmp_path, arguments, expected
 ):
     path = folder / "sub_01" / "T010" / "movement" / "HandTracker_movement_T010.csv"
-    lines = path.read_text().splitlines()
-    lines[2] = ",".join(["nan", *lines[2].split(",")[1:]])  # its trial is left out: line 3
-    path.write_text("\n".join(lines) + "\n")
+    set_sample(path, 3, "nan")  # its trial is left out: line 3
     out = tmp_path / "out"
     out.mkdir()
     argv = [a.format(tmp=out) for a in arguments]

@@ -121,6 +121,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.splits < 1 or args.folds < 2:
         parser.error("--splits must be at least 1 and --folds at least 2")
+    if args.models and args.category == UNSTRUCTURED and args.mode != "fixed":
+        parser.error("unstructured trials (--category) are segmented in fixed mode only")
     if args.protocol == "unstructured" and args.mode != "fixed":
         parser.error(
             "the unstructured protocol segments in fixed mode (faithful mode cannot read unstructured rows)"

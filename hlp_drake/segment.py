@@ -110,9 +110,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     dataset = Dataset(args.dataset)
     if args.trial is not None:
         if args.trial not in dataset:
-            left_out = [q for q in dataset.problems if f"{args.trial}/" in q["path"].replace("\\", "/")]
-            if left_out:
-                raise HlpError(f"{args.trial} was left out of the dataset: {left_out[0]['reason']}")
+            problem = dataset.left_out().get(args.trial)
+            if problem is not None:
+                raise HlpError(
+                    f"{args.trial} was left out of the dataset: {problem['path']}: {problem['reason']}"
+                )
             raise HlpError(f"no trial {args.trial!r} in the dataset (expected e.g. sub_01/T050)")
         try:
             demo = segment_trial(dataset.trial(args.trial), mode=args.mode)

@@ -202,7 +202,26 @@ def test_a_trial_listed_twice_in_the_results_is_left_out_with_both_lines(folder,
     ds = load(folder, tmp_path)
     assert "sub_01/T010" not in ds and "sub_01/T011" in ds
     reasons = [p["reason"] for p in ds.problems if p["path"].endswith("trial_results.csv")]
-    assert len(reasons) == 2 and all("trial 10 is listed more than once" in r for r in reasons)
+    assert len(reasons) == 2 and all("sub_01/T010 is listed more than once" in r for r in reasons)
+
+
+def test_segment_trial_of_a_trial_listed_twice_names_the_results_file(folder, tmp_path):
+    results = folder / "sub_01" / "trial_results.csv"
+    results.write_text(results.read_text() + results.read_text().splitlines()[2] + "\n")  # T010 again
+    result = run_module(
+        "hlp_drake.segment",
+        "--dataset",
+        str(folder),
+        "--trial",
+        "sub_01/T010",
+        "--png",
+        str(tmp_path / "t.png"),
+        env={"HLP_CACHE": str(tmp_path / "cache")},
+    )
+    assert result.returncode == 2 and not (tmp_path / "t.png").exists()
+    assert (
+        f"sub_01/T010 was left out of the dataset: {results}: line 3: sub_01/T010 is listed" in result.stderr
+    )
 
 
 def test_an_unusable_cache_folder_is_one_line_before_parsing(folder, tmp_path, monkeypatch, capsys):
@@ -284,7 +303,7 @@ def test_summary_cli_reports_problems_and_counts(folder, tmp_path):
         (["--category", "unstructured", "--out", "{tmp}/d.csv"], "no successful unstructured trials"),
         (
             ["--trial", "sub_01/T010", "--png", "{tmp}/t.png"],
-            "sub_01/T010 was left out of the dataset: line 3",
+            "HandTracker_movement_T010.csv: line 3: non-finite value",
         ),
     ],
 )

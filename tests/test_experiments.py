@@ -281,7 +281,7 @@ def _bad_row(text: str, field: str, value: str) -> str:
     [
         ("results.csv", lambda t: t.encode() + b"\xff\xfe\n", "unreadable"),
         ("results.csv", lambda t: t + "x" * 200_000 + "\n", "unreadable"),
-        ("results.csv", lambda t: _bad_row(t, "total_s", "nan"), "total_s nan"),
+        ("results.csv", lambda t: _bad_row(t, "total_s", "inf"), "total_s inf, expected 0 to"),
         ("results.csv", lambda t: _bad_row(t, "init_s", "-1e308"), "init_s"),
         ("results.csv", lambda t: _bad_row(t, "rollouts", "-3"), "rollouts -3"),
         ("results.csv", lambda t: _bad_row(t, "planner", "magic"), "planner 'magic'"),
@@ -311,6 +311,39 @@ def test_a_damaged_run_directory_is_refused_and_left_as_it_was(tmp_path, capsys,
     assert err.count("\n") == 1 and expected in err, err
     assert "--fresh" in err or damage is None  # a folder in an output's place: --fresh cannot help
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()} == before
+
+
+def crash_gen2_5_11_sto(job: Job) -> dict:
+    """``cheap_job``, but the straight line on gen2-5-11 crashes as ``run_job`` records a crash."""
+    if job.key == ("gen2-5-11", "sto"):
+        nan = float("nan")
+        times = {"plan_s": nan, "ik_s": nan, "optimise_s": nan, "execute_s": nan, "verify_s": nan}
+        return make_row(
+            job,
+            success=False,
+            failure_reason="crashed: RuntimeError: x",
+            rollouts=0,
+            iterations=0,
+            objects_moved=0,
+            objects_dropped=0,
+            **times,
+        )
+    return cheap_job(job)
+
+
+def test_a_gen2_run_over_two_counts_with_a_crash_resumes_and_extends(tmp_path):
+    run_experiment(settings("gen2", objects=(5, 7), scenes=2), tmp_path, job=crash_gen2_5_11_sto)
+    rows = read_results(tmp_path / "results.csv", "gen2")
+    assert len(rows) == 8 and sum(row["total_s"] != row["total_s"] for row in rows) == 1  # NaN
+    resumed = RecordingJob()
+    run_experiment(settings("gen2", objects=(5, 7), scenes=3), tmp_path, job=resumed)
+    assert sorted(resumed.ran) == [
+        ("gen2-5-12", "hlp"),
+        ("gen2-5-12", "sto"),
+        ("gen2-7-12", "hlp"),
+        ("gen2-7-12", "sto"),
+    ]
+    assert len(read_results(tmp_path / "results.csv", "gen2")) == 12
 
 
 def test_dask_not_installed_says_how_to_install_it(tmp_path, capsys, monkeypatch):

@@ -194,7 +194,7 @@ def _edited_models(folder: Path, how: str) -> None:
     ("how", "problem"),
     [
         ("subjects: 5", "models.json: subjects: expected a list"),
-        ("n_estimators: -5", "models.json: settings.n_estimators: expected 1 to 10000, got -5"),
+        ("n_estimators: -5", "models.json: settings.n_estimators: expected 1 to 10,000, got -5"),
         ("faithful rows models", "models.json: mode: the rows planner's models are trained in fixed mode"),
         ("an extra field", "models.json: top level: unknown field 'extra'"),
         ("10^12 elements", "array 'arm.train' has shape (1000000, 1000000)"),

@@ -166,7 +166,7 @@ def _assemble(collector: _Collector) -> list[dict[str, Any]]:
             key = (subject, number)
             listed.add(key)
             if listings[number] > 1:  # which row is the trial's is unknown: neither is kept
-                collector.problem(where, f"line {line}: trial {number} is listed more than once: left out")
+                collector.problem(where, f"line {line}: {trial_key(*key)} is listed more than once: left out")
                 continue
             entry = _trial_entry(collector, key, category, handedness, row, times)
             if entry is not None:

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import os
+import re
 import sys
+import tempfile
 from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
@@ -25,6 +27,24 @@ from hlp_drake.dataset.records import TRACKERS, Interaction, Trial, TrialRecord,
 from hlp_drake.dataset.source import Source, resolve_source
 from hlp_drake.errors import DatasetError, SceneError
 from hlp_drake.scene.model import Scene
+
+_TRIAL_IN_TEXT = re.compile(r"(sub_\d+)[/\\]T(\d{3})")
+
+
+def _check_cache_root(root: Path) -> None:
+    """Make the cache folder ``root`` and probe that a file can be written in it."""
+    try:
+        root.mkdir(parents=True, exist_ok=True)
+        tempfile.TemporaryFile(dir=root).close()
+    except OSError as error:
+        raise _cache_error(root, error) from None
+
+
+def _cache_error(root: Path, error: OSError) -> DatasetError:
+    reason = "not a folder" if root.exists() and not root.is_dir() else error.strerror or str(error)
+    return DatasetError(
+        f"cannot write the dataset cache in {root} ({reason}); set {CACHE_ENV_VAR} to a writable folder"
+    )
 
 
 class Dataset:
@@ -69,14 +89,11 @@ class Dataset:
                 except ValueError as error:
                     if self.cache_path.exists():
                         print(f"rebuilding the dataset cache at {self.cache_path} ({error})", file=sys.stderr)
+                    _check_cache_root(root)  # before parsing: a bad folder fails fast
                     try:
-                        root.mkdir(parents=True, exist_ok=True)  # before parsing: a bad path fails fast
                         build_cache(self.source, self.cache_path, progress=progress)
                     except OSError as error:
-                        raise DatasetError(
-                            f"cannot write the dataset cache in {root} ({error.strerror or error}); "
-                            f"set {CACHE_ENV_VAR} to a writable folder"
-                        ) from None
+                        raise _cache_error(root, error) from None
                     try:
                         index, tracks = load_cache(self.cache_path)
                     except ValueError as again:
@@ -94,6 +111,16 @@ class Dataset:
 
     def __len__(self) -> int:
         return len(self.records)
+
+    def left_out(self) -> dict[str, dict[str, str]]:
+        """The trials the loader left out, by key ("sub_01/T050"): the first problem naming each
+        (in its file's path, or in its reason for a problem of ``trial_results.csv``)."""
+        trials: dict[str, dict[str, str]] = {}
+        for problem in self.problems:
+            match = _TRIAL_IN_TEXT.search(problem["path"]) or _TRIAL_IN_TEXT.search(problem["reason"])
+            if match:
+                trials.setdefault(trial_key(match.group(1), int(match.group(2))), problem)
+        return trials
 
     def __contains__(self, key: str) -> bool:
         return key in self._entries

@@ -145,20 +145,19 @@ def _row(header: tuple[str, ...], record: list[str], kind: str | None) -> Row:
         raise ValueError(f"planner {row['planner']!r}")
     for column in INT_COLUMNS:
         if row[column] < 0:
-            raise ValueError(f"{column} {row[column]}")
-    for column in FLOAT_COLUMNS:  # verify_s is NaN (unknown) in the rows of an earlier file
+            raise ValueError(f"{column} {row[column]}, expected a count")
+    for column in FLOAT_COLUMNS:  # NaN: unknown (a crashed job's times, an earlier file's verify_s)
         value = row[column]
-        if not (math.isfinite(value) and 0.0 <= value <= MAX_SECONDS) and not (
-            column == "verify_s" and math.isnan(value)
-        ):
-            raise ValueError(f"{column} {value}")
+        if not (math.isnan(value) or 0.0 <= value <= MAX_SECONDS):
+            raise ValueError(f"{column} {value}, expected 0 to {MAX_SECONDS:g} s or nan")
     if kind is not None and row["scene"] != scene_name(kind, row["seed"], row["objects"]):
         raise ValueError(f"scene {row['scene']!r} is not the {kind} scene of its seed and object count")
     return {column: row[column] for column in COLUMNS}
 
 
 def scene_name(kind: str, seed: int, objects: int) -> str:
-    """The name of the ``kind`` scene of ``seed`` with ``objects`` obstacles (``generate_scene``'s)."""
+    """The name ``generate_scene`` gives the experiments' ``kind`` ("gen1", "gen2") scene of ``seed``
+    with ``objects`` obstacles."""
     return f"{kind}-{seed}" if kind == "gen1" else f"{kind}-{objects}-{seed}"
 
 

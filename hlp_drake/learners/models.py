@@ -149,7 +149,7 @@ def _settings(meta: Any, where: Path) -> LearnerSettings:
     for name, (low, high) in SETTING_RANGES.items():
         value = settings.get(name)
         if isinstance(value, int | float) and not isinstance(value, bool) and not low <= value <= high:
-            problems.append(f"settings.{name}: expected {low:g} to {high:g}, got {value!r}")
+            problems.append(f"settings.{name}: expected {low:,} to {high:,}, got {value!r}")
     if settings.get("planner") == "rows" and meta.get("mode", "fixed") != "fixed":
         problems.append(
             f"mode: the rows planner's models are trained in fixed mode, got {brief(meta['mode'])}"

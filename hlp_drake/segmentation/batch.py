@@ -16,8 +16,6 @@ from hlp_drake.segmentation.modes import DEFAULT_MODE, Mode, check_mode
 from hlp_drake.segmentation.segment import Rejected, segment_trial
 from hlp_drake.taskspace import TaskSpace
 
-_TRIAL_IN_PATH = re.compile(r"(sub_\d+)[/\\]T(\d{3})")
-
 
 @dataclass
 class SegmentationResult:
@@ -66,10 +64,8 @@ def segment_dataset(
     if records is None:
         categories = tuple(categories)
         records = demonstration_records(dataset, categories=categories)
-        for problem in dataset.problems:
-            match = _TRIAL_IN_PATH.search(problem["path"])
-            if match and category_of(int(match.group(2))) in categories:
-                key = f"{match.group(1)}/T{match.group(2)}"
+        for key, problem in dataset.left_out().items():
+            if category_of(int(key[-3:])) in categories:
                 result.rejections.append(Rejection(key, f"unreadable data: {problem['reason']}"))
     for record in tqdm(records, desc=f"segmenting ({mode})", unit="trial", disable=not progress):
         trial = dataset.trial(record.key)

@@ -145,8 +145,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     structured = [d for d in demonstrations if category_of(d.trial) == STRUCTURED]
     unstructured = [d for d in demonstrations if category_of(d.trial) == UNSTRUCTURED]
     unstructured_subjects = sorted({d.subject for d in unstructured})
-    subjects = {d.subject for d in demonstrations}
-    jobs = _jobs(args, sorted({d.subject for d in structured}), sorted(subjects), unstructured_subjects)
+    everyone = sorted({d.subject for d in demonstrations})
+    jobs = _jobs(args, sorted({d.subject for d in structured}), everyone, unstructured_subjects)
     workers = max(1, min(args.workers or os.cpu_count() or 1, len(jobs)))
     results: dict[str, list] = {}
     with worker_pool(workers, method=None) if workers > 1 else nullcontext() as pool:

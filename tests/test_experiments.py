@@ -292,6 +292,7 @@ def _bad_row(text: str, field: str, value: str) -> str:
         ("run.json", lambda t: '{"earlier_runs": "abc"}', "earlier_runs"),
         ("run.json", lambda t: "{not json", "unreadable"),
         ("config.json", lambda t: "[1, 2]", "not a JSON object"),
+        ("config.json", lambda t: "[" * 200_000, "unreadable"),
         ("config.json", lambda t: " " * (17 << 20), "larger than"),
     ],
 )

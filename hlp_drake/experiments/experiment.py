@@ -24,7 +24,7 @@ from hlp_drake.errors import HlpError
 from hlp_drake.experiments.executors import EXECUTORS, check_executor, run_jobs
 from hlp_drake.experiments.metadata import git_commit, machine_info, software_versions, utc_now
 from hlp_drake.experiments.plots import write_plots
-from hlp_drake.experiments.results import START_OVER, ResultsFile, read_results, row_key
+from hlp_drake.experiments.results import START_OVER, ResultsFile, read_results, read_run_file, row_key
 from hlp_drake.experiments.runner import KINDS, Job, JobFunction, make_jobs, run_job
 from hlp_drake.experiments.summary import summarise, write_summary
 
@@ -143,10 +143,8 @@ def _read_record(path: Path) -> dict[str, Any]:
         HlpError: it is unreadable, too large or not a JSON object.
     """
     try:
-        if path.stat().st_size > MAX_RECORD_BYTES:
-            raise ValueError(f"larger than {MAX_RECORD_BYTES >> 20} MiB")
-        record = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as error:
+        record = json.loads(read_run_file(path, MAX_RECORD_BYTES))
+    except (ValueError, RecursionError) as error:  # RecursionError: nested too deep
         raise HlpError(f"{path} is unreadable ({error}); {START_OVER}") from None
     if not isinstance(record, dict):
         raise HlpError(f"{path} is unreadable (not a JSON object); {START_OVER}")

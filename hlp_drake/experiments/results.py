@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from hlp_drake.atomic import atomic_path
+from hlp_drake.documents import read_bytes
 from hlp_drake.errors import HlpError
 from hlp_drake.experiments.runner import PLANNERS, Row
 
@@ -114,26 +115,37 @@ def read_results(path: Path, kind: str | None = None) -> list[Row]:
     """
     if not path.exists():
         return []
+    reader = csv.reader(io.StringIO(read_run_file(path, MAX_RESULTS_BYTES), newline=""))
     try:
-        if path.stat().st_size > MAX_RESULTS_BYTES:
-            raise HlpError(f"{path}: larger than {MAX_RESULTS_BYTES >> 20} MiB, not an experiment's results")
-        with path.open(newline="", encoding="utf-8") as file:
-            reader = csv.reader(file)
-            header = tuple(next(reader, ()))
-            if header not in (COLUMNS, EARLIER_COLUMNS):
-                raise HlpError(f"{path}: not an experiment results file (unexpected columns); {START_OVER}")
-            rows = []
-            for record in reader:
-                try:
-                    rows.append(_row(header, record, kind))
-                except (KeyError, ValueError) as error:
-                    raise HlpError(
-                        f"{path}: line {reader.line_num}: malformed row ({error}); {START_OVER}"
-                    ) from None
-    except (OSError, UnicodeDecodeError, csv.Error) as error:
-        reason = error.strerror if isinstance(error, OSError) and error.strerror else str(error)
-        raise HlpError(f"{path}: unreadable ({reason}); {START_OVER}") from None
+        header = tuple(next(reader, ()))
+        if header not in (COLUMNS, EARLIER_COLUMNS):
+            raise HlpError(f"{path}: not an experiment results file (unexpected columns); {START_OVER}")
+        rows = []
+        for record in reader:
+            try:
+                rows.append(_row(header, record, kind))
+            except (KeyError, ValueError) as error:
+                raise HlpError(
+                    f"{path}: line {reader.line_num}: malformed row ({error}); {START_OVER}"
+                ) from None
+    except csv.Error as error:
+        raise HlpError(f"{path}: unreadable ({error}); {START_OVER}") from None
     return rows
+
+
+def read_run_file(path: Path, limit: int) -> str:
+    """The text of a run folder's record ``path`` (``results.csv``, ``run.json``, ``config.json``).
+
+    Raises:
+        HlpError: it is unreadable, larger than ``limit`` bytes or not UTF-8 (one line, with how to
+            start over).
+    """
+    try:
+        return read_bytes(path, limit=limit).decode("utf-8")
+    except HlpError as error:
+        raise HlpError(f"{error.problems[0]}; {START_OVER}") from None
+    except UnicodeDecodeError as error:
+        raise HlpError(f"{path}: unreadable ({error}); {START_OVER}") from None
 
 
 def _row(header: tuple[str, ...], record: list[str], kind: str | None) -> Row:

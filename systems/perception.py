@@ -26,7 +26,7 @@ import numpy as np
 
 from hlp_drake.planner.blas import single_blas_thread
 from hlp_drake.scene.geometry import footprint_bounds
-from hlp_drake.scene.model import Scene, SceneObject, Table
+from hlp_drake.scene.model import Scene, SceneObject, Table, plan_view_order
 from hlp_drake.scene.validation import scene_problems
 from hlp_drake.systems.cameras import ROBOT_LABEL, TARGET_LABEL
 from hlp_drake.systems.depth_points import (
@@ -239,7 +239,7 @@ def _perceive(
         _perceived(cluster, table, views, share, template.target.name if i == target else "", i == target)
         for i, (cluster, share) in enumerate(zip(clusters, shares))
     ]
-    others = sorted((o for i, o in enumerate(objects) if i != target), key=lambda o: (o.x, o.y))
+    others = plan_view_order(o for i, o in enumerate(objects) if i != target)
     objects = [objects[target], *(replace(o, name=f"object_{k}") for k, o in enumerate(others, start=1))]
     perceived_table = Table(length=x1, width=y1 - y0, height=table.height_at(x1 / 2.0, (y0 + y1) / 2.0))
     placed = [_inside_table(o.scene_object(), perceived_table) for o in objects]

@@ -34,7 +34,7 @@ from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
 from pydrake.multibody.tree import ModelInstanceIndex, RigidBody, SpatialInertia, UnitInertia
 from pydrake.systems.framework import Context
 
-from hlp_drake.scene.model import Scene, SceneObject
+from hlp_drake.scene.model import Scene, SceneObject, plan_view_order
 from hlp_drake.systems.world_settings import BodiesConfig, ContactConfig
 
 TABLE_NAME = "table"
@@ -215,7 +215,7 @@ def add_scene(
     plant.RegisterVisualGeometry(table_body, RigidTransform(), box, "table_top_visual", TABLE_COLOR)
 
     objects: dict[str, ModelInstanceIndex] = {}
-    for obj in scene.objects if with_objects else ():
+    for obj in (scene.target, *plan_view_order(scene.obstacles)) if with_objects else ():
         color = TARGET_COLOR if obj is scene.target else OBSTACLE_COLOR
         instance, body = _add_object(
             plant,

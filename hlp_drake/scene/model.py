@@ -8,9 +8,19 @@ planar pose (x, y, yaw) and their size.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
+from typing import Protocol, TypeVar
 
 SHAPES = ("box", "cylinder")
+
+
+class _PlanarPosition(Protocol):
+    x: float
+    y: float
+
+
+Placed = TypeVar("Placed", bound=_PlanarPosition)
 
 
 @dataclass(frozen=True)
@@ -100,3 +110,9 @@ class Scene:
             if obstacle.name == name:
                 return obstacle
         raise KeyError(f"no obstacle named {name!r}")
+
+
+def plan_view_order(objects: Iterable[Placed]) -> list[Placed]:
+    """``objects`` by x (away from the start's edge), then y: the order worlds are built in (and a
+    camera names what it finds in), so how a scene lists its objects cannot change a simulation."""
+    return sorted(objects, key=lambda o: (o.x, o.y))

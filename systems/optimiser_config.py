@@ -137,7 +137,9 @@ class StoConfig:
             execution does); only if it passes there too does the optimisation succeed, else that
             outcome (and cost) replaces the rollout's and the optimisation goes on.
         max_verifications: verifications per optimisation at most (they do not count in
-            ``max_rollouts``: each costs several rollouts' time, reported apart).
+            ``max_rollouts``: each costs several rollouts' time, reported apart). Once they are
+            spent the optimisation ends, whatever rollouts are left (8: with 4, searches whose
+            fifth candidate held ended at half their rollouts, see docs/perception.md).
         alternatives: when the initial sequence's rollout fails, roll out the planner's next this
             many distinct candidate plans once (the HLP's, by expected arm collision; the straight
             line has none) and go on from the best of them all (0: never).
@@ -176,7 +178,7 @@ class StoConfig:
     max_sink: float = 0.03
     cost: StoCost = field(default_factory=StoCost)
     verify: bool = True
-    max_verifications: int = 4
+    max_verifications: int = 8
     alternatives: int = 3
     displaced_checks: int | None = None
     displaced_sigma: float = 0.001

@@ -16,7 +16,7 @@ from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import SceneObject
 from hlp_drake.systems.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser import Budget, mppi_weights, optimise, sample_base_noise
-from hlp_drake.systems.optimiser_config import PERCEIVED_CHECKS
+from hlp_drake.systems.optimiser_config import PERCEIVED_CHECKS, StoConfig
 from hlp_drake.systems.optimiser_system import StochasticTrajectoryOptimiser
 from hlp_drake.systems.planning_diagram import make_planning_diagram
 from hlp_drake.systems.rollout_cost import BLOWN_UP_COST, RolloutSamples, rollout_cost
@@ -417,6 +417,19 @@ def test_a_verified_sequence_counts_only_if_it_passes_with_the_objects_displaced
     assert "rollout budget of 1 spent" in moved.failure_reason
     with pytest.raises(HlpError, match=r"optimiser\.displaced_checks must be between 0 and 100"):
         on(scene, "optimiser: {displaced_checks: -1}")
+
+
+def test_the_search_ends_once_its_verifications_are_spent_whatever_rollouts_are_left(scene, trajectories):
+    reaching = ControlSequence.from_trajectory(trajectories["hlp"], 0.5)  # passes every rollout
+    settings = (
+        "optimiser: {max_rollouts: 40, samples: 2, max_verifications: 2, displaced_checks: 1,"
+        " displaced_sigma: 0.05}"  # every verified sequence fails with the objects displaced
+    )
+    with RolloutPool(2) as pool:
+        result = optimise(on(scene, settings), reaching, pool)
+    assert not result.success and (result.verifications, result.rejected) == (2, 2)
+    assert result.failure_reason.endswith("(verifications spent)") and result.rollouts < 40
+    assert StoConfig().max_verifications == 8
 
 
 def test_perceived_scenes_get_displaced_checks_unless_the_scenario_sets_them(scene, trajectories):

@@ -32,7 +32,7 @@ def first_pass(kind: str, seed: int, objects: int | None, planner: str, config_y
     from dataclasses import replace
 
     from hlp_drake.learners.bundled import default_models
-    from hlp_drake.systems.planning_diagram import first_rollout
+    from hlp_drake.systems.planning.diagram import first_rollout
     from hlp_drake.systems.scenario import load_scenario
 
     scene = generate_scene(kind, seed, objects)

@@ -34,10 +34,10 @@ from hlp_drake.learners.bundled import default_models
 from hlp_drake.plotting import new_figure, save_png
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene
-from hlp_drake.systems.keyframes import Keyframes
-from hlp_drake.systems.planning_diagram import make_planning_diagram
+from hlp_drake.systems.planning.diagram import make_planning_diagram
+from hlp_drake.systems.planning.keyframes import Keyframes
 from hlp_drake.systems.scenario import Scenario, load_scenario
-from hlp_drake.systems.scene_source import SCENE_PORT
+from hlp_drake.systems.world.scene_source import SCENE_PORT
 
 SAME_POSITIONS = 1e-4
 """Keyframes whose positions differ by at most this (rad or m) count as the same."""

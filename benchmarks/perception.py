@@ -35,11 +35,11 @@ from hlp_drake.planner import plan
 from hlp_drake.plotting import new_figure, save_png
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene, SceneObject
-from hlp_drake.systems.perception_config import CameraSettings, PerceptionConfig
-from hlp_drake.systems.perception_errors import match_objects, perception_record, same_decisions
+from hlp_drake.systems.perception.accuracy import match_objects, perception_record, same_decisions
+from hlp_drake.systems.perception.cameras import CameraSettings, PerceptionConfig
+from hlp_drake.systems.perception.system import ScenePerception
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.scene_perception import ScenePerception
-from hlp_drake.systems.world import make_world_diagram
+from hlp_drake.systems.world.world import make_world_diagram
 
 TARGETS = {
     "position_median_mm": 5.0,

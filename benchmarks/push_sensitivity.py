@@ -20,11 +20,11 @@ import time
 import numpy as np
 
 from hlp_drake.scene.generators import generate_scene
-from hlp_drake.systems.model_error import displaced_scenes
-from hlp_drake.systems.planning_diagram import initial_sequence
+from hlp_drake.systems.optimiser.pool import SceneRollouts
+from hlp_drake.systems.perception.system import perceive_world
+from hlp_drake.systems.planning.diagram import initial_sequence
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.scene_perception import perceive_world
-from hlp_drake.systems.scene_rollouts import SceneRollouts
+from hlp_drake.systems.world.uncertainty import displaced_scenes
 
 
 def variants(scene, scenario: Scenario) -> dict:

@@ -38,9 +38,9 @@ import numpy as np
 from sto import HORIZON, nudged, throughput_sequences, validation_sequences
 from tqdm import tqdm
 
-from hlp_drake.systems.rollout_world import RolloutWorld
+from hlp_drake.systems.optimiser.pool import SceneRollouts
+from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.scene_rollouts import SceneRollouts
 
 UNTRIMMED = (
     "rollout_trims: {top_spheres: true, rim_spheres: 8, robot_self_contact: true, sampled_output_ports: true}"

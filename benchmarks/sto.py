@@ -35,15 +35,14 @@ from tqdm import tqdm
 
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import load_scene
-from hlp_drake.systems.control_sequence import ControlSequence
-from hlp_drake.systems.execution import plan_and_execute
-from hlp_drake.systems.optimiser import sample_base_noise
-from hlp_drake.systems.planning_diagram import initial_sequence
-from hlp_drake.systems.rollout_cost import RolloutOutcome
-from hlp_drake.systems.rollout_pool import RolloutPool
-from hlp_drake.systems.rollout_world import RolloutWorld
+from hlp_drake.systems.execution.execution import plan_and_execute
+from hlp_drake.systems.optimiser.control_sequence import ControlSequence
+from hlp_drake.systems.optimiser.cost import RolloutOutcome
+from hlp_drake.systems.optimiser.optimiser import sample_base_noise
+from hlp_drake.systems.optimiser.pool import RolloutPool, SceneRollouts
+from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
+from hlp_drake.systems.planning.diagram import initial_sequence
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.scene_rollouts import SceneRollouts
 
 DEFAULT_SCENE = Path(__file__).resolve().parents[1] / "hlp_drake" / "scenes" / "default.yaml"
 HORIZON = 3.0

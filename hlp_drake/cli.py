@@ -77,7 +77,7 @@ def add_quiet(parser: argparse.ArgumentParser) -> None:
 
 
 PERCEPTION_SOURCES = ("truth", "camera")
-"""``perception.source``'s values (``hlp_drake.systems.perception_config``'s, without importing Drake)."""
+"""``perception.source``'s values (``hlp_drake.systems.perception.cameras``'s, without importing Drake)."""
 
 
 def add_perception(parser: argparse.ArgumentParser) -> None:

@@ -34,12 +34,10 @@ from hlp_drake.planner.config import PlannerConfig
 from hlp_drake.scene.io import default_scene
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.validation import scene_problems
-from hlp_drake.systems.model_error import UncertaintyConfig
-from hlp_drake.systems.optimiser_config import ClosedLoopConfig, StoConfig
-from hlp_drake.systems.perception_config import PerceptionConfig
+from hlp_drake.systems.optimiser.config import ClosedLoopConfig, StoConfig
+from hlp_drake.systems.perception.cameras import PerceptionConfig
 from hlp_drake.systems.scenario_checks import check_scenario, scenario_problems
-from hlp_drake.systems.transfer_geometry import TransferConfig
-from hlp_drake.systems.world_settings import (
+from hlp_drake.systems.world.config import (
     BodiesConfig,
     ContactConfig,
     ControlConfig,
@@ -48,6 +46,8 @@ from hlp_drake.systems.world_settings import (
     MotionConfig,
     default_plant_config,
 )
+from hlp_drake.systems.world.uncertainty import UncertaintyConfig
+from hlp_drake.transfer.rules import TransferConfig
 from hlp_drake.typed_yaml import dump_typed, load_typed
 
 PLANNERS = ("hlp", "sto")

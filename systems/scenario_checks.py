@@ -9,10 +9,9 @@ from hlp_drake.errors import HlpError
 from hlp_drake.planner.config import planner_config_problems
 from hlp_drake.scene.generators import MAX_SEED
 from hlp_drake.scene.validation import name_problem
-from hlp_drake.systems.cameras import CLIPPING, camera_pose
-from hlp_drake.systems.optimiser_config import StoCost
-from hlp_drake.systems.perception_config import PERCEPTION_SOURCES
-from hlp_drake.systems.transfer_geometry import TransferConfig
+from hlp_drake.systems.optimiser.config import StoCost
+from hlp_drake.systems.perception.cameras import CLIPPING, PERCEPTION_SOURCES, camera_pose
+from hlp_drake.transfer.rules import TransferConfig
 
 if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario

@@ -5,14 +5,14 @@ from __future__ import annotations
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
-from hlp_drake.systems.control_sequence import ControlSequence
-from hlp_drake.systems.optimiser import StoResult
-from hlp_drake.systems.receding_horizon import RecedingHorizonController
-from hlp_drake.systems.rollout_pool import RolloutPool
+from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
+from hlp_drake.systems.optimiser.control_sequence import ControlSequence
+from hlp_drake.systems.optimiser.optimiser import StoResult
+from hlp_drake.systems.optimiser.pool import RolloutPool
+from hlp_drake.systems.perception.system import add_scene_perception
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.scene_perception import add_scene_perception
-from hlp_drake.systems.scene_source import SceneFromPlant
-from hlp_drake.systems.world import connect_robot_command, make_world_diagram, world_plant
+from hlp_drake.systems.world.scene_source import SceneFromPlant
+from hlp_drake.systems.world.world import connect_robot_command, make_world_diagram, world_plant
 
 
 def run_controller(

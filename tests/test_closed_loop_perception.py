@@ -12,16 +12,16 @@ from pydrake.systems.analysis import Simulator
 
 from hlp_drake.run_scene import DEFAULT_SCENE
 from hlp_drake.scene.io import load_scene
-from hlp_drake.systems.control_sequence import ControlSequence
-from hlp_drake.systems.optimiser import StoResult
-from hlp_drake.systems.perception import Perception, unperceived_scene
-from hlp_drake.systems.perception_config import CameraSettings, PerceptionConfig
-from hlp_drake.systems.receding_horizon import RecedingHorizonController
-from hlp_drake.systems.rollout_cost import Prediction, RolloutOutcome
-from hlp_drake.systems.rollout_pool import RolloutPool
-from hlp_drake.systems.rollout_world import RolloutWorld
+from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
+from hlp_drake.systems.optimiser.control_sequence import ControlSequence
+from hlp_drake.systems.optimiser.cost import Prediction, RolloutOutcome
+from hlp_drake.systems.optimiser.optimiser import StoResult
+from hlp_drake.systems.optimiser.pool import RolloutPool
+from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
+from hlp_drake.systems.perception.cameras import CameraSettings, PerceptionConfig
+from hlp_drake.systems.perception.perception import Perception, unperceived_scene
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.world import make_world_diagram, world_plant
+from hlp_drake.systems.world.world import make_world_diagram, world_plant
 
 SETTINGS = (
     "optimiser: {samples: 2, workers: 1, verify: false}\n"

@@ -108,9 +108,9 @@ def _scenario_texts(draw) -> str:
 def _check_scenario(text: str) -> None:
     """Refused in one line per problem, or loaded and then usable: its cameras build (Drake's
     checks of the intrinsics and depth range pass) and its model error can be drawn."""
-    from hlp_drake.systems.cameras import camera_pose, render_cameras
-    from hlp_drake.systems.model_error import sample_model_error
+    from hlp_drake.systems.perception.cameras import camera_pose, render_cameras
     from hlp_drake.systems.scenario import load_scenario
+    from hlp_drake.systems.world.uncertainty import sample_model_error
 
     STATS["scenario files"] += 1
     try:

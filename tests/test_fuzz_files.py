@@ -232,7 +232,7 @@ def test_a_pinned_model_refuses_other_files_with_a_valid_checksum(tmp_path):
 
 def test_a_scenario_pins_its_models_by_the_sha256_of_models_json(tmp_path):
     from hlp_drake.systems import load_scenario
-    from hlp_drake.systems.planning_diagram import scenario_models
+    from hlp_drake.systems.planning.diagram import scenario_models
 
     folder = tmp_path / "m"
     shutil.copytree(BUNDLED_DIRECTORY, folder)

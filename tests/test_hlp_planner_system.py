@@ -9,7 +9,7 @@ import pytest
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.planner import plan
 from hlp_drake.scene.generators import generate_scene
-from hlp_drake.systems.hlp_planner_system import HlpPlannerSystem
+from hlp_drake.systems.planning.planners import HlpPlannerSystem
 
 
 def test_plan_output_matches_the_planner_and_is_cached_by_drake():
@@ -37,9 +37,9 @@ def test_plans_from_the_plants_body_poses_in_a_diagram_and_again_when_an_object_
     from pydrake.systems.framework import DiagramBuilder
 
     from hlp_drake.systems.scenario import Scenario
-    from hlp_drake.systems.scene_models import object_body
-    from hlp_drake.systems.scene_source import SceneFromPlant
-    from hlp_drake.systems.world import make_world_diagram, world_plant
+    from hlp_drake.systems.world.scene_models import object_body
+    from hlp_drake.systems.world.scene_source import SceneFromPlant
+    from hlp_drake.systems.world.world import make_world_diagram, world_plant
 
     scene = generate_scene("gen2", 3, 5)  # objects turned about z: their yaws go through quaternions
     builder = DiagramBuilder()

@@ -11,11 +11,11 @@ import pytest
 from conftest import run_module
 
 from hlp_drake.errors import MAX_LINE
-from hlp_drake.systems.model_package import models_directory
+from hlp_drake.systems.world.robot import models_directory
 
 # run_scene with its model package read from the folder argv[1] (a damaged copy of the installed one).
 _WITH_PACKAGE = (
-    "import sys, pathlib, hlp_drake.systems.model_package as package; "
+    "import sys, pathlib, hlp_drake.systems.world.robot as package; "
     "package.models_directory = lambda: pathlib.Path(sys.argv[1]); "
     "from hlp_drake.cli import run_cli; from hlp_drake.run_scene import main; "
     "raise SystemExit(run_cli(main, sys.argv[2:]))"

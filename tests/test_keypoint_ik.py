@@ -12,11 +12,12 @@ from pydrake.trajectories import PiecewisePolynomial
 from hlp_drake.planner.plan import HighLevelPlan, PlanKeypoint
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene, SceneObject, Table
-from hlp_drake.systems.keypoint_ik import Keyframes, KeypointIk
-from hlp_drake.systems.robot import BASE_FOOTPRINT, GRIPPER_CLOSED, GRIPPER_OPEN, TCP_FRAME
+from hlp_drake.systems.planning.ik import KeypointIk
+from hlp_drake.systems.planning.keyframes import Keyframes
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.start_pose import start_configuration
-from hlp_drake.systems.world import make_world_diagram, world_plant
+from hlp_drake.systems.world.robot import BASE_FOOTPRINT, GRIPPER_CLOSED, GRIPPER_OPEN, TCP_FRAME
+from hlp_drake.systems.world.start_pose import start_configuration
+from hlp_drake.systems.world.world import make_world_diagram, world_plant
 from hlp_drake.taskspace import TaskSpace
 
 CONFIG = Scenario()
@@ -375,8 +376,8 @@ def test_a_persons_plan_wired_straight_into_ik_is_refused_not_executed(system):
     """A person's "move" keypoints are the obstacles' centres; only RobotPlanTransfer's plan is solved."""
     from hlp_drake.learners.bundled import default_models
     from hlp_drake.planner import plan as human_plan
-    from hlp_drake.systems.push_transfer import robot_plan
-    from hlp_drake.systems.transfer_geometry import gripper_geometry, push_rules
+    from hlp_drake.transfer.push import robot_plan
+    from hlp_drake.transfer.rules import gripper_geometry, push_rules
 
     scene = generate_scene("gen1", 3)
     person = human_plan(scene, default_models())
@@ -392,8 +393,8 @@ def test_the_default_iteration_cap_gives_the_keyframes_of_a_five_times_larger_on
     """On gen2-7-5 SNOPT lingers at a converged point of one keypoint for hundreds of major
     iterations; stopping at ``ik.max_iterations`` (an iterate meeting every constraint counts)
     leaves every keyframe where 5x the iterations put it."""
-    from hlp_drake.systems.planning_diagram import make_planning_diagram
-    from hlp_drake.systems.scene_source import SCENE_PORT
+    from hlp_drake.systems.planning.diagram import make_planning_diagram
+    from hlp_drake.systems.world.scene_source import SCENE_PORT
 
     scene = generate_scene("gen2", 5, 7)
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from hlp_drake.systems.object_matching import largest_displacement, match_obstacles
+from hlp_drake.systems.perception.accuracy import largest_displacement, match_obstacles
 
 EXPECTED = np.array([[0.6, 0.0], [0.3, -0.2], [0.3, 0.2], [0.45, 0.0]])  # the target, then obstacles
 

@@ -12,14 +12,21 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.sensors import ImageDepth32F, ImageLabel16I
 
 from hlp_drake.scene.model import Scene, SceneObject, Table
-from hlp_drake.systems.cameras import ROBOT_LABEL, TABLE_LABEL, TARGET_LABEL, DepthNoise, camera_pose
-from hlp_drake.systems.depth_points import view_points
-from hlp_drake.systems.model_error import ModelError, ObjectError
-from hlp_drake.systems.perception_config import CameraSettings, PerceptionConfig
-from hlp_drake.systems.perception_errors import perception_record
+from hlp_drake.systems.perception.accuracy import perception_record
+from hlp_drake.systems.perception.cameras import (
+    ROBOT_LABEL,
+    TABLE_LABEL,
+    TARGET_LABEL,
+    CameraSettings,
+    DepthNoise,
+    PerceptionConfig,
+    camera_pose,
+)
+from hlp_drake.systems.perception.depth_points import view_points
+from hlp_drake.systems.perception.system import ScenePerception, add_scene_perception, perceive_world
 from hlp_drake.systems.scenario import Scenario, load_scenario
-from hlp_drake.systems.scene_perception import ScenePerception, add_scene_perception, perceive_world
-from hlp_drake.systems.world import make_world_diagram, world_plant
+from hlp_drake.systems.world.uncertainty import ModelError, ObjectError
+from hlp_drake.systems.world.world import make_world_diagram, world_plant
 
 CAMERA = CameraSettings(width=320, height=240, depth_noise=0.001, dropout=0.01, seed=4)
 SCENE = Scene(
@@ -378,7 +385,7 @@ def test_a_rolled_cameras_table_edges_are_found_without_the_pixel_grids_bias():
 
 def _spy_on_clustering(monkeypatch) -> list[tuple]:
     """Each call of the perception's clustering: (linked, its clusters, every point linked's clusters)."""
-    from hlp_drake.systems import perception as module
+    from hlp_drake.systems.perception import perception as module
 
     calls, real = [], module.cluster_points
 

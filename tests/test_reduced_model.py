@@ -7,12 +7,11 @@ import numpy as np
 import pytest
 from sto_support import on, short
 
-from hlp_drake.systems.control_sequence import ControlSequence
-from hlp_drake.systems.proximity import ProximityContext
-from hlp_drake.systems.rollout_reading import OBJECT, ROBOT, TABLE, contact_summary
-from hlp_drake.systems.rollout_world import RolloutStart, RolloutWorld
-from hlp_drake.systems.scene_rollouts import SceneRollouts
-from hlp_drake.systems.sleep_schedule import Sweep
+from hlp_drake.systems.optimiser.control_sequence import ControlSequence
+from hlp_drake.systems.optimiser.pool import SceneRollouts
+from hlp_drake.systems.optimiser.rollout_world import RolloutStart, RolloutWorld
+from hlp_drake.systems.optimiser.sampler import OBJECT, ROBOT, TABLE, contact_summary
+from hlp_drake.systems.optimiser.sleep import ProximityContext, Sweep
 
 # --- The reduced rollout model ---------------------------------------------------------------------
 

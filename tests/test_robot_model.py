@@ -22,8 +22,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
-from hlp_drake.systems.model_package import models_directory
-from hlp_drake.systems.robot import (
+from hlp_drake.systems.world.robot import (
     ACTUATED_JOINTS,
     ARM_BASE_FRAME,
     ARM_JOINTS,
@@ -43,6 +42,7 @@ from hlp_drake.systems.robot import (
     TCP_FRAME,
     TCP_OFFSET,
     add_robot,
+    models_directory,
     robot_joint_limits,
     set_robot_positions,
 )

@@ -18,11 +18,11 @@ from hlp_drake.learners.bundled import default_models
 from hlp_drake.planner import plan
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import scene_to_dict
-from hlp_drake.systems.planning_diagram import make_planning_diagram
-from hlp_drake.systems.push_transfer import ROBOT_ACTIONS, robot_alternatives, robot_plan
+from hlp_drake.systems.planning.diagram import make_planning_diagram
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.transfer_geometry import TransferConfig, gripper_geometry, push_rules
 from hlp_drake.taskspace import DIRECTION_VECTORS, TaskSpace
+from hlp_drake.transfer.push import ROBOT_ACTIONS, robot_alternatives, robot_plan
+from hlp_drake.transfer.rules import TransferConfig, gripper_geometry, push_rules
 
 RULES = push_rules(TransferConfig(), gripper_geometry())
 
@@ -218,7 +218,7 @@ def test_run_scene_rejects_a_bad_worker_count(tmp_path):
 
 
 def test_pushes_stop_short_of_the_table_edge_and_the_other_objects():
-    from hlp_drake.systems.push_transfer import push_travel
+    from hlp_drake.transfer.push import push_travel
 
     EDGE_MARGIN, OBJECT_MARGIN = RULES.edge_margin, RULES.object_margin
 
@@ -251,8 +251,8 @@ def test_pushes_stop_short_of_the_table_edge_and_the_other_objects():
 
 
 def test_pushes_stop_short_of_where_earlier_pushes_left_the_other_objects():
-    from hlp_drake.systems.push_transfer import push_travel
     from hlp_drake.taskspace import Rect
+    from hlp_drake.transfer.push import push_travel
 
     OBJECT_MARGIN = RULES.object_margin
 
@@ -289,7 +289,7 @@ def scene_with_one_obstacle(scene):
 
 
 def test_a_push_with_no_room_to_move_the_obstacle_is_left_out():
-    from hlp_drake.systems.push_transfer import _robot_direction, _unit, _wanted, push_travel
+    from hlp_drake.transfer.push import _robot_direction, _unit, _wanted, push_travel
 
     MIN_PUSH_TRAVEL = RULES.min_push_travel
 
@@ -312,7 +312,7 @@ def test_a_push_with_no_room_to_move_the_obstacle_is_left_out():
 
 
 def test_an_obstacle_already_near_an_edge_can_be_pushed_along_it_but_not_towards_it():
-    from hlp_drake.systems.push_transfer import push_travel
+    from hlp_drake.transfer.push import push_travel
 
     EDGE_MARGIN = RULES.edge_margin
 
@@ -331,7 +331,7 @@ def test_an_obstacle_already_near_an_edge_can_be_pushed_along_it_but_not_towards
 
 
 def test_a_backward_move_becomes_the_sideways_push_that_clears_the_corridor():
-    from hlp_drake.systems.push_transfer import _robot_direction
+    from hlp_drake.transfer.push import _robot_direction
 
     scene = generate_scene("gen1", 14)
     space = TaskSpace(scene)
@@ -444,8 +444,8 @@ def test_run_scene_meshcat_serves_the_run_live(tmp_path):
 
 def test_transit_goes_over_the_objects_where_the_arm_can_come_down():
     from hlp_drake.planner.plan import PlanKeypoint
-    from hlp_drake.systems.push_transfer import transit
     from hlp_drake.taskspace import Rect
+    from hlp_drake.transfer.push import transit
 
     ARM_SHADOW_LENGTH = RULES.arm_shadow_length
 
@@ -484,8 +484,8 @@ def test_transit_goes_over_the_objects_where_the_arm_can_come_down():
 
 
 def test_a_way_that_would_pass_over_an_object_goes_over_it():
-    from hlp_drake.systems.push_transfer import crosses, transit_height
     from hlp_drake.taskspace import Rect
+    from hlp_drake.transfer.push import crosses, transit_height
 
     PATH_CLEARANCE = RULES.path_clearance
 
@@ -510,7 +510,7 @@ def test_a_way_that_would_pass_over_an_object_goes_over_it():
 
 
 def test_a_push_that_would_leave_the_obstacle_in_the_way_goes_another_way():
-    from hlp_drake.systems.push_transfer import chosen_push, crosses, robot_push
+    from hlp_drake.transfer.push import chosen_push, crosses, robot_push
 
     WAY_CLEARANCE = RULES.way_clearance
 
@@ -554,8 +554,8 @@ def test_a_push_that_would_leave_the_obstacle_in_the_way_goes_another_way():
 
 
 def test_the_gripper_slides_onto_the_target_along_its_approach_axis():
-    from hlp_drake.systems.push_transfer import approach
     from hlp_drake.taskspace import Rect
+    from hlp_drake.transfer.push import approach
 
     APPROACH_GAP, GRIPPER_AHEAD = RULES.approach_gap, RULES.gripper_ahead
 

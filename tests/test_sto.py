@@ -14,17 +14,16 @@ from sto_support import on, short
 from hlp_drake.errors import HlpError
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import SceneObject
-from hlp_drake.systems.control_sequence import ControlSequence
-from hlp_drake.systems.optimiser import Budget, mppi_weights, optimise, sample_base_noise
-from hlp_drake.systems.optimiser_config import PERCEIVED_CHECKS, StoConfig
-from hlp_drake.systems.optimiser_system import StochasticTrajectoryOptimiser
-from hlp_drake.systems.planning_diagram import make_planning_diagram
-from hlp_drake.systems.rollout_cost import BLOWN_UP_COST, RolloutSamples, rollout_cost
-from hlp_drake.systems.rollout_pool import RolloutPool
-from hlp_drake.systems.rollout_world import RolloutWorld
+from hlp_drake.systems.optimiser.config import PERCEIVED_CHECKS, StoConfig
+from hlp_drake.systems.optimiser.control_sequence import ControlSequence
+from hlp_drake.systems.optimiser.cost import BLOWN_UP_COST, RolloutSamples, rollout_cost
+from hlp_drake.systems.optimiser.optimiser import Budget, mppi_weights, optimise, sample_base_noise
+from hlp_drake.systems.optimiser.pool import RolloutPool, SceneRollouts
+from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
+from hlp_drake.systems.optimiser.system import StochasticTrajectoryOptimiser
+from hlp_drake.systems.planning.diagram import make_planning_diagram
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.scene_rollouts import SceneRollouts
-from hlp_drake.systems.start_pose import tcp_keypoint_height
+from hlp_drake.systems.world.start_pose import tcp_keypoint_height
 
 # --- Control sequences -----------------------------------------------------------------------------
 
@@ -44,9 +43,9 @@ def test_sequence_keeps_every_keyframe_and_bounds_the_step(trajectories):
 
 
 def test_base_velocity_is_integrated_and_the_start_stays():
-    from hlp_drake.systems.control_sequence import BASE_COLUMNS
-    from hlp_drake.systems.robot import BASE_JOINTS
-    from hlp_drake.systems.start_pose import robot_position_names
+    from hlp_drake.systems.optimiser.control_sequence import BASE_COLUMNS
+    from hlp_drake.systems.world.robot import BASE_JOINTS
+    from hlp_drake.systems.world.start_pose import robot_position_names
 
     assert tuple(robot_position_names()[i] for i in BASE_COLUMNS) == BASE_JOINTS
     sequence = ControlSequence(np.array([0.0, 0.5, 1.5]), np.zeros((3, 11)))
@@ -225,7 +224,7 @@ def test_a_drake_internal_check_failing_mid_rollout_is_a_failure_and_the_world_g
 
 
 def test_only_drake_failures_count_as_simulation_failures():
-    from hlp_drake.systems.rollout_world import simulation_failure
+    from hlp_drake.systems.optimiser.rollout_world import simulation_failure
 
     assert simulation_failure(RuntimeError("SAP failed\nmore")) == "SAP failed"
     assert simulation_failure(SystemExit("Failure at x.h:1 in f(): condition 'c' failed.")).startswith(
@@ -364,7 +363,7 @@ def test_optimiser_block_ports_and_cache(scene, trajectories):
 
 
 def test_an_unreachable_target_fails_with_a_reason_and_no_rollouts(scene):
-    from hlp_drake.systems.execution import plan_and_execute
+    from hlp_drake.systems.execution.execution import plan_and_execute
 
     far = dataclasses.replace(scene.target, x=scene.table.length + 1.5)
     with RolloutPool(1) as pool:
@@ -391,7 +390,7 @@ def test_a_pool_keeps_its_worlds_by_scenario_until_it_is_closed(scene):
 
 
 def test_displaced_scenes_move_every_object_by_about_sigma_and_are_seeded(scene):
-    from hlp_drake.systems.model_error import displaced_scenes
+    from hlp_drake.systems.world.uncertainty import displaced_scenes
 
     a, b = displaced_scenes(scene, 2, 0.001, 0.01), displaced_scenes(scene, 2, 0.001, 0.01)
     assert a == b and len(a) == 2 and a[0] != a[1]

@@ -18,10 +18,10 @@ from pydrake.trajectories import PiecewisePolynomial
 from hlp_drake.errors import HlpError
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene, SceneObject, Table, plan_view_order
-from hlp_drake.systems.planning_model import PlanningModel
-from hlp_drake.systems.robot import ACTUATED_JOINTS, BASE_FOOTPRINT, TCP_FRAME
+from hlp_drake.systems.planning.keyframes import PlanningModel
 from hlp_drake.systems.scenario import Scenario, load_scenario
-from hlp_drake.systems.scene_models import (
+from hlp_drake.systems.world.robot import ACTUATED_JOINTS, BASE_FOOTPRINT, TCP_FRAME
+from hlp_drake.systems.world.scene_models import (
     add_scene,
     fallen_objects,
     object_body,
@@ -32,8 +32,8 @@ from hlp_drake.systems.scene_models import (
     set_object_poses,
     tilted_objects,
 )
-from hlp_drake.systems.start_pose import robot_base_pose, robot_position_names, start_configuration
-from hlp_drake.systems.world import (
+from hlp_drake.systems.world.start_pose import robot_base_pose, robot_position_names, start_configuration
+from hlp_drake.systems.world.world import (
     DESIRED_STATE_PORT,
     add_position_trajectory,
     desired_state_from_robot_state,
@@ -465,13 +465,13 @@ def test_a_camera_source_without_a_camera_is_refused_whichever_way_it_is_asked_f
 
 
 def test_a_scenario_made_in_python_is_checked_by_the_builders_and_blocks():
-    from hlp_drake.systems.keypoint_ik import KeypointIk
-    from hlp_drake.systems.optimiser_system import StochasticTrajectoryOptimiser
-    from hlp_drake.systems.perception_config import CameraSettings, PerceptionConfig
-    from hlp_drake.systems.planning_diagram import make_planning_diagram
-    from hlp_drake.systems.receding_horizon import RecedingHorizonController
-    from hlp_drake.systems.robot_transfer import RobotPlanTransfer
-    from hlp_drake.systems.scene_perception import ScenePerception
+    from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
+    from hlp_drake.systems.optimiser.system import StochasticTrajectoryOptimiser
+    from hlp_drake.systems.perception.cameras import CameraSettings, PerceptionConfig
+    from hlp_drake.systems.perception.system import ScenePerception
+    from hlp_drake.systems.planning.diagram import make_planning_diagram
+    from hlp_drake.systems.planning.ik import KeypointIk
+    from hlp_drake.systems.planning.transfer import RobotPlanTransfer
 
     bad = Scenario(perception=PerceptionConfig(source="camera", cameras=(CameraSettings(width=0),)))
     for build in (

@@ -1,0 +1,196 @@
+"""What the push transfer needs to know: its margins (a ``Scenario``'s ``transfer``) and the robot's sizes.
+
+The sizes (the tcp's offset from the flange, how far the fingertips reach ahead of the tcp, the open
+fingers' half-width, the wrist's radius) are read from the robot model's collision geometry, where
+they live, and rounded up to ``SIZE_RESOLUTION``; ``push_rules`` combines them with the margins
+into the clearances ``hlp_drake.transfer.push`` works with.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+SIZE_RESOLUTION = 0.005
+"""The robot's sizes are rounded up to this (m): the transfer's clearances are set to 5 mm."""
+
+
+@dataclass(frozen=True)
+class TransferConfig:
+    """The push transfer's margins and rules (m, rad), beside the robot's sizes (``GripperGeometry``).
+
+    Attributes:
+        forward_margin: free approach between the fingertips and an obstacle's face at the start of
+            a forward push (the arm comes down there from a transit waypoint, up to 20 degrees off level).
+        sideways_margin: the same between the open fingers' outer side and the face, sideways.
+        corridor_margin: a backward move (which the robot cannot push) becomes the sideways push
+            leaving the least of the obstacle in the corridor along the start-target line, the open
+            fingers' half-width plus this to either side.
+        min_push_travel: a push that would move its obstacle less than this is left out.
+        edge_margin, object_margin: a push stops this short of the table's edge and the other objects.
+        travel_step: pushes are measured in steps of this.
+        transit_margin: transit waypoints lift the tcp this far plus the wrist's radius over the tallest
+            object.
+        wrist_shadow: how far the wrist reaches behind the flange along the approach axis, over the
+            table at push height (with the tcp's offset the length of the ``arm_shadow``).
+        shadow_margin: the arm's shadow is the wrist's radius plus this to either side.
+        path_clearance: a way whose tcp path passes this close to an object goes over it.
+        approach_gap: the gripper slides onto the target from this far behind its back face ...
+        approach_angle: ... where the way there would come in more than this off the approach axis.
+        gripper_behind: the gripper's footprint at that waypoint reaches this far behind the tcp.
+    """
+
+    forward_margin: float = 0.03
+    sideways_margin: float = 0.02
+    corridor_margin: float = 0.025
+    min_push_travel: float = 0.01
+    edge_margin: float = 0.03
+    object_margin: float = 0.01
+    travel_step: float = 0.005
+    transit_margin: float = 0.025
+    wrist_shadow: float = 0.21
+    shadow_margin: float = 0.015
+    path_clearance: float = 0.02
+    approach_gap: float = 0.05
+    approach_angle: float = math.radians(15.0)
+    gripper_behind: float = 0.05
+
+
+@dataclass(frozen=True)
+class GripperGeometry:
+    """The robot's sizes the transfer uses, m (``gripper_geometry`` reads them from the model).
+
+    Attributes:
+        tcp_offset: the tcp's distance from the flange along the approach axis.
+        fingertip_reach: how far the fingertips reach ahead of the tcp.
+        finger_half_width: the open fingers' outer sides from the tcp, sideways.
+        wrist_radius: the radius of the wrist's links.
+    """
+
+    tcp_offset: float
+    fingertip_reach: float
+    finger_half_width: float
+    wrist_radius: float
+
+
+@dataclass(frozen=True)
+class PushRules:
+    """The clearances of the push transfer (m, rad): ``TransferConfig``'s margins on the robot's sizes.
+
+    Attributes:
+        forward_clearance, sideways_clearance: the tcp's distance from an obstacle's face at the
+            start of a push along x, along y.
+        corridor_half_width: the corridor along the start-target line a backward move should clear.
+        transit_clearance: the tcp's height over the tallest object on transit waypoints.
+        arm_shadow_length, arm_shadow_half_width: the table area under the gripper and wrist behind
+            the tcp at push height; the arm only comes down where nothing lies there.
+        gripper_ahead, gripper_half_width, gripper_behind: the gripper's footprint around the tcp.
+        way_clearance: a push must not leave its obstacle this close to the way on to the target.
+        The rest: as in ``TransferConfig``.
+    """
+
+    forward_clearance: float
+    sideways_clearance: float
+    corridor_half_width: float
+    transit_clearance: float
+    arm_shadow_length: float
+    arm_shadow_half_width: float
+    gripper_ahead: float
+    gripper_half_width: float
+    gripper_behind: float
+    way_clearance: float
+    min_push_travel: float
+    edge_margin: float
+    object_margin: float
+    travel_step: float
+    path_clearance: float
+    approach_gap: float
+    approach_angle: float
+
+
+def _length(value: float) -> float:
+    return round(value, 6)  # sums of sizes and margins as the decimal numbers they are
+
+
+def push_rules(config: TransferConfig, geometry: GripperGeometry) -> PushRules:
+    """The clearances of ``config`` for a robot of ``geometry``."""
+    g = geometry
+    return PushRules(
+        forward_clearance=_length(g.fingertip_reach + config.forward_margin),
+        sideways_clearance=_length(g.finger_half_width + config.sideways_margin),
+        corridor_half_width=_length(g.finger_half_width + config.corridor_margin),
+        transit_clearance=_length(g.wrist_radius + config.transit_margin),
+        arm_shadow_length=_length(g.tcp_offset + config.wrist_shadow),
+        arm_shadow_half_width=_length(g.wrist_radius + config.shadow_margin),
+        gripper_ahead=g.fingertip_reach,
+        gripper_half_width=g.finger_half_width,
+        gripper_behind=config.gripper_behind,
+        way_clearance=g.finger_half_width,
+        min_push_travel=config.min_push_travel,
+        edge_margin=config.edge_margin,
+        object_margin=config.object_margin,
+        travel_step=config.travel_step,
+        path_clearance=config.path_clearance,
+        approach_gap=config.approach_gap,
+        approach_angle=config.approach_angle,
+    )
+
+
+def _rounded_up(value: float) -> float:
+    return _length(math.ceil(value / SIZE_RESOLUTION - 1e-6) * SIZE_RESOLUTION)
+
+
+def _extent(plant, scene_graph, context, bodies, frame) -> np.ndarray:
+    """(2, 3) lower and upper corners, in ``frame``, of the box holding the bodies' collision geometry."""
+    inspector = scene_graph.model_inspector()
+    X_FW = frame.CalcPoseInWorld(context).inverse()
+    corners = []
+    signs = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)], dtype=float)
+    for body in bodies:
+        X_FB = X_FW @ plant.EvalBodyPoseInWorld(context, body)
+        for geometry in plant.GetCollisionGeometriesForBody(body):
+            box = inspector.GetObbInGeometryFrame(geometry)
+            X_FO = X_FB @ inspector.GetPoseInFrame(geometry) @ box.pose()
+            corners += [X_FO @ (s * box.half_width()) for s in signs]
+    corners = np.array(corners)
+    return np.array([corners.min(axis=0), corners.max(axis=0)])
+
+
+@functools.cache
+def gripper_geometry() -> GripperGeometry:
+    """The robot's sizes, read from its model's collision geometry with the fingers open (once)."""
+    from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+    from pydrake.systems.framework import DiagramBuilder
+
+    from hlp_drake.systems.world.robot import (
+        FLANGE_FRAME,
+        GRIPPER_JOINTS,
+        GRIPPER_MIMIC_JOINTS,
+        GRIPPER_OPEN,
+        TCP_FRAME,
+        add_robot,
+    )
+
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    robot = add_robot(plant)
+    plant.Finalize()
+    diagram = builder.Build()
+    context = plant.GetMyMutableContextFromRoot(diagram.CreateDefaultContext())
+    for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS:
+        plant.GetJointByName(name, robot).set_translation(context, GRIPPER_OPEN)
+    tcp = plant.GetFrameByName(TCP_FRAME, robot)
+    fingers = [plant.GetBodyByName(name, robot) for name in ("left_finger_link", "right_finger_link")]
+    finger_box = _extent(plant, scene_graph, context, fingers, tcp)
+    offset = plant.GetFrameByName(FLANGE_FRAME, robot).CalcPose(context, tcp).translation()
+    wrist = plant.GetBodyByName("wrist_3_link", robot)
+    wrist_box = _extent(plant, scene_graph, context, [wrist], plant.GetFrameByName(FLANGE_FRAME, robot))
+    return GripperGeometry(
+        tcp_offset=_rounded_up(float(np.linalg.norm(offset))),
+        fingertip_reach=_rounded_up(float(finger_box[1, 2])),
+        finger_half_width=_rounded_up(float(np.max(np.abs(finger_box[:, 1])))),
+        wrist_radius=_rounded_up(float(np.max(wrist_box[1, :2]))),
+    )

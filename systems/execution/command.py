@@ -1,0 +1,109 @@
+"""How an execution commands the robot: open loop (a ``TrajectorySource``) or closed loop (a
+``RecedingHorizonController``), behind one interface the execution's reach and grasp use."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from hlp_drake.systems.optimiser.control_sequence import ControlSequence
+
+if TYPE_CHECKING:
+    from pydrake.systems.framework import Context
+    from pydrake.systems.primitives import TrajectorySource
+
+    from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
+
+from pydrake.math import RotationMatrix
+from pydrake.multibody.inverse_kinematics import InverseKinematics
+from pydrake.solvers import Solve
+
+from hlp_drake.systems.optimiser.control_sequence import BASE_COLUMNS
+from hlp_drake.systems.world.config import GraspConfig
+from hlp_drake.systems.world.robot import GRIPPER_CLOSED, GRIPPER_JOINTS, GRIPPER_MIMIC_JOINTS, TCP_FRAME
+from hlp_drake.systems.world.start_pose import ik_solver_options, kinematic_robot, robot_position_names
+
+
+class OpenLoopCommand:
+    """``sequence`` played from time 0 by ``source``."""
+
+    def __init__(self, source: TrajectorySource, sequence: ControlSequence) -> None:
+        self._source, self._sequence = source, sequence
+
+    def end(self, root_context: Context) -> float:
+        """When the commanded reach ends, s of simulated time."""
+        return self._sequence.duration
+
+    def final(self, root_context: Context) -> np.ndarray:
+        """The reach's last knot (11 positions)."""
+        return self._sequence.knots[-1]
+
+    def then(self, root_context: Context, t0: float, times: np.ndarray, knots: np.ndarray) -> None:
+        """After holding the final knot, go through ``knots`` at ``t0 + times`` (e.g. the grasp)."""
+        offset = t0 - self._sequence.duration
+        self._source.UpdateTrajectory(
+            self._sequence.followed_by(
+                np.concatenate([[offset], offset + times]), np.vstack([self.final(root_context), knots])
+            )
+        )
+
+
+class ClosedLoopCommand:
+    """The sequence ``controller`` commands (re-optimised as the execution goes)."""
+
+    def __init__(self, controller: RecedingHorizonController) -> None:
+        self._controller = controller
+
+    def end(self, root_context: Context) -> float:
+        record = self._controller.record(root_context)
+        return record.t0 + record.sequence.duration
+
+    def final(self, root_context: Context) -> np.ndarray:
+        return self._controller.record(root_context).sequence.knots[-1]
+
+    def then(self, root_context: Context, t0: float, times: np.ndarray, knots: np.ndarray) -> None:
+        sequence = ControlSequence(
+            np.concatenate([[0.0], times]), np.vstack([self.final(root_context), knots])
+        )
+        self._controller.command(root_context, sequence, t0)
+
+
+__all__ = ["ClosedLoopCommand", "OpenLoopCommand"]
+
+
+# The grasp after a reach: close the fingers round the target, lift it, and check that it held.
+_NAMES = robot_position_names()
+FINGER_COLUMNS = [_NAMES.index(name) for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS]
+
+
+def lifted_configuration(q: np.ndarray, height: float, *, max_iterations: int = 200) -> np.ndarray | None:
+    """Robot positions (11) with the tcp ``height`` higher than at ``q``, same orientation, the base
+    and the fingers unchanged; None if the arm cannot."""
+    plant, robot = kinematic_robot()
+    context = plant.CreateDefaultContext()
+    plant.SetPositions(context, robot, q)
+    tcp = plant.GetFrameByName(TCP_FRAME, robot)
+    pose = tcp.CalcPoseInWorld(context)
+    ik = InverseKinematics(plant, context, with_joint_limits=True)
+    fixed = [*BASE_COLUMNS, *FINGER_COLUMNS]
+    prog = ik.get_mutable_prog()
+    prog.AddBoundingBoxConstraint(q[fixed], q[fixed], ik.q()[fixed])
+    target = pose.translation() + np.array([0.0, 0.0, height])
+    ik.AddPositionConstraint(tcp, np.zeros(3), plant.world_frame(), target - 1e-3, target + 1e-3)
+    ik.AddOrientationConstraint(plant.world_frame(), pose.rotation(), tcp, RotationMatrix(), 0.05)
+    prog.AddQuadraticErrorCost(np.eye(len(q)), q, ik.q())
+    result = Solve(prog, q, ik_solver_options(max_iterations))
+    return result.GetSolution(ik.q()) if result.is_success() else None
+
+
+def grasp_knots(q_end: np.ndarray, grasp: GraspConfig) -> tuple[np.ndarray, np.ndarray] | None:
+    """Times (after the reach's end) and robot positions of the grasp: close the fingers at the end
+    pose, lift the tcp by ``grasp.lift_height``, hold. None if the lift has no IK solution."""
+    closed = np.array(q_end, dtype=float)
+    closed[FINGER_COLUMNS] = GRIPPER_CLOSED
+    lifted = lifted_configuration(closed, grasp.lift_height) if grasp.lift_height > 0 else closed
+    if lifted is None:
+        return None
+    times = np.cumsum([grasp.close_s, grasp.lift_s, max(grasp.hold_s, 1e-3)])
+    return times, np.vstack([closed, lifted, lifted])

@@ -1,0 +1,1 @@
+"""The stochastic trajectory optimiser: control sequences, rollout worlds, their cost and pool."""

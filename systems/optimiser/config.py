@@ -1,0 +1,212 @@
+"""``StoConfig``: every setting of the stochastic trajectory optimiser (a ``Scenario``'s ``optimiser``).
+
+In a scenario file it sits under ``optimiser:``::
+
+    optimiser:
+      samples: 8
+      update: mppi
+      noise: {vx: 0.04, vy: 0.04, yaw_rate: 0.02}
+      cost: {goal_weight: 2000.0}
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Literal
+
+UPDATES = ("greedy", "mppi")
+PERCEIVED_CHECKS = 2
+"""``StoConfig.displaced_checks`` when it is None and the scene is perceived (``perception.source:
+camera``): the 100-scene Table III at 9 objects, docs/perception.md."""
+
+
+@dataclass(frozen=True)
+class BaseNoise:
+    """Standard deviations of the Gaussian noise added to the base's planar velocity per control step.
+
+    The STO family perturbs the planar (x, y, yaw) velocity of the holonomic base; the arm keeps the
+    joint motion of the sequence being improved, so the whole gripper shifts in the table plane.
+    """
+
+    vx: float = 0.04  # m/s
+    vy: float = 0.04  # m/s
+    yaw_rate: float = 0.02  # rad/s
+    end_fraction: float = 0.25
+    """Share of the noise's accumulated drift kept at the end of the sequence: the rest is taken out
+    evenly over the steps, so a detour returns towards the end point the sequence aims at."""
+
+
+@dataclass(frozen=True)
+class StoCost:
+    """Weights of the rollout cost (charged from the states at the ends of the control steps).
+
+    Attributes:
+        pregrasp_margin: the target is inside the gripper's pre-grasp region when the tcp is within
+            its radius plus this (horizontally) and within this of the keypoint height, m.
+        goal_weight: final cost per metre of tcp-to-pre-grasp-region distance outside the region.
+        off_table: per object off the table (centre outside the top or below it), at every step.
+        table_contact: per control step in which the robot touches the table (its edge or top).
+        force_limit, force_weight: per newton of a contact force on an object above the limit.
+        disturbance_weight: final, per square metre of the obstacles' summed squared displacement.
+        target_disturbance_weight: final, per square metre of the target's squared displacement.
+        near_obstacle: final, when the tcp ends within ``near_distance`` of an obstacle's centre
+            line plus its half-size (the fingers would close on it).
+        effort_weight: per (rad/s)^2 or (m/s)^2, times seconds, of the commanded joint velocities.
+    """
+
+    pregrasp_margin: float = 0.03
+    goal_weight: float = 2000.0
+    off_table: float = 300.0
+    table_contact: float = 300.0
+    force_limit: float = 60.0
+    force_weight: float = 50.0
+    disturbance_weight: float = 100.0
+    target_disturbance_weight: float = 1000.0
+    near_obstacle: float = 500.0
+    near_distance: float = 0.01
+    effort_weight: float = 0.05
+
+
+@dataclass(frozen=True)
+class RolloutTrims:
+    """How the rollout model's contact geometry and plant differ from the world's (the execution
+    model), besides its time step and the sleeping objects; chosen with ``benchmarks/rollout_models.py``.
+
+    Attributes:
+        top_spheres: keep the contact spheres on the objects' top corners and rims (the objects
+            stand upright: only the bottom ones carry them on the table).
+        rim_spheres: spheres on each rim of a cylinder (the world's ``contact.rim_spheres``: 8).
+        robot_self_contact: keep contact between the robot's own links (the world filters only
+            links one joint apart).
+        sampled_output_ports: the plant's ``use_sampled_output_ports`` (False: outputs from the
+            current state, no sampled copy kept per step).
+    """
+
+    top_spheres: bool = False
+    rim_spheres: int = 4
+    robot_self_contact: bool = False
+    sampled_output_ports: bool = False
+
+
+@dataclass(frozen=True)
+class StoConfig:
+    """The stochastic trajectory optimiser (``hlp_drake.systems.optimiser.optimiser``).
+
+    Attributes:
+        samples: noisy rollouts per iteration (K).
+        max_iterations: iteration budget (an iteration = K rollouts + an update).
+        max_rollouts: rollout budget of one optimisation, the initial and the alternatives'
+            rollouts included: no iteration starts that would pass it. With ``max_iterations`` it
+            decides when the optimiser gives up, so the same seed gives the same result on any
+            machine, busy or idle, on 1 or N workers.
+        time_budget_s: an optional wall-clock safety cap of one optimisation, s (0: none); no
+            iteration starts that is expected to end past it. A result then depends on the machine.
+        step_duration: duration of one control step, s (the sequence's knots are this far apart).
+        noise: base-velocity noise per step.
+        update: "greedy" (keep the best noisy rollout) or "mppi" (cost-weighted mean of the noise).
+        mppi_temperature: h in w_k = exp(-h (c_k - c_min) / (c_max - c_min)).
+        workers: rollout processes (1: roll out in this process).
+        seed: seed of the noise.
+        rollout_time_step: plant time step of the rollouts, s (coarser than the execution's; an
+            accepted rollout is verified on the execution model, see ``verify``).
+        rollout_trims: how else the rollout model is cheaper than the world.
+        reduced_model: let the objects sleep (their joints locked) while nothing comes near them,
+            and again once they have come to rest with nothing near (fewer degrees of freedom and
+            contacts; every cost term still covers every object); off: every object is awake in
+            every rollout (the full model).
+        weld_clearance: an object is woken ``weld_lookahead`` before the robot's collision geometry,
+            following the commanded motion, first comes within this of it, and goes back to sleep
+            only with neither the robot nor a moving object this close, m.
+        weld_lookahead: see ``weld_clearance``, s.
+        weld_margin: when at a sample the robot or an awake object that has moved comes within this
+            (plus the largest motion of a body since the previous sample) of a sleeping object, the
+            rollout goes back to the previous sample and on with it awake, m.
+        sleep_speed: an awake object slower than this at two samples in a row has come to rest, m/s.
+        settle_s: simulated time after the last control step before the final state is read, s.
+        sample_period: how often a rollout's state is read for the cost on the execution model
+            (verifying), s.
+        rollout_sample_period: the same on the rollout model (the cost terms are per second, the
+            sleep checks' margins grow with the motion between samples), s.
+        max_object_speed: an object faster than this (m/s) means the simulation blew up.
+        max_sink: an object's centre more than this below the table top while over it means it
+            tunnelled into the table, m.
+        cost: the cost weights.
+        verify: before declaring success, simulate a passing rollout's sequence again on the
+            execution model (the world at the plant's time step, every object free, settling as the
+            execution does); only if it passes there too does the optimisation succeed, else that
+            outcome (and cost) replaces the rollout's and the optimisation goes on.
+        max_verifications: verifications per optimisation at most (they do not count in
+            ``max_rollouts``: each costs several rollouts' time, reported apart). Once they are
+            spent the optimisation ends, whatever rollouts are left (8: with 4, searches whose
+            fifth candidate held ended at half their rollouts, see docs/perception.md).
+        alternatives: when the initial sequence's rollout fails, roll out the planner's next this
+            many distinct candidate plans once (the HLP's, by expected arm collision; the straight
+            line has none) and go on from the best of them all (0: never).
+        displaced_checks: a sequence that passes its verification counts only if it also passes
+            on the execution model in this many worlds with every object displaced (seeded
+            Gaussian offsets of ``displaced_sigma`` per axis and ``displaced_yaw_sigma``): a push
+            whose outcome hinges on where an object stands to a fraction of a millimetre, as a
+            perceived scene cannot promise, is rejected (0: off; None, the default:
+            ``PERCEIVED_CHECKS`` on a perceived scene, ``perception.source: camera``, else 0; the
+            initial optimisation only, not the closed loop's re-optimisations).
+        displaced_sigma: see ``displaced_checks``, m.
+        displaced_yaw_sigma: see ``displaced_checks``, rad.
+    """
+
+    samples: int = 8
+    max_iterations: int = 20
+    max_rollouts: int = 100
+    time_budget_s: float = 0.0
+    step_duration: float = 0.5
+    noise: BaseNoise = field(default_factory=BaseNoise)
+    update: Literal["greedy", "mppi"] = "greedy"
+    mppi_temperature: float = 10.0
+    workers: int = 2
+    seed: int = 0
+    rollout_time_step: float = 0.02
+    rollout_trims: RolloutTrims = field(default_factory=RolloutTrims)
+    reduced_model: bool = True
+    weld_clearance: float = 0.15
+    weld_lookahead: float = 0.5
+    weld_margin: float = 0.01
+    sleep_speed: float = 0.005
+    settle_s: float = 0.5
+    sample_period: float = 0.1
+    rollout_sample_period: float = 0.2
+    max_object_speed: float = 5.0
+    max_sink: float = 0.03
+    cost: StoCost = field(default_factory=StoCost)
+    verify: bool = True
+    max_verifications: int = 8
+    alternatives: int = 3
+    displaced_checks: int | None = None
+    displaced_sigma: float = 0.001
+    displaced_yaw_sigma: float = math.radians(0.5)
+
+
+@dataclass(frozen=True)
+class ClosedLoopConfig:
+    """The receding-horizon controller of closed-loop execution (``receding_horizon``).
+
+    Attributes:
+        enabled: execute closed loop (``--execution closed``); False plays the optimised sequence.
+        replan_period: simulated time between two re-optimisations, s.
+        iterations, rollouts: the budget of each re-optimisation (its iterations and rollouts).
+        replan_distance: an object this far from where the current plan's rollout put it has
+            "moved far": the controller asks for a new initial sequence (the planner's, on the
+            observed scene) and optimises from it, the remainder of the current one its alternative, m.
+        track_distance: while every observed object is within this of where the initial sequence's
+            verification on the execution model had it, that verified sequence is on track and is
+            kept without re-optimising (0: always re-optimise), m.
+        max_rollouts: the re-optimisations' rollouts in all, so an execution the controller cannot
+            rescue ends: once spent, the commanded sequence plays to its end without re-optimising.
+    """
+
+    enabled: bool = False
+    replan_period: float = 0.5
+    iterations: int = 1
+    rollouts: int = 9
+    replan_distance: float = 0.05
+    track_distance: float = 0.005
+    max_rollouts: int = 300

@@ -1,0 +1,365 @@
+"""The physics-based stochastic trajectory optimiser (STO).
+
+``optimise(scenario, initial, pool)`` improves a ``ControlSequence`` as the STO family does
+(the project's notes, section A): every iteration rolls out ``samples`` noisy copies of the current
+sequence in the contact simulation (``RolloutWorld``), the noise being Gaussian per-step velocities
+of the holonomic base; the update keeps the cheapest copy ("greedy") or the cost-weighted mean of
+the noise, w_k = exp(-h (c_k - c_min) / (c_max - c_min)) ("mppi", rolled out once more); a candidate
+replaces the current sequence only if its cost is lower (monotone acceptance). A rollout that passes
+the success test (target in the pre-grasp region, nothing fell) is simulated again on the execution
+model (``verify``); the optimisation succeeds when it passes there too, else that outcome replaces
+the rollout's and it goes on; with ``displaced_checks`` it must also pass in copies of the scene
+with every object displaced by about ``displaced_sigma`` (a push that only works to a fraction of
+a millimetre is rejected). The budget counts rollouts and iterations (``max_rollouts``,
+``max_iterations``), so a result does not depend on the machine's speed or load; seconds
+(``time_budget_s``) are only an optional safety cap. Beyond the paper: when the initial sequence's
+rollout fails and the planner has alternatives (the HLP's next candidate plans), they are rolled
+out once each before the first iteration; a successful one ends the optimisation (the best-ranked
+first), else the cheapest of them all becomes the current sequence.
+
+Its Drake block is ``StochasticTrajectoryOptimiser`` (``hlp_drake.systems.optimiser.system``).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from hlp_drake.systems.optimiser.config import PERCEIVED_CHECKS, BaseNoise, StoConfig
+from hlp_drake.systems.optimiser.control_sequence import ControlSequence
+from hlp_drake.systems.optimiser.cost import RolloutOutcome
+from hlp_drake.systems.optimiser.pool import RolloutPool
+from hlp_drake.systems.world.uncertainty import displaced_scenes
+
+if TYPE_CHECKING:
+    from hlp_drake.systems.optimiser.rollout_world import RolloutStart
+    from hlp_drake.systems.scenario import Scenario
+
+
+@dataclass
+class StoResult:
+    """The outcome of one optimisation.
+
+    Attributes:
+        sequence: the best sequence found (the initial one if nothing was better).
+        outcome: its rollout.
+        success: whether its rollout passed the success test.
+        failure_reason: why not (None on success), one line.
+        iterations: iterations run (0: the initial sequence already succeeded, or none was run).
+        rollouts: rollouts simulated, the initial one included.
+        optimise_s: wall-clock time of the optimisation, s.
+        costs: the current cost after the initial rollout, after the alternatives' rollouts (if
+            any) and after every iteration.
+        initial_cost: the initial sequence's cost.
+        start: which sequence the result grew from: 0 the initial one, i >= 1 the i-th alternative.
+        verifications: passing rollouts simulated again on the execution model (not in ``rollouts``).
+        rejected: of those, how many failed there (their rollout passed, the execution model's did not).
+        verify_s: wall-clock time of the verifications, s (part of ``optimise_s``; the displaced
+            worlds' included).
+        displaced_checks: simulations on the execution model in worlds with the objects displaced
+            (``StoConfig.displaced_checks`` per verification).
+    """
+
+    sequence: ControlSequence
+    outcome: RolloutOutcome | None
+    success: bool
+    failure_reason: str | None
+    iterations: int = 0
+    rollouts: int = 0
+    optimise_s: float = 0.0
+    costs: list[float] = field(default_factory=list)
+    initial_cost: float | None = None
+    start: int = 0
+    verifications: int = 0
+    rejected: int = 0
+    verify_s: float = 0.0
+    displaced_checks: int = 0
+
+    def to_dict(self) -> dict:
+        return {
+            "success": self.success,
+            "failure_reason": self.failure_reason,
+            "iterations": self.iterations,
+            "rollouts": self.rollouts,
+            "optimise_s": self.optimise_s,
+            "initial_cost": self.initial_cost,
+            "start": self.start,
+            "verifications": self.verifications,
+            "rejected": self.rejected,
+            "verify_s": self.verify_s,
+            "displaced_checks": self.displaced_checks,
+            "final_cost": self.outcome.cost if self.outcome is not None else None,
+            "cost_terms": dict(self.outcome.terms) if self.outcome is not None else {},
+            "costs": list(self.costs),
+        }
+
+
+def sample_base_noise(
+    rng: np.random.Generator, sequence: ControlSequence, noise: BaseNoise, samples: int
+) -> np.ndarray:
+    """(samples, n, 3) Gaussian base velocities (vx, vy, yaw rate) per step of ``sequence``.
+
+    All but ``noise.end_fraction`` of each sample's accumulated drift is taken out evenly over the
+    duration, so a noisy copy detours and comes back towards the sequence's end point.
+    """
+    sigma = np.array([noise.vx, noise.vy, noise.yaw_rate])
+    velocity = rng.normal(size=(samples, sequence.num_steps, 3)) * sigma
+    drift = np.einsum("knj,n->kj", velocity, sequence.steps)  # (samples, 3) displacement at the end
+    return velocity - (1.0 - noise.end_fraction) * drift[:, None, :] / sequence.duration
+
+
+EMPTY_RESULT = StoResult(
+    ControlSequence(np.array([0.0, 1.0]), np.zeros((2, 11))), None, False, "not optimised"
+)
+"""A placeholder result (an abstract port's model value)."""
+
+
+def mppi_weights(costs: np.ndarray, temperature: float) -> np.ndarray:
+    """Normalised weights exp(-h (c - c_min) / (c_max - c_min)) of the rollouts' costs."""
+    costs = np.asarray(costs, dtype=float)
+    spread = float(np.max(costs) - np.min(costs))
+    if not np.isfinite(spread) or spread <= 0:
+        return np.full(len(costs), 1.0 / len(costs))
+    weights = np.exp(-temperature * (costs - np.min(costs)) / spread)
+    return weights / np.sum(weights)
+
+
+def displaced_checks(scenario: Scenario) -> int:
+    """``optimiser.displaced_checks``, or when it is None ``PERCEIVED_CHECKS`` on a perceived scene
+    (``perception.source: camera``) and 0 on the true one."""
+    checks = scenario.optimiser.displaced_checks
+    if checks is not None:
+        return checks
+    return PERCEIVED_CHECKS if scenario.perception.source == "camera" else 0
+
+
+@dataclass(frozen=True)
+class Budget:
+    """How much one optimisation may do (``Budget.of(scenario)`` by default; the
+    receding-horizon controller gives its replans smaller ones).
+
+    Attributes:
+        samples: noisy rollouts per iteration.
+        max_iterations, max_rollouts: the iteration and rollout budgets (no iteration starts that
+            would pass ``max_rollouts``).
+        time_budget_s: the optional wall-clock cap, s (0: none).
+        alternatives: the planner's alternatives tried when the initial rollout fails (0: none).
+        verify: verify a passing rollout on the execution model before declaring success.
+        max_verifications: verifications at most.
+        seed: seed of the noise.
+        displaced_checks: worlds with displaced objects a verified sequence must pass in too
+            (``displaced_checks(scenario)``; 0: none).
+    """
+
+    samples: int
+    max_iterations: int
+    max_rollouts: int
+    time_budget_s: float = 0.0
+    alternatives: int = 0
+    verify: bool = False
+    max_verifications: int = 0
+    seed: int = 0
+    displaced_checks: int = 0
+
+    @classmethod
+    def of(cls, scenario: Scenario) -> Budget:
+        """The budget ``scenario.optimiser`` sets."""
+        sto = scenario.optimiser
+        return cls(
+            sto.samples,
+            sto.max_iterations,
+            sto.max_rollouts,
+            sto.time_budget_s,
+            sto.alternatives,
+            sto.verify,
+            sto.max_verifications,
+            sto.seed,
+            displaced_checks(scenario),
+        )
+
+
+class _Run:
+    """One optimisation's rollouts and verifications, counted into its ``StoResult``."""
+
+    def __init__(
+        self, scenario: Scenario, pool: RolloutPool, budget: Budget, start: RolloutStart | None
+    ) -> None:
+        self.scenario, self.pool, self.budget, self.start = scenario, pool, budget, start
+        self.rollouts = self.verifications = self.rejected = 0
+        self.verify_s = 0.0
+        self._displaced: list[Scenario] | None = None
+
+    def displaced_scenarios(self) -> list[Scenario]:
+        """The scenario with its objects displaced, ``budget.displaced_checks`` times (none from a
+        measured start: the closed loop's re-optimisations see where the objects are)."""
+        if self._displaced is None:
+            sto = self.scenario.optimiser
+            count = self.budget.displaced_checks if self.start is None else 0
+            scenes = displaced_scenes(
+                self.scenario.scene, count, sto.displaced_sigma, sto.displaced_yaw_sigma
+            )
+            self._displaced = [replace(self.scenario, scene=scene) for scene in scenes]
+        return self._displaced
+
+    def roll(self, sequences: list[ControlSequence]) -> list[RolloutOutcome]:
+        """The rollouts of ``sequences`` (on the rollout model, from the run's start)."""
+        outcomes = self.pool.rollouts(self.scenario, sequences, start=self.start)
+        self.rollouts += len(sequences)
+        return outcomes
+
+    def settle(self, sequences: list[ControlSequence], outcomes: list[RolloutOutcome], order) -> None:
+        """Verify the passing outcomes in ``order`` (indices) on the execution model until one
+        passes there too (or the verifications run out); each one that fails is replaced by its
+        verification's outcome, and once they run out no passing rollout is trusted."""
+        if not self.budget.verify:
+            return
+        for i in order:
+            if not outcomes[i].success:
+                continue
+            if self.verifications >= self.budget.max_verifications:
+                outcomes[i] = replace(
+                    outcomes[i],
+                    success=False,
+                    failure_reason="passed its rollout, but the verifications ran out",
+                )
+                continue
+            started = time.perf_counter()
+            displaced = self.displaced_scenarios()
+            verified, *moved = self.pool.verifications(
+                [self.scenario, *displaced], sequences[i], start=self.start
+            )
+            self.verify_s += time.perf_counter() - started
+            self.verifications += 1
+            failed = next((k for k, o in enumerate(moved) if not o.success), None)
+            if verified.success and failed is None:
+                outcomes[i] = replace(outcomes[i], verification=verified)
+                return
+            self.rejected += 1
+            outcomes[i] = (
+                replace(
+                    verified,
+                    failure_reason=f"passed its rollout, failed its verification: {verified.failure_reason}",
+                )
+                if not verified.success
+                else replace(
+                    moved[failed],
+                    failure_reason=(
+                        f"passed its verification, failed with the objects displaced ({failed + 1} of "
+                        f"{len(moved)}): {moved[failed].failure_reason}"
+                    ),
+                )
+            )
+
+
+def optimise(
+    scenario: Scenario,
+    initial: ControlSequence,
+    pool: RolloutPool,
+    *,
+    alternatives: Callable[[], Sequence[ControlSequence]] | None = None,
+    progress: Callable[[int, float], None] | None = None,
+    budget: Budget | None = None,
+    start: RolloutStart | None = None,
+) -> StoResult:
+    """Improve ``initial`` on ``scenario``'s scene (see the module's docstring); never raises for a bad scene.
+
+    Args:
+        pool: the rollout workers (the caller's, who closes them).
+        alternatives: returns the planner's other initial sequences, best first; called only if
+            the initial rollout fails and the budget has alternatives (the first that many are used).
+        progress: called as ``progress(iteration, cost)`` after every iteration.
+        budget: what the optimisation may spend (default: ``Budget.of(scenario)``).
+        start: roll out from this state rather than the scene's (the receding-horizon controller's
+            measured state; the robot's start is then not checked for collisions: it may be pushing).
+    """
+    sto: StoConfig = scenario.optimiser
+    budget = budget or Budget.of(scenario)
+    started = time.perf_counter()
+    collisions = () if start is not None else pool.world(scenario).start_collisions
+    if collisions:
+        return StoResult(
+            initial,
+            None,
+            False,
+            f"the robot starts in collision with {', '.join(collisions)}",
+            optimise_s=time.perf_counter() - started,
+        )
+    run = _Run(scenario, pool, budget, start)
+    rng = np.random.default_rng(budget.seed)
+    best = initial
+    outcomes = run.roll([best])
+    run.settle([best], outcomes, [0])
+    (outcome,) = outcomes
+    result = StoResult(
+        best,
+        outcome,
+        outcome.success,
+        outcome.failure_reason,
+        costs=[outcome.cost],
+        initial_cost=outcome.cost,
+    )
+    if not result.success and alternatives is not None and budget.alternatives > 0:
+        others = list(alternatives())[: budget.alternatives]
+        if others:
+            outcomes = run.roll(others)
+            run.settle(others, outcomes, range(len(others)))
+            passed = [i for i, o in enumerate(outcomes) if o.success]
+            i = passed[0] if passed else int(np.argmin([o.cost for o in outcomes]))
+            if passed or outcomes[i].cost < outcome.cost:
+                best, outcome, result.start = others[i], outcomes[i], i + 1
+                result.sequence, result.outcome = best, outcome
+                result.success, result.failure_reason = outcome.success, outcome.failure_reason
+            result.costs.append(outcome.cost)
+    last_iteration_s = 0.0
+    per_iteration = budget.samples + (1 if sto.update == "mppi" else 0)
+    while not result.success and result.iterations < budget.max_iterations:
+        if run.rollouts + per_iteration > budget.max_rollouts:
+            result.failure_reason = (
+                f"{outcome.failure_reason} (rollout budget of {budget.max_rollouts} spent)"
+            )
+            break
+        elapsed = time.perf_counter() - started
+        if budget.time_budget_s > 0 and elapsed + last_iteration_s > budget.time_budget_s:
+            result.failure_reason = (
+                f"{outcome.failure_reason} (time budget of {budget.time_budget_s:g} s spent)"
+            )
+            break
+        iteration_started = time.perf_counter()
+        noise = sample_base_noise(rng, best, sto.noise, budget.samples)
+        candidates = [best.with_base_velocity(v) for v in noise]
+        outcomes = run.roll(candidates)
+        if sto.update == "mppi":
+            weights = mppi_weights(np.array([o.cost for o in outcomes]), sto.mppi_temperature)
+            mean = best.with_base_velocity(np.einsum("k,knj->nj", weights, noise))
+            candidates.append(mean)
+            outcomes.extend(run.roll([mean]))
+        run.settle(candidates, outcomes, np.argsort([o.cost for o in outcomes], kind="stable"))
+        costs = [o.cost for o in outcomes]
+        passing = [j for j, o in enumerate(outcomes) if o.success]  # verified, or none
+        i = min(passing, key=costs.__getitem__) if passing else int(np.argmin(costs))
+        if passing or outcomes[i].cost < outcome.cost:  # monotone acceptance, a pass first
+            best, outcome = candidates[i], outcomes[i]
+        result.iterations += 1
+        result.sequence, result.outcome = best, outcome
+        result.success, result.failure_reason = outcome.success, outcome.failure_reason
+        result.costs.append(outcome.cost)
+        last_iteration_s = time.perf_counter() - iteration_started
+        if progress is not None:
+            progress(result.iterations, outcome.cost)
+        if budget.verify and run.verifications >= budget.max_verifications and not result.success:
+            result.failure_reason = f"{result.failure_reason} (verifications spent)"
+            break
+    if not result.success and result.iterations >= budget.max_iterations and result.failure_reason:
+        result.failure_reason = f"{result.failure_reason} (after {result.iterations} iterations)"
+    result.rollouts, result.verifications, result.rejected = run.rollouts, run.verifications, run.rejected
+    result.displaced_checks = run.verifications * len(run.displaced_scenarios())
+    result.verify_s = run.verify_s
+    result.optimise_s = time.perf_counter() - started
+    return result
+
+
+__all__ = ["EMPTY_RESULT", "Budget", "StoResult", "mppi_weights", "optimise", "sample_base_noise"]

@@ -1,0 +1,1 @@
+"""Perception: simulated depth cameras to a scene of fitted objects, and its accuracy."""

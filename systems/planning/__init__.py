@@ -1,0 +1,1 @@
+"""Planning blocks: the planners, the push transfer, keypoint IK and the planning diagram."""

@@ -1,0 +1,121 @@
+"""``Keyframes``: the IK result of a plan (per keypoint the robot's positions, a flag, a message)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+from pydrake.geometry import SceneGraph
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
+from pydrake.systems.framework import DiagramBuilder
+
+from hlp_drake.planner.plan import PlanKeypoint
+from hlp_drake.systems.world.robot import add_robot
+from hlp_drake.systems.world.scene_models import SceneModels, add_scene
+
+if TYPE_CHECKING:
+    from hlp_drake.systems.scenario import Scenario
+
+
+@dataclass(frozen=True)
+class Keyframes:
+    """The IK result of a plan.
+
+    Attributes:
+        keypoints: the plan's keypoints.
+        positions: (n, 11) robot positions per keypoint (for a failed keypoint: the solver's last
+            iterate, not to be executed).
+        success: per keypoint, whether its IK succeeded.
+        messages: per keypoint, "" on success, else why it failed (naming the keypoint).
+        tcp_positions: (n, 3) tcp positions of ``positions`` (forward kinematics).
+        start: the robot's 11 start positions.
+        problems: plan-level problems (no plan, wrong scene); empty normally.
+        solve_time_s: wall-clock time of all the solves.
+    """
+
+    keypoints: tuple[PlanKeypoint, ...]
+    positions: np.ndarray
+    success: tuple[bool, ...]
+    messages: tuple[str, ...]
+    tcp_positions: np.ndarray
+    start: np.ndarray
+    problems: tuple[str, ...] = ()
+    solve_time_s: float = 0.0
+    details: dict = field(default_factory=dict, compare=False)
+
+    @property
+    def ok(self) -> bool:
+        """True when there are keyframes, all succeeded, and the plan had no problem."""
+        return not self.problems and len(self.success) > 0 and all(self.success)
+
+    @property
+    def failures(self) -> list[str]:
+        """Every problem and failure message."""
+        return [*self.problems, *(m for m, ok in zip(self.messages, self.success) if not ok)]
+
+    @classmethod
+    def empty(cls, start: np.ndarray, problem: str | None = None) -> Keyframes:
+        n = len(start)
+        return cls(
+            keypoints=(),
+            positions=np.zeros((0, n)),
+            success=(),
+            messages=(),
+            tcp_positions=np.zeros((0, 3)),
+            start=np.array(start, dtype=float),
+            problems=() if problem is None else (problem,),
+        )
+
+
+def describe_keypoint(index: int, keypoint: PlanKeypoint) -> str:
+    element = f" {keypoint.element}" if keypoint.element else ""
+    x, y = keypoint.position
+    return f"keypoint {index} ({keypoint.action}{element}) at ({x:.3f}, {y:.3f})"
+
+
+# ``PlanningModel``: the robot and the table (and the scene's objects, welded), for kinematics.
+class PlanningModel:
+    """Robot + table (+ the objects welded at their scene poses), for kinematics (IK, distance queries).
+
+    A continuous plant (no dynamics) with its SceneGraph in a Diagram; it holds no context (make one
+    with ``diagram.CreateDefaultContext()``).
+
+    Attributes:
+        diagram, plant, scene_graph: the model.
+        robot: the robot's model instance.
+        scene_models: the table's and objects' model instances.
+    """
+
+    def __init__(self, scenario: Scenario, *, with_objects: bool = True) -> None:
+        builder = DiagramBuilder()
+        plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+        self.robot = add_robot(plant)
+        self.scene_models: SceneModels = add_scene(
+            plant,
+            scenario.scene,
+            contact=scenario.contact,
+            bodies=scenario.bodies,
+            weld_objects=True,
+            with_objects=with_objects,
+        )
+        plant.Finalize()
+        self.diagram = builder.Build()
+        self.diagram.set_name("planning_model")
+        self.plant: MultibodyPlant = plant
+        self.scene_graph: SceneGraph = scene_graph
+
+    def robot_geometries(self) -> list:
+        return [
+            geometry
+            for body in self.plant.GetBodyIndices(self.robot)
+            for geometry in self.plant.GetCollisionGeometriesForBody(self.plant.get_body(body))
+        ]
+
+    def object_geometries(self) -> list:
+        return [
+            geometry
+            for instance in self.scene_models.objects.values()
+            for body in self.plant.GetBodyIndices(instance)
+            for geometry in self.plant.GetCollisionGeometriesForBody(self.plant.get_body(body))
+        ]

@@ -1,0 +1,159 @@
+"""The robot's start pose and the kinematics it is solved on (shared by the world, IK and the grasp).
+
+Frames and start pose: the world frame is the scene's (z up, x into the table from the middle of its
+front edge). The robot's base starts in front of the table facing +x; at the start the gripper
+points along +x (horizontal approach), fingers opening along y, its tcp above ``scene.start`` at
+``ik.height`` above the table top (``scene.start_yaw`` is not used: the gripper faces +x).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+from pydrake.math import RotationMatrix
+from pydrake.multibody.inverse_kinematics import InverseKinematics
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import ModelInstanceIndex
+from pydrake.solvers import SnoptSolver, Solve, SolverOptions
+
+from hlp_drake.errors import HlpError
+from hlp_drake.scene.model import Scene
+from hlp_drake.systems.world.config import IkConfig
+from hlp_drake.systems.world.robot import (
+    ARM_JOINTS,
+    BASE_FOOTPRINT,
+    BASE_JOINTS,
+    GRIPPER_JOINTS,
+    GRIPPER_MIMIC_JOINTS,
+    GRIPPER_OPEN,
+    HOME_ARM_POSITIONS,
+    TCP_FRAME,
+    add_robot,
+)
+
+
+def robot_position_names() -> tuple[str, ...]:
+    """The joints of the robot's 11 positions, in model-instance order: the 10 actuated, then the mimic."""
+    return BASE_JOINTS + ARM_JOINTS + GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS
+
+
+def robot_base_pose(scene: Scene, ik: IkConfig) -> tuple[float, float, float]:
+    """(x, y, yaw) of the base at the start: in front of the table, facing +x, behind ``scene.start``.
+
+    The base's centre stands ``ik.start_reach`` behind the start point on its line, but never closer
+    to the table than ``ik.start_base_clearance`` (its front edge then stays at x <= -clearance,
+    outside the table's footprint).
+    """
+    start_x, start_y = scene.start
+    x = min(start_x - ik.start_reach, -(BASE_FOOTPRINT[0] / 2.0 + ik.start_base_clearance))
+    return (float(x), float(start_y), 0.0)
+
+
+def tcp_rotation(approach_yaw: float = 0.0) -> RotationMatrix:
+    """The gripper's keypoint orientation: tcp +z horizontal at heading ``approach_yaw`` (0: +x),
+    tcp +y horizontal (fingers open sideways), tcp +x pointing down."""
+    c, s = math.cos(approach_yaw), math.sin(approach_yaw)
+    z = np.array([c, s, 0.0])
+    y = np.array([-s, c, 0.0])
+    return RotationMatrix(np.column_stack([np.cross(y, z), y, z]))
+
+
+def tcp_keypoint_height(scene: Scene, ik: IkConfig) -> float:
+    """World z of the tcp at the keypoints."""
+    return scene.table.height + ik.height
+
+
+@functools.lru_cache(maxsize=1)
+def kinematic_robot() -> tuple[MultibodyPlant, ModelInstanceIndex]:
+    """A robot-only continuous plant for kinematics (built once, shared; do not modify it)."""
+    plant = MultibodyPlant(time_step=0.0)
+    instance = add_robot(plant)
+    plant.Finalize()
+    return plant, instance
+
+
+def _to_plant_order(
+    plant: MultibodyPlant, instance: ModelInstanceIndex, values: dict[str, float]
+) -> np.ndarray:
+    """The robot's positions in ``plant``'s own order for ``instance``, from joint names."""
+    starts = np.arange(plant.num_positions())
+    instance_starts = plant.GetPositionsFromArray(instance, starts)
+    local = {int(index): i for i, index in enumerate(instance_starts)}
+    q = np.zeros(len(instance_starts))
+    for name, value in values.items():
+        q[local[plant.GetJointByName(name, instance).position_start()]] = value
+    return q
+
+
+def ik_solver_options(max_iterations: int) -> SolverOptions:
+    options = SolverOptions()
+    snopt = SnoptSolver().solver_id()
+    options.SetOption(snopt, "Major iterations limit", int(max_iterations))
+    options.SetOption(snopt, "Iterations limit", int(50 * max_iterations))
+    return options
+
+
+def start_configuration(
+    scene: Scene, ik: IkConfig, plant: MultibodyPlant, instance: ModelInstanceIndex
+) -> np.ndarray:
+    """The robot's 11 start positions, in ``plant``'s order for ``instance`` (as ``SetPositions`` takes them).
+
+    The base stands at ``robot_base_pose(scene, ik)``; the arm (solved by IK on a robot-only
+    kinematic model, seeded and regularised towards the ready pose ``HOME_ARM_POSITIONS``) puts the
+    tcp above ``scene.start`` at ``ik.height`` above the table top, pointing along +x with the
+    fingers opening along y; the gripper is open.
+
+    Raises:
+        HlpError: the start point is out of the arm's reach from that base pose.
+    """
+    base = robot_base_pose(scene, ik)
+    arm = _start_arm(
+        round(base[0] - scene.start[0], 9),
+        round(tcp_keypoint_height(scene, ik), 9),
+        ik.max_iterations,
+    )
+    if arm is None:
+        raise HlpError(
+            f"scene {scene.name or '<unnamed>'}: the arm cannot put the tcp above the start "
+            f"{tuple(scene.start)} at height {tcp_keypoint_height(scene, ik):.3f} m "
+            f"from the base pose {base}"
+        )
+    values = dict(zip(BASE_JOINTS + ARM_JOINTS, (*base, *arm)))
+    values.update({name: GRIPPER_OPEN for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS})
+    return _to_plant_order(plant, instance, values)
+
+
+@functools.lru_cache(maxsize=64)
+def _start_arm(base_offset_x: float, tcp_z: float, max_iterations: int) -> tuple[float, ...] | None:
+    """Arm angles putting the tcp ``-base_offset_x`` ahead of the base at height ``tcp_z`` (cached)."""
+    plant, instance = kinematic_robot()
+    context = plant.CreateDefaultContext()
+    ik = InverseKinematics(plant, context, with_joint_limits=True)
+    q = ik.q()
+    seed = _to_plant_order(
+        plant,
+        instance,
+        {
+            **dict(zip(BASE_JOINTS + ARM_JOINTS, (0.0, 0.0, 0.0, *HOME_ARM_POSITIONS))),
+            **{name: GRIPPER_OPEN for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS},
+        },
+    )
+    fixed = np.full(len(seed), True)
+    for name in ARM_JOINTS:
+        fixed[plant.GetJointByName(name, instance).position_start()] = False
+    prog = ik.get_mutable_prog()
+    prog.AddBoundingBoxConstraint(seed[fixed], seed[fixed], q[fixed])
+    tcp = plant.GetFrameByName(TCP_FRAME, instance)
+    target = np.array([-base_offset_x, 0.0, tcp_z])
+    ik.AddPositionConstraint(tcp, np.zeros(3), plant.world_frame(), target - 1e-4, target + 1e-4)
+    ik.AddOrientationConstraint(plant.world_frame(), tcp_rotation(0.0), tcp, RotationMatrix(), 1e-3)
+    prog.AddQuadraticErrorCost(np.eye(int(np.sum(~fixed))), seed[~fixed], q[~fixed])
+    result = Solve(prog, seed, ik_solver_options(max_iterations))
+    if not result.is_success():
+        return None
+    solution = result.GetSolution(q)
+    return tuple(
+        float(solution[plant.GetJointByName(name, instance).position_start()]) for name in ARM_JOINTS
+    )

@@ -2,6 +2,7 @@
 
 from hlp_drake.learners.arm import ArmRegressor
 from hlp_drake.learners.choice import RowChoiceClassifier
+from hlp_drake.learners.conformance import expected_failed_checks
 from hlp_drake.learners.direction import DirectionClassifier
 from hlp_drake.learners.models import DEFAULT_PRESET, PRESETS, DecisionModels, LearnerSettings
 from hlp_drake.learners.svm import RbfSvmClassifier
@@ -15,4 +16,5 @@ __all__ = [
     "LearnerSettings",
     "RbfSvmClassifier",
     "RowChoiceClassifier",
+    "expected_failed_checks",
 ]

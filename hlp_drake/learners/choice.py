@@ -8,6 +8,8 @@ the demonstrations.
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import numpy as np
 from scipy.special import expit
 from sklearn.base import BaseEstimator, ClassifierMixin
@@ -17,6 +19,7 @@ from sklearn.model_selection import GroupKFold, StratifiedKFold
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from hlp_drake.learners.conformance import SAMPLE_WEIGHT_EQUIVALENCE
 from hlp_drake.learners.inputs import binary_classes, prediction_input, sample_weights
 from hlp_drake.learners.kernel import distance_weights
 from hlp_drake.learners.novelty import fit_novelty, novelty_score
@@ -39,6 +42,14 @@ class RowChoiceClassifier(ClassifierMixin, BaseEstimator):
         novelty_neighbours, novelty_quantile, novelty_samples: see ``learners.novelty``.
         random_state: seed of the subsamples and folds.
     """
+
+    EXPECTED_FAILED_CHECKS: ClassVar[dict[str, str]] = {
+        SAMPLE_WEIGHT_EQUIVALENCE: (
+            "the calibration folds, the trees' subsample and minimum node sizes count rows, not "
+            "weights (as for scikit-learn's GradientBoostingClassifier); learner='svm': see "
+            "RbfSvmClassifier"
+        )
+    }
 
     def __init__(
         self,
@@ -116,7 +127,7 @@ class RowChoiceClassifier(ClassifierMixin, BaseEstimator):
         positive = (y == self.classes_[1]).astype(int)
         weight = sample_weights(sample_weight, len(y))
         oof = np.zeros(len(X))
-        folds = self._folds(positive, groups)
+        folds = self._folds(positive, groups, weight)
         for train, test in folds:
             learner = self._fit_learner(X[train], positive[train], None if weight is None else weight[train])
             oof[test] = learner.decision_function(X[test])
@@ -138,8 +149,10 @@ class RowChoiceClassifier(ClassifierMixin, BaseEstimator):
         self._novelty_weights = distance_weights(self.novelty_["points"])
         return self
 
-    def _folds(self, positive: np.ndarray, groups: np.ndarray | None) -> list[tuple[np.ndarray, np.ndarray]]:
-        """The calibration folds (none where a fold could not hold both classes)."""
+    def _folds(
+        self, positive: np.ndarray, groups: np.ndarray | None, weight: np.ndarray | None = None
+    ) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The calibration folds (only those whose training rows hold both classes with weight > 0)."""
         k = self.calibration_folds
         if groups is not None and len(np.unique(groups)) >= k:
             folds = list(GroupKFold(n_splits=k).split(positive, positive, groups))
@@ -151,7 +164,8 @@ class RowChoiceClassifier(ClassifierMixin, BaseEstimator):
             )
         else:
             return []
-        return [(tr, te) for tr, te in folds if len(np.unique(positive[tr])) == 2]
+        weighted = np.ones(len(positive), dtype=bool) if weight is None else weight > 0
+        return [(tr, te) for tr, te in folds if len(np.unique(positive[tr][weighted[tr]])) == 2]
 
     def decision_function(self, X: np.ndarray) -> np.ndarray:
         """The learner's raw score: > 0 leans to "taken" (``classes_[1]``)."""

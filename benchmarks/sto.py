@@ -35,7 +35,7 @@ from tqdm import tqdm
 
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import load_scene
-from hlp_drake.systems.execution.execution import plan_and_execute
+from hlp_drake.systems.execution.run import plan_and_execute
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.cost import RolloutOutcome
 from hlp_drake.systems.optimiser.optimiser import sample_base_noise

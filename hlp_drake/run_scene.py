@@ -201,7 +201,7 @@ def _meshcat():
 def _run(scenario, args, started: float):
     """Plan and execute ``scenario`` on a rollout pool of its own, the stages printed as they come."""
     from hlp_drake.run_progress import ProgressListener
-    from hlp_drake.systems.execution.execution import plan_and_execute
+    from hlp_drake.systems.execution.run import plan_and_execute
     from hlp_drake.systems.optimiser.pool import RolloutPool
 
     meshcat = _meshcat() if args.meshcat or args.html else None

@@ -6,9 +6,10 @@ the scene from their ``scene`` input port (``SceneFromPlant`` reads it from a pl
 (``RolloutPool``) belong to the caller, who closes them.
 """
 
-from hlp_drake.systems.execution.execution import ExecutionResult, RunListener, plan_and_execute
+from hlp_drake.systems.execution.diagram import ExecutionDiagram, make_execution_diagram
 from hlp_drake.systems.execution.meshcat_view import draw_perception, draw_plan, frame_table
 from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
+from hlp_drake.systems.execution.run import ExecutionResult, RunListener, plan_and_execute, run_execution
 from hlp_drake.systems.optimiser.config import StoConfig
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.cost import RolloutOutcome
@@ -81,6 +82,7 @@ __all__ = [
     "TCP_FRAME",
     "CameraSettings",
     "ControlSequence",
+    "ExecutionDiagram",
     "ExecutionResult",
     "GraspConfig",
     "GripperGeometry",
@@ -123,6 +125,7 @@ __all__ = [
     "gripper_geometry",
     "initial_sequence",
     "load_scenario",
+    "make_execution_diagram",
     "make_planning_diagram",
     "make_world_diagram",
     "models_directory",
@@ -138,6 +141,7 @@ __all__ = [
     "robot_joint_limits",
     "robot_plan",
     "robot_position_names",
+    "run_execution",
     "scene_from_plant",
     "set_object_poses",
     "set_robot_positions",

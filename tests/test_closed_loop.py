@@ -11,8 +11,8 @@ from closed_loop_support import run_controller
 from hlp_drake.errors import HlpError
 from hlp_drake.run_scene import DEFAULT_SCENE
 from hlp_drake.scene.io import load_scene
-from hlp_drake.systems.execution.execution import SETTLE_S
 from hlp_drake.systems.execution.receding_horizon import remainder
+from hlp_drake.systems.execution.run import SETTLE_S
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.cost import Prediction, RolloutOutcome
 from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
@@ -184,7 +184,7 @@ def test_the_reach_is_simulated_to_its_end_wherever_a_re_plan_moves_it(ends, set
     from pydrake.systems.analysis import Simulator
     from pydrake.systems.primitives import ConstantVectorSource
 
-    from hlp_drake.systems.execution.execution import advance_through_reach
+    from hlp_drake.systems.execution.command import advance_through_reach
 
     simulator = Simulator(ConstantVectorSource([0.0]))
     assert advance_through_reach(simulator, _MovingEnd(*ends)) == pytest.approx(settled)

@@ -527,7 +527,7 @@ def test_rows_finishing_in_any_order_are_written_sorted(tmp_path):
 
 def test_a_drake_check_failing_in_a_job_is_that_jobs_crash_and_a_real_exit_is_not(monkeypatch):
     from hlp_drake.experiments.runner import run_job
-    from hlp_drake.systems.execution import execution
+    from hlp_drake.systems.execution import run as execution
     from hlp_drake.systems.scenario import Scenario
 
     job = Job("gen1", 0, 6, "gen1-0", "hlp", Scenario().updated("optimiser: {workers: 1}").yaml)

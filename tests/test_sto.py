@@ -363,7 +363,7 @@ def test_optimiser_block_ports_and_cache(scene, trajectories):
 
 
 def test_an_unreachable_target_fails_with_a_reason_and_no_rollouts(scene):
-    from hlp_drake.systems.execution.execution import plan_and_execute
+    from hlp_drake.systems.execution.run import plan_and_execute
 
     far = dataclasses.replace(scene.target, x=scene.table.length + 1.5)
     with RolloutPool(1) as pool:

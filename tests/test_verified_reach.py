@@ -12,7 +12,7 @@ from test_closed_loop import forward  # the base moving along x
 
 from hlp_drake.run_scene import DEFAULT_SCENE
 from hlp_drake.scene.io import load_scene
-from hlp_drake.systems.execution.execution import plan_and_execute, verified_reach
+from hlp_drake.systems.execution.run import plan_and_execute, verified_reach
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.optimiser import StoResult
 from hlp_drake.systems.optimiser.pool import RolloutPool

@@ -131,7 +131,7 @@ def run_job(job: Job) -> Row:
     other planner on the same scene) built.
     """
     from hlp_drake.learners.bundled import default_models
-    from hlp_drake.systems.execution.execution import plan_and_execute
+    from hlp_drake.systems.execution.run import plan_and_execute
     from hlp_drake.systems.optimiser.pool import RolloutPool
     from hlp_drake.systems.optimiser.rollout_world import simulation_failure
     from hlp_drake.systems.scenario import load_scenario

@@ -6,23 +6,22 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
-
-from hlp_drake.systems.optimiser.control_sequence import ControlSequence
-
-if TYPE_CHECKING:
-    from pydrake.systems.framework import Context
-    from pydrake.systems.primitives import TrajectorySource
-
-    from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
-
 from pydrake.math import RotationMatrix
 from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.solvers import Solve
 
-from hlp_drake.systems.optimiser.control_sequence import BASE_COLUMNS
-from hlp_drake.systems.world.config import GraspConfig
+from hlp_drake.systems.optimiser.control_sequence import BASE_COLUMNS, ControlSequence
+from hlp_drake.systems.world.config import EXECUTION_SETTLE_S, GraspConfig
 from hlp_drake.systems.world.robot import GRIPPER_CLOSED, GRIPPER_JOINTS, GRIPPER_MIMIC_JOINTS, TCP_FRAME
+from hlp_drake.systems.world.scene_models import object_body
 from hlp_drake.systems.world.start_pose import ik_solver_options, kinematic_robot, robot_position_names
+
+if TYPE_CHECKING:
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import Context
+    from pydrake.systems.primitives import TrajectorySource
+
+    from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
 
 
 class OpenLoopCommand:
@@ -107,3 +106,33 @@ def grasp_knots(q_end: np.ndarray, grasp: GraspConfig) -> tuple[np.ndarray, np.n
         return None
     times = np.cumsum([grasp.close_s, grasp.lift_s, max(grasp.hold_s, 1e-3)])
     return times, np.vstack([closed, lifted, lifted])
+
+
+def advance_through_reach(simulator: Simulator, command: OpenLoopCommand | ClosedLoopCommand) -> float:
+    """Simulate to the end of the commanded reach, then ``EXECUTION_SETTLE_S`` more; return that time. A closed
+    loop's re-plan may move the end while the simulation goes there: later (it goes on), or earlier
+    than the time already simulated (the robot has held the reach's last pose since; the settling
+    ends no earlier than now: going back would be Drake's "boundary_time >= context time" failure)."""
+    root = simulator.get_mutable_context()
+    end = command.end(root)
+    while root.get_time() < end:
+        simulator.AdvanceTo(end)
+        end = command.end(root)
+    settled = max(end + EXECUTION_SETTLE_S, root.get_time())
+    simulator.AdvanceTo(settled)
+    return settled
+
+
+def grasp_and_lift(simulator, command, t0, scenario, plant, plant_context, scene) -> bool:
+    """Close the fingers at the reach's end pose (from ``t0``) and lift; whether the target rose
+    with the gripper."""
+    root = simulator.get_mutable_context()
+    grasp = grasp_knots(command.final(root), scenario.grasp)
+    if grasp is None:
+        return False
+    times, knots = grasp
+    command.then(root, t0, times, knots)
+    target = object_body(plant, scene.target.name)
+    z0 = target.EvalPoseInWorld(plant_context).translation()[2]
+    simulator.AdvanceTo(t0 + times[-1])
+    return bool(target.EvalPoseInWorld(plant_context).translation()[2] - z0 >= scenario.grasp.held_height)

@@ -14,26 +14,20 @@ import time
 from collections import OrderedDict
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
+from functools import cached_property
 from typing import TYPE_CHECKING, Self
 
 from hlp_drake.processes import interrupts_held, terminate_workers, worker_pool
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
-from hlp_drake.systems.optimiser.cost import RolloutOutcome
-
-if TYPE_CHECKING:
-    from hlp_drake.systems.optimiser.rollout_world import RolloutStart
-    from hlp_drake.systems.scenario import Scenario
-
-from functools import cached_property
-from typing import TYPE_CHECKING
-
-from hlp_drake.systems.optimiser.cost import RolloutSamples
+from hlp_drake.systems.optimiser.cost import RolloutOutcome, RolloutSamples
 from hlp_drake.systems.optimiser.rollout_world import RolloutStart, RolloutWorld, timed_rollout
 from hlp_drake.systems.optimiser.sampler import sample_rollout
 from hlp_drake.systems.optimiser.sleep import AWAKE, SleepSchedule, Sweep
 
 if TYPE_CHECKING:
+    from hlp_drake.systems.optimiser.rollout_world import RolloutStart
     from hlp_drake.systems.scenario import Scenario
+
 
 WORLDS_KEPT = 4
 """Scenarios whose rollout worlds a pool (or a worker process) keeps: a scene and the displaced

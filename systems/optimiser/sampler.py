@@ -22,7 +22,8 @@ A rollout's outcome is a pure function of the scene, the configuration, the star
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -34,8 +35,6 @@ if TYPE_CHECKING:
     from hlp_drake.systems.optimiser.rollout_world import RolloutStart, RolloutWorld
     from hlp_drake.systems.optimiser.sleep import SleepSchedule
 
-from dataclasses import dataclass
-from typing import NamedTuple
 
 MOVED = 1.0e-3
 """An awake object whose geometry has moved more than this from its start (m) is watched near sleeping ones."""

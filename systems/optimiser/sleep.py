@@ -11,19 +11,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
-
-import numpy as np
-
-from hlp_drake.systems.optimiser.control_sequence import ControlSequence
-
-if TYPE_CHECKING:
-    from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
-
 from typing import TYPE_CHECKING, NamedTuple
 
+import numpy as np
 from pydrake.geometry import CollisionFilterDeclaration, GeometrySet
 
+from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.world.scene_models import is_support_geometry
 
 if TYPE_CHECKING:

@@ -16,6 +16,7 @@ import math
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from scipy.optimize import linear_sum_assignment
 
 from hlp_drake.planner import HighLevelPlan
 from hlp_drake.scene.model import Scene, SceneObject
@@ -23,7 +24,6 @@ from hlp_drake.scene.model import Scene, SceneObject
 if TYPE_CHECKING:
     from hlp_drake.systems.perception.system import Perception
 
-from scipy.optimize import linear_sum_assignment
 
 MATCH_DISTANCE = 0.05
 """A perceived object further than this (m) from a true one's centre is not that object."""

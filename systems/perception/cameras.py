@@ -19,7 +19,8 @@ they tell the target from the obstacles and the robot from the scene, never one 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 from pydrake.common.value import AbstractValue
@@ -48,8 +49,6 @@ from hlp_drake.systems.world.scene_models import SceneModels
 if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
 
-from dataclasses import dataclass, field
-from typing import Literal
 
 RENDERER = "vtk"
 TABLE_LABEL, TARGET_LABEL, OBSTACLE_LABEL, ROBOT_LABEL = 1, 2, 3, 4

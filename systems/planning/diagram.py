@@ -10,6 +10,7 @@ from functools import cache
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import ConstantValueSource
@@ -26,13 +27,6 @@ from hlp_drake.systems.planning.planners import HlpPlannerSystem, StraightLinePl
 from hlp_drake.systems.planning.transfer import RobotPlanTransfer
 from hlp_drake.systems.scenario_checks import check_scenario
 from hlp_drake.systems.world.scene_source import SCENE_PORT
-
-if TYPE_CHECKING:
-    from hlp_drake.systems.scenario import Scenario
-
-from typing import TYPE_CHECKING
-
-import numpy as np
 
 if TYPE_CHECKING:
     from hlp_drake.scene.model import Scene

@@ -1,19 +1,12 @@
-"""Plan, solve IK, optimise and execute in the physics world: what ``python -m hlp_drake.run_scene`` runs.
+"""Run an execution diagram: plan, solve IK, optimise, execute in the physics world and grasp; what
+``python -m hlp_drake.run_scene`` runs (``plan_and_execute``: ``make_execution_diagram``, then
+``run_execution``).
 
-``plan_and_execute(scenario, pool=...)`` builds one diagram: the world (the scenario's plant at its
-own time step), the scene source feeding the planning diagram (``SceneFromPlant`` on the world's
-body poses, or with ``perception.source: camera`` the perceived scene: the planner, IK and
-optimiser then work on it while the world simulates the true one; open loop one frame of the
-world's cameras at the start, ``perceive_world``, so the executed world renders nothing; closed
-loop ``ScenePerception`` on the executed world's cameras), and
-what drives the robot: open loop a trajectory source, closed loop (``scenario.closed_loop.enabled``)
-a ``RecedingHorizonController`` re-optimising on the measured state and the scene source's scene
-(re-perceived at every re-plan with cameras). It evaluates the plan, the
-keyframes and the optimisation at the start, plays the optimised trajectory, checks the reach, then
-closes the gripper and lifts (open loop in the optimiser's own world, the reach is the optimiser's
-verification of it on the execution model: the execution starts from where that ended). With ``scenario.uncertainty.enabled`` the world differs from what the
-planners believe (``model_error``): without cameras the planning diagram then plans on the
-scenario's scene, not the plant's. A ``RunListener`` hears of every stage as it happens.
+The run evaluates the plan, the keyframes and the optimisation at the start, plays the optimised
+trajectory (open loop) or hands it to the receding-horizon controller (closed loop), checks the
+reach, then closes the gripper and lifts. Open loop in the optimiser's own world, the reach is the
+optimiser's verification of it on the execution model: the execution starts from where that ended.
+A ``RunListener`` hears of every stage as it happens.
 """
 
 from __future__ import annotations
@@ -25,48 +18,43 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from pydrake.geometry import Meshcat
 from pydrake.systems.analysis import Simulator
-from pydrake.systems.framework import DiagramBuilder, EventStatus
+from pydrake.systems.framework import EventStatus
 
 from hlp_drake.learners.models import DecisionModels
 from hlp_drake.planner import HighLevelPlan
 from hlp_drake.scene.model import Scene
-from hlp_drake.systems.execution.command import ClosedLoopCommand, OpenLoopCommand, grasp_knots
+from hlp_drake.systems.execution.command import (
+    ClosedLoopCommand,
+    OpenLoopCommand,
+    advance_through_reach,
+    grasp_and_lift,
+)
+from hlp_drake.systems.execution.diagram import (
+    ExecutionDiagram,
+    execution_model_error,
+    make_execution_diagram,
+)
 from hlp_drake.systems.execution.meshcat_view import draw_perception, draw_plan, frame_table
-from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.cost import FinalState, pregrasp_check, reach_problem
-from hlp_drake.systems.optimiser.optimiser import StoResult
 from hlp_drake.systems.optimiser.pool import RolloutPool
 from hlp_drake.systems.optimiser.rollout_world import simulation_failure
 from hlp_drake.systems.perception.accuracy import perception_record
-from hlp_drake.systems.perception.system import add_scene_perception, perceive_world
-from hlp_drake.systems.planning.diagram import ObservedScenePlanner, make_planning_diagram
+from hlp_drake.systems.perception.system import perceive_world
 from hlp_drake.systems.planning.keyframes import Keyframes
 from hlp_drake.systems.world.config import EXECUTION_SETTLE_S
 from hlp_drake.systems.world.robot import TCP_FRAME
-from hlp_drake.systems.world.scene_models import fallen_objects, object_body, object_planar_poses
-from hlp_drake.systems.world.scene_source import SCENE_PORT, SceneFromPlant
+from hlp_drake.systems.world.scene_models import fallen_objects, object_planar_poses
+from hlp_drake.systems.world.scene_source import SCENE_PORT
 from hlp_drake.systems.world.start_pose import tcp_keypoint_height
-from hlp_drake.systems.world.uncertainty import sample_model_error
-from hlp_drake.systems.world.world import (
-    add_position_trajectory,
-    connect_robot_command,
-    make_world_diagram,
-    world_plant,
-)
-
-if TYPE_CHECKING:
-    from hlp_drake.systems.scenario import Scenario
-
-from typing import TYPE_CHECKING
+from hlp_drake.systems.world.world import world_plant
 
 if TYPE_CHECKING:
     from pydrake.trajectories import PiecewisePolynomial
 
-    from hlp_drake.planner import HighLevelPlan
     from hlp_drake.systems.optimiser.optimiser import StoResult
     from hlp_drake.systems.perception.perception import Perception
-    from hlp_drake.systems.planning.keyframes import Keyframes
+    from hlp_drake.systems.scenario import Scenario
 
 SETTLE_S = EXECUTION_SETTLE_S  # simulated time after the trajectory ends, before objects are checked
 MOVED_TOLERANCE = 0.01  # m: an object displaced further than this counts as moved
@@ -141,143 +129,95 @@ def plan_and_execute(
     listener: RunListener | None = None,
 ) -> ExecutionResult:
     """Plan ``scenario``'s scene with its planner, solve IK, optimise with the STO, execute with
-    contact, and grasp.
+    contact, and grasp: ``make_execution_diagram``, then ``run_execution``.
 
     Success (the paper's test): the optimiser found a sequence whose rollout passes (open loop; closed
-    loop the controller may rescue one that does not), and in the execution (the world at its own time step) the target ends inside the gripper's pre-grasp region
-    (the tcp within the target's radius + ``optimiser.cost.pregrasp_margin`` horizontally, at grasp
-    height) with no object off the table. Then the fingers close and the tcp lifts;
-    ``grasp_held`` says whether the target came up with it (not part of success).
+    loop the controller may rescue one that does not), and in the execution (the world at its own time
+    step) the target ends inside the gripper's pre-grasp region (the tcp within the target's radius +
+    ``optimiser.cost.pregrasp_margin`` horizontally, at grasp height) with no object off the table.
+    Then the fingers close and the tcp lifts; ``grasp_held`` says whether the target came up with it
+    (not part of success).
 
     Args:
         pool: the optimiser's rollout workers (the caller's; its start-up is not timed here).
         meshcat: record the execution there, framed on the table, with the human and robot plans.
         contact_forces: draw the contact forces in MeshCat too.
         listener: told of every stage as it happens.
-
-    Open loop plays the optimised sequence; closed loop (``scenario.closed_loop.enabled``) hands it
-    to a ``RecedingHorizonController``.
     """
-    execution = "closed" if scenario.closed_loop.enabled else "open"
     listener = listener or RunListener()
-    scene = scenario.scene
-    camera = scenario.perception.source == "camera"
-    watching = camera and execution == "closed"  # cameras in the executed world, re-perceived at re-plans
-    error = sample_model_error(scenario.uncertainty, scene) if scenario.uncertainty.enabled else None
-    perception, perceive_s, fixed = None, 0.0, None  # fixed: the planners' scene, if not the source's
-    if camera and not watching:  # one frame, in a world of its own: the executed one renders nothing
-        perception, perceive_s = perceive_world(scenario, model_error=error)
+    perception, perceive_s = None, 0.0
+    if scenario.perception.source == "camera" and not scenario.closed_loop.enabled:
+        # one frame, in a world of its own: the executed one renders nothing
+        perception, perceive_s = perceive_world(scenario, model_error=execution_model_error(scenario))
         listener.perceived(perception, perceive_s)
-        fixed = perception.scene
-    elif error is not None and not camera:  # the scene the planners believe in
-        fixed = scene
-    builder = DiagramBuilder()
-    world = builder.AddSystem(
-        make_world_diagram(
-            scenario, meshcat=meshcat, contact_forces=contact_forces, cameras=watching, model_error=error
-        )
-    )
-    plant, robot = world_plant(world)
     started = time.perf_counter()
-    planning = builder.AddNamedSystem("planning", make_planning_diagram(scenario, pool=pool, models=models))
-    if watching:  # the planners see what the cameras see of the (true) world
-        source = add_scene_perception(builder, world, scenario)
-    else:  # the plant's poses (of the believed objects, under model error)
-        source = builder.AddNamedSystem("scene_from_plant", SceneFromPlant(plant, scene))
-        builder.Connect(world.GetOutputPort("body_poses"), source.get_body_poses_input_port())
-    if fixed is None:
-        builder.Connect(source.get_scene_output_port(), planning.GetInputPort(SCENE_PORT))
-    if execution == "closed":  # it observes the scene through the same source at every re-plan
-        replanner = ObservedScenePlanner(scenario, models=models)  # when objects have moved far
-        controller = builder.AddNamedSystem(
-            "controller", RecedingHorizonController(scenario, plant, pool, initialiser=replanner)
-        )
-        builder.Connect(world.GetOutputPort("state"), controller.GetInputPort("state"))
-        builder.Connect(source.get_scene_output_port(), controller.GetInputPort(SCENE_PORT))
-        if camera:
-            builder.Connect(source.get_perception_output_port(), controller.GetInputPort("perception"))
-        builder.Connect(planning.GetOutputPort("optimisation"), controller.GetInputPort("initial"))
-        connect_robot_command(
-            builder, world, controller.GetOutputPort("desired_trajectory_state"), name="controller"
-        )
-    else:
-        start = plant.GetPositions(plant.CreateDefaultContext(), robot)
-        hold = ControlSequence(np.array([0.0, 1.0]), np.vstack([start, start]))
-        trajectory_source = add_position_trajectory(builder, world, hold.to_trajectory())
-    simulator = Simulator(builder.Build())
-    if watching:  # rendering and perception, timed apart from the planner
+    handles = make_execution_diagram(
+        scenario,
+        pool=pool,
+        models=models,
+        meshcat=meshcat,
+        contact_forces=contact_forces,
+        planned_scene=None if perception is None else perception.scene,
+    )
+    return run_execution(
+        handles,
+        scenario,
+        pool=pool,
+        meshcat=meshcat,
+        listener=listener,
+        perceived=(perception, perceive_s),
+        started=started,
+    )
+
+
+def run_execution(
+    handles: ExecutionDiagram,
+    scenario: Scenario,
+    *,
+    pool: RolloutPool,
+    meshcat: Meshcat | None = None,
+    listener: RunListener | None = None,
+    perceived: tuple[Perception | None, float] = (None, 0.0),
+    started: float | None = None,
+) -> ExecutionResult:
+    """Run the execution diagram ``handles`` of ``scenario``: plan, IK, optimise, execute and grasp
+    (``perceived``: the frame the planners' scene came from and its seconds, if perceived before the
+    build; ``started``: when the run's clock started, by default now)."""
+    listener = listener or RunListener()
+    started = time.perf_counter() if started is None else started
+    simulator = Simulator(handles.diagram)
+    perception, perceive_s = perceived
+    if handles.watching:  # rendering and perception, timed apart from the planner
         seen = time.perf_counter()
-        perception = source.get_perception_output_port().Eval(
-            source.GetMyContextFromRoot(simulator.get_context())
+        perception = handles.source.get_perception_output_port().Eval(
+            handles.source.GetMyContextFromRoot(simulator.get_context())
         )
         perceive_s = time.perf_counter() - seen
         listener.perceived(perception, perceive_s)
-    context = planning.GetMyContextFromRoot(simulator.get_mutable_context())
-    if fixed is not None:
-        planning.GetInputPort(SCENE_PORT).FixValue(context, fixed)
-    plan: HighLevelPlan = planning.GetOutputPort("plan").Eval(context)
-    planned = time.perf_counter()
-    plan_s = planned - started - (perceive_s if watching else 0.0)  # open loop it was perceived before
-    listener.planned(plan, plan_s)
-    keyframes: Keyframes = planning.GetOutputPort("keyframes").Eval(context)
-    trajectory = planning.GetOutputPort("trajectory").Eval(context)
-    solved = time.perf_counter()
-    listener.solved(keyframes, trajectory, solved - planned)
-    result = ExecutionResult(
-        scenario.planner.kind,
-        scene,
-        plan,
-        keyframes,
-        planning.GetOutputPort("robot_plan").Eval(context),
-        execution=execution,
-    )
-    result.timings = {"plan_s": plan_s, "ik_s": solved - planned, "optimise_s": 0.0}
-    if camera:
-        result.perception = perception_record(scene, perception)
-        result.timings["perceive_s"] = perceive_s
-    if perception is not None and not perception.ok:
-        result.failure_reason = f"perception failed: {perception.reason}"
-    elif not plan.ok:
-        result.failure_reason = f"no plan: {plan.reason}"
-    elif not keyframes.ok:
-        result.failure_reason = "IK failed: " + "; ".join(keyframes.failures)
-    if result.failure_reason is None:
-        listener.optimising()
-        optimisation: StoResult = planning.GetOutputPort("optimisation").Eval(context)
-        listener.optimised(optimisation)
-        sequence = optimisation.sequence
-        result.iterations, result.rollouts = optimisation.iterations, optimisation.rollouts
-        result.optimisation = optimisation.to_dict()
-        result.timings["optimise_s"] = optimisation.optimise_s
-        if not optimisation.success and execution == "open":  # closed loop: the controller may rescue it
-            result.failure_reason = f"the optimiser found no solution: {optimisation.failure_reason}"
-    else:  # nothing to optimise: the (partial) IK trajectory is executed for inspection only
-        sequence = ControlSequence.from_trajectory(trajectory, scenario.optimiser.step_duration)
+    result, trajectory = _plan(handles, scenario, simulator, listener, started, perception, perceive_s)
+    sequence, optimisation = _optimise(handles, scenario, simulator, listener, result, trajectory)
     optimised = time.perf_counter()
-    if execution == "closed":
-        command = ClosedLoopCommand(controller)
+    if handles.controller is not None:
+        command = ClosedLoopCommand(handles.controller)
     else:
-        trajectory_source.UpdateTrajectory(sequence.to_trajectory())
-        command = OpenLoopCommand(trajectory_source, sequence)
+        handles.trajectory_source.UpdateTrajectory(sequence.to_trajectory())
+        command = OpenLoopCommand(handles.trajectory_source, sequence)
     if meshcat is not None:
-        frame_table(meshcat, scene)
-        heights = {
-            "table_height": scene.table.height,
-            "keypoint_height": tcp_keypoint_height(scene, scenario.ik),
-        }
-        draw_plan(meshcat, plan, path="plan", markers=False, **heights)
-        draw_plan(meshcat, result.robot_plan, path="robot_plan", **heights)
-        if perception is not None:
-            draw_perception(meshcat, perception)
+        _draw(meshcat, scenario, result, perception)
     reached = None
-    if execution == "open" and error is None and meshcat is None and result.failure_reason is None:
+    if (
+        handles.execution == "open"
+        and handles.model_error is None
+        and meshcat is None
+        and result.failure_reason is None
+    ):
         reached = verified_reach(optimisation, scenario)
     result.reach_reused = reached is not None
-    executing = execution == "open" or result.failure_reason is None  # closed loop: an optimised sequence
+    executing = handles.execution == "open" or result.failure_reason is None  # closed: an optimised sequence
     if executing:
         _execute(result, simulator, command, scenario, meshcat, listener, reached)
-    if execution == "closed" and executing:  # what the controller did, the execution failed or not
-        result.closed_loop = controller.record(simulator.get_context()).to_dict()
+    if handles.controller is not None and executing:  # what the controller did, the execution failed or not
+        result.closed_loop = handles.controller.record(simulator.get_context()).to_dict()
     executed = time.perf_counter()
     result.success = result.failure_reason is None
     result.timings.update(
@@ -285,6 +225,68 @@ def plan_and_execute(
     )
     listener.finished(result)
     return result
+
+
+def _plan(handles, scenario, simulator, listener, started, perception, perceive_s):
+    """Evaluate the plan, the keyframes and the initial trajectory; the result so far (failed if
+    perception, the plan or IK failed) and the trajectory."""
+    planning = handles.planning
+    context = planning.GetMyContextFromRoot(simulator.get_mutable_context())
+    if handles.planned_scene is not None:
+        planning.GetInputPort(SCENE_PORT).FixValue(context, handles.planned_scene)
+    plan: HighLevelPlan = planning.GetOutputPort("plan").Eval(context)
+    planned = time.perf_counter()
+    plan_s = planned - started - (perceive_s if handles.watching else 0.0)  # open loop: perceived before
+    listener.planned(plan, plan_s)
+    keyframes: Keyframes = planning.GetOutputPort("keyframes").Eval(context)
+    trajectory = planning.GetOutputPort("trajectory").Eval(context)
+    solved = time.perf_counter()
+    listener.solved(keyframes, trajectory, solved - planned)
+    robot_plan = planning.GetOutputPort("robot_plan").Eval(context)
+    result = ExecutionResult(
+        scenario.planner.kind, scenario.scene, plan, keyframes, robot_plan, execution=handles.execution
+    )
+    result.timings = {"plan_s": plan_s, "ik_s": solved - planned, "optimise_s": 0.0}
+    if scenario.perception.source == "camera":
+        result.perception = perception_record(scenario.scene, perception)
+        result.timings["perceive_s"] = perceive_s
+    if perception is not None and not perception.ok:
+        result.failure_reason = f"perception failed: {perception.reason}"
+    elif not plan.ok:
+        result.failure_reason = f"no plan: {plan.reason}"
+    elif not keyframes.ok:
+        result.failure_reason = "IK failed: " + "; ".join(keyframes.failures)
+    return result, trajectory
+
+
+def _optimise(handles, scenario, simulator, listener, result, trajectory):
+    """The optimised sequence (or, with nothing to optimise, the IK trajectory's, executed for
+    inspection only) and the optimisation (None if it did not run); fills ``result``."""
+    if result.failure_reason is not None:
+        return ControlSequence.from_trajectory(trajectory, scenario.optimiser.step_duration), None
+    listener.optimising()
+    context = handles.planning.GetMyContextFromRoot(simulator.get_mutable_context())
+    optimisation: StoResult = handles.planning.GetOutputPort("optimisation").Eval(context)
+    listener.optimised(optimisation)
+    result.iterations, result.rollouts = optimisation.iterations, optimisation.rollouts
+    result.optimisation = optimisation.to_dict()
+    result.timings["optimise_s"] = optimisation.optimise_s
+    if not optimisation.success and handles.execution == "open":  # closed: the controller may rescue it
+        result.failure_reason = f"the optimiser found no solution: {optimisation.failure_reason}"
+    return optimisation.sequence, optimisation
+
+
+def _draw(
+    meshcat: Meshcat, scenario: Scenario, result: ExecutionResult, perception: Perception | None
+) -> None:
+    """Frame the table and draw the human and robot plans (and what the cameras saw) in ``meshcat``."""
+    scene = scenario.scene
+    frame_table(meshcat, scene)
+    heights = {"table_height": scene.table.height, "keypoint_height": tcp_keypoint_height(scene, scenario.ik)}
+    draw_plan(meshcat, result.plan, path="plan", markers=False, **heights)
+    draw_plan(meshcat, result.robot_plan, path="robot_plan", **heights)
+    if perception is not None:
+        draw_perception(meshcat, perception)
 
 
 def verified_reach(optimisation: StoResult, scenario: Scenario) -> FinalState | None:
@@ -353,7 +355,9 @@ def _execute(
         if problem is not None and result.failure_reason is None:
             result.failure_reason = f"in execution: {problem}"
         if problem is None:
-            result.grasp_held = _grasp(simulator, command, settled, scenario, plant, plant_context, scene)
+            result.grasp_held = grasp_and_lift(
+                simulator, command, settled, scenario, plant, plant_context, scene
+            )
     except (RuntimeError, SystemExit) as error:
         failure = simulation_failure(error)
         if result.failure_reason is None:
@@ -366,37 +370,6 @@ def _execute(
             meshcat.PublishRecording()
 
 
-def advance_through_reach(simulator: Simulator, command: OpenLoopCommand | ClosedLoopCommand) -> float:
-    """Simulate to the end of the commanded reach, then ``SETTLE_S`` more; return that time. A closed
-    loop's re-plan may move the end while the simulation goes there: later (it goes on), or earlier
-    than the time already simulated (the robot has held the reach's last pose since; the settling
-    ends no earlier than now: going back would be Drake's "boundary_time >= context time" failure)."""
-    root = simulator.get_mutable_context()
-    end = command.end(root)
-    while root.get_time() < end:
-        simulator.AdvanceTo(end)
-        end = command.end(root)
-    settled = max(end + SETTLE_S, root.get_time())
-    simulator.AdvanceTo(settled)
-    return settled
-
-
-def _grasp(simulator, command, t0, scenario, plant, plant_context, scene) -> bool:
-    """Close the fingers at the reach's end pose (from ``t0``) and lift; whether the target rose
-    with the gripper."""
-    root = simulator.get_mutable_context()
-    grasp = grasp_knots(command.final(root), scenario.grasp)
-    if grasp is None:
-        return False
-    times, knots = grasp
-    command.then(root, t0, times, knots)
-    target = object_body(plant, scene.target.name)
-    z0 = target.EvalPoseInWorld(plant_context).translation()[2]
-    simulator.AdvanceTo(t0 + times[-1])
-    return bool(target.EvalPoseInWorld(plant_context).translation()[2] - z0 >= scenario.grasp.held_height)
-
-
-# ``RunListener``: what hears of a ``plan_and_execute`` run's stages as they happen.
 class RunListener:
     """Hears of a run's stages as they happen (every method does nothing here; override what you need)."""
 
@@ -423,6 +396,3 @@ class RunListener:
 
     def finished(self, result: ExecutionResult) -> None:
         """The run is over."""
-
-
-__all__ = ["RunListener"]

@@ -289,67 +289,29 @@ def optimise(
             optimise_s=time.perf_counter() - started,
         )
     run = _Run(scenario, pool, budget, start)
-    rng = np.random.default_rng(budget.seed)
-    best = initial
-    outcomes = run.roll([best])
-    run.settle([best], outcomes, [0])
-    (outcome,) = outcomes
+    (outcome,) = outcomes = run.roll([initial])
+    run.settle([initial], outcomes, [0])
     result = StoResult(
-        best,
+        initial,
         outcome,
         outcome.success,
         outcome.failure_reason,
         costs=[outcome.cost],
         initial_cost=outcome.cost,
     )
-    if not result.success and alternatives is not None and budget.alternatives > 0:
-        others = list(alternatives())[: budget.alternatives]
-        if others:
-            outcomes = run.roll(others)
-            run.settle(others, outcomes, range(len(others)))
-            passed = [i for i, o in enumerate(outcomes) if o.success]
-            i = passed[0] if passed else int(np.argmin([o.cost for o in outcomes]))
-            if passed or outcomes[i].cost < outcome.cost:
-                best, outcome, result.start = others[i], outcomes[i], i + 1
-                result.sequence, result.outcome = best, outcome
-                result.success, result.failure_reason = outcome.success, outcome.failure_reason
-            result.costs.append(outcome.cost)
+    _try_alternatives(run, result, alternatives, budget)
+    rng = np.random.default_rng(budget.seed)
     last_iteration_s = 0.0
-    per_iteration = budget.samples + (1 if sto.update == "mppi" else 0)
     while not result.success and result.iterations < budget.max_iterations:
-        if run.rollouts + per_iteration > budget.max_rollouts:
-            result.failure_reason = (
-                f"{outcome.failure_reason} (rollout budget of {budget.max_rollouts} spent)"
-            )
-            break
-        elapsed = time.perf_counter() - started
-        if budget.time_budget_s > 0 and elapsed + last_iteration_s > budget.time_budget_s:
-            result.failure_reason = (
-                f"{outcome.failure_reason} (time budget of {budget.time_budget_s:g} s spent)"
-            )
+        spent = _budget_spent(run, result, budget, time.perf_counter() - started + last_iteration_s)
+        if spent is not None:
+            result.failure_reason = f"{result.outcome.failure_reason} ({spent} spent)"
             break
         iteration_started = time.perf_counter()
-        noise = sample_base_noise(rng, best, sto.noise, budget.samples)
-        candidates = [best.with_base_velocity(v) for v in noise]
-        outcomes = run.roll(candidates)
-        if sto.update == "mppi":
-            weights = mppi_weights(np.array([o.cost for o in outcomes]), sto.mppi_temperature)
-            mean = best.with_base_velocity(np.einsum("k,knj->nj", weights, noise))
-            candidates.append(mean)
-            outcomes.extend(run.roll([mean]))
-        run.settle(candidates, outcomes, np.argsort([o.cost for o in outcomes], kind="stable"))
-        costs = [o.cost for o in outcomes]
-        passing = [j for j, o in enumerate(outcomes) if o.success]  # verified, or none
-        i = min(passing, key=costs.__getitem__) if passing else int(np.argmin(costs))
-        if passing or outcomes[i].cost < outcome.cost:  # monotone acceptance, a pass first
-            best, outcome = candidates[i], outcomes[i]
-        result.iterations += 1
-        result.sequence, result.outcome = best, outcome
-        result.success, result.failure_reason = outcome.success, outcome.failure_reason
-        result.costs.append(outcome.cost)
+        _iterate(run, result, rng, sto, budget)
         last_iteration_s = time.perf_counter() - iteration_started
         if progress is not None:
-            progress(result.iterations, outcome.cost)
+            progress(result.iterations, result.outcome.cost)
         if budget.verify and run.verifications >= budget.max_verifications and not result.success:
             result.failure_reason = f"{result.failure_reason} (verifications spent)"
             break
@@ -360,6 +322,69 @@ def optimise(
     result.verify_s = run.verify_s
     result.optimise_s = time.perf_counter() - started
     return result
+
+
+def _accept(result: StoResult, sequence: ControlSequence, outcome: RolloutOutcome) -> None:
+    """Make ``sequence`` (rolled out as ``outcome``) the result's."""
+    result.sequence, result.outcome = sequence, outcome
+    result.success, result.failure_reason = outcome.success, outcome.failure_reason
+
+
+def _try_alternatives(
+    run: _Run,
+    result: StoResult,
+    alternatives: Callable[[], Sequence[ControlSequence]] | None,
+    budget: Budget,
+) -> None:
+    """If the initial sequence failed, roll out the planner's other initial sequences (the budget's
+    number of them, best first) and take the first that passes, or else the cheapest if it is cheaper."""
+    if result.success or alternatives is None or budget.alternatives <= 0:
+        return
+    others = list(alternatives())[: budget.alternatives]
+    if not others:
+        return
+    outcomes = run.roll(others)
+    run.settle(others, outcomes, range(len(others)))
+    passed = [i for i, o in enumerate(outcomes) if o.success]
+    i = passed[0] if passed else int(np.argmin([o.cost for o in outcomes]))
+    if passed or outcomes[i].cost < result.outcome.cost:
+        result.start = i + 1
+        _accept(result, others[i], outcomes[i])
+    result.costs.append(result.outcome.cost)
+
+
+def _budget_spent(run: _Run, result: StoResult, budget: Budget, elapsed_next_s: float) -> str | None:
+    """What of the budget another iteration would overspend (``elapsed_next_s``: the time spent
+    and the last iteration's), if anything."""
+    per_iteration = budget.samples + (1 if run.scenario.optimiser.update == "mppi" else 0)
+    if run.rollouts + per_iteration > budget.max_rollouts:
+        return f"rollout budget of {budget.max_rollouts}"
+    if budget.time_budget_s > 0 and elapsed_next_s > budget.time_budget_s:
+        return f"time budget of {budget.time_budget_s:g} s"
+    return None
+
+
+def _iterate(run: _Run, result: StoResult, rng: np.random.Generator, sto: StoConfig, budget: Budget) -> None:
+    """One iteration: noisy base velocities round the result's sequence (and, with ``mppi``, their
+    weighted mean) rolled out; the best is accepted if it passes or costs less (monotone)."""
+    best, outcome = result.sequence, result.outcome
+    noise = sample_base_noise(rng, best, sto.noise, budget.samples)
+    candidates = [best.with_base_velocity(v) for v in noise]
+    outcomes = run.roll(candidates)
+    if sto.update == "mppi":
+        weights = mppi_weights(np.array([o.cost for o in outcomes]), sto.mppi_temperature)
+        mean = best.with_base_velocity(np.einsum("k,knj->nj", weights, noise))
+        candidates.append(mean)
+        outcomes.extend(run.roll([mean]))
+    run.settle(candidates, outcomes, np.argsort([o.cost for o in outcomes], kind="stable"))
+    costs = [o.cost for o in outcomes]
+    passing = [j for j, o in enumerate(outcomes) if o.success]  # verified, or none
+    i = min(passing, key=costs.__getitem__) if passing else int(np.argmin(costs))
+    if passing or outcomes[i].cost < outcome.cost:  # monotone acceptance, a pass first
+        best, outcome = candidates[i], outcomes[i]
+    result.iterations += 1
+    _accept(result, best, outcome)
+    result.costs.append(outcome.cost)
 
 
 __all__ = ["EMPTY_RESULT", "Budget", "StoResult", "mppi_weights", "optimise", "sample_base_noise"]

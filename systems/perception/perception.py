@@ -213,18 +213,9 @@ def _perceive(
     linked = linked_sample(views, object_points, radius)
     groups = cluster_points(object_points, radius=radius, min_points=config.min_points, linked=linked)
     clusters = boundaries(views, object_points, groups, config.border_margin, table)
-    classes = []  # the display's classes per pixel (``Perception.cloud_class``)
     clustered = np.zeros(len(object_points), bool)
     clustered[np.concatenate(groups) if groups else []] = True
-    for k, (mask, h) in enumerate(zip(keep, heights)):
-        image = np.full(mask.shape, 3, dtype=np.int8)
-        with np.errstate(invalid="ignore"):
-            image[mask & (np.abs(h) <= config.table_tolerance)] = 0
-        mine = object_points.camera == k
-        image[object_points.row[mine], object_points.col[mine]] = 2
-        mine &= clustered
-        image[object_points.row[mine], object_points.col[mine]] = 1
-        classes.append(image)
+    classes = _class_images(keep, heights, object_points, clustered, config.table_tolerance)
     noise = len(object_points) - int(clustered.sum())
     display = {"class_images": tuple(classes), "noise_points": noise, "table": table}
     for cluster in clusters:
@@ -247,9 +238,7 @@ def _perceive(
     ]
     others = plan_view_order(o for i, o in enumerate(objects) if i != target)
     objects = [objects[target], *(replace(o, name=f"object_{k}") for k, o in enumerate(others, start=1))]
-    perceived_table = Table(length=x1, width=y1 - y0, height=table.height_at(x1 / 2.0, (y0 + y1) / 2.0))
-    placed = [_inside_table(o.scene_object(), perceived_table) for o in objects]
-    scene = replace(template, table=perceived_table, target=placed[0], obstacles=tuple(placed[1:]))
+    scene = _perceived_scene(template, table, objects)
     problems = scene_problems(scene)
     elapsed = time.perf_counter() - started
     result = Perception(scene, None, tuple(objects), perception_s=elapsed, **base, **display)
@@ -258,6 +247,32 @@ def _perceive(
             result, scene=unperceived_scene(template), reason="perceived scene: " + "; ".join(problems)
         )
     return result
+
+
+def _class_images(
+    keep: list[np.ndarray], heights: list[np.ndarray], points, clustered: np.ndarray, tolerance: float
+) -> list[np.ndarray]:
+    """Each camera's class per pixel for display (``Perception.cloud_class``): 0 the table, 1 a
+    clustered object point, 2 an object point in no cluster, 3 anything else."""
+    classes = []
+    for k, (mask, h) in enumerate(zip(keep, heights)):
+        image = np.full(mask.shape, 3, dtype=np.int8)
+        with np.errstate(invalid="ignore"):
+            image[mask & (np.abs(h) <= tolerance)] = 0
+        mine = points.camera == k
+        image[points.row[mine], points.col[mine]] = 2
+        mine &= clustered
+        image[points.row[mine], points.col[mine]] = 1
+        classes.append(image)
+    return classes
+
+
+def _perceived_scene(template: Scene, table: TablePlane, objects: list[PerceivedObject]) -> Scene:
+    """``template`` with the perceived table and objects (the target first), each moved onto the table."""
+    _, y0, x1, y1 = table.bounds
+    perceived_table = Table(length=x1, width=y1 - y0, height=table.height_at(x1 / 2.0, (y0 + y1) / 2.0))
+    placed = [_inside_table(o.scene_object(), perceived_table) for o in objects]
+    return replace(template, table=perceived_table, target=placed[0], obstacles=tuple(placed[1:]))
 
 
 def _perceived(

@@ -34,7 +34,7 @@ from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
 from pydrake.multibody.tree import ModelInstanceIndex, RigidBody, SpatialInertia, UnitInertia
 from pydrake.systems.framework import Context
 
-from hlp_drake.scene.model import Scene, SceneObject, plan_view_order
+from hlp_drake.scene.model import Scene, SceneObject, Table, plan_view_order
 from hlp_drake.systems.world.config import BodiesConfig, ContactConfig
 
 TABLE_NAME = "table"
@@ -186,34 +186,9 @@ def add_scene(
     bodies = BodiesConfig() if bodies is None else bodies
     if plant.is_finalized():
         raise ValueError("add_scene needs a plant that is not finalized yet")
-    names = [obj.name for obj in scene.objects]
-    welded = frozenset(welded_objects)
-    unknown = sorted(welded - set(names))
-    if unknown:
-        raise ValueError(f"cannot weld objects the scene does not have: {', '.join(unknown)}")
-    if weld_objects:
-        welded = frozenset(names)
-    for name in (TABLE_NAME, *(obj.name for obj in scene.objects)):
-        if plant.HasModelInstanceNamed(name):
-            raise ValueError(f"the plant already has a model instance named {name!r}")
+    welded = _welded_names(plant, scene, welded_objects, weld_objects)
     table = scene.table
-    thickness = bodies.table_thickness
-    table_instance = plant.AddModelInstance(TABLE_NAME)
-    box = Box(table.length, table.width, thickness)
-    table_body = plant.AddRigidBody(
-        TABLE_NAME,
-        table_instance,
-        SpatialInertia(20.0, np.zeros(3), UnitInertia.SolidBox(table.length, table.width, thickness)),
-    )
-    plant.WeldFrames(
-        plant.world_frame(),
-        table_body.body_frame(),
-        RigidTransform([table.length / 2.0, 0.0, table.height - thickness / 2.0]),
-    )
-    properties = _contact_properties(contact, contact.table_friction)
-    plant.RegisterCollisionGeometry(table_body, RigidTransform(), box, "table_top_collision", properties)
-    plant.RegisterVisualGeometry(table_body, RigidTransform(), box, "table_top_visual", TABLE_COLOR)
-
+    table_instance = _add_table(plant, table, contact, bodies.table_thickness)
     objects: dict[str, ModelInstanceIndex] = {}
     for obj in (scene.target, *plan_view_order(scene.obstacles)) if with_objects else ():
         color = TARGET_COLOR if obj is scene.target else OBSTACLE_COLOR
@@ -233,6 +208,43 @@ def add_scene(
         else:
             plant.SetDefaultFloatingBaseBodyPose(body, X_WO)
     return SceneModels(table=table_instance, objects=objects, welded=weld_objects, welded_objects=welded)
+
+
+def _welded_names(
+    plant: MultibodyPlant, scene: Scene, welded_objects: Iterable[str], weld_objects: bool
+) -> frozenset[str]:
+    """The names of the objects to weld; a ``ValueError`` for an unknown one or a name the plant has."""
+    names = [obj.name for obj in scene.objects]
+    welded = frozenset(welded_objects)
+    unknown = sorted(welded - set(names))
+    if unknown:
+        raise ValueError(f"cannot weld objects the scene does not have: {', '.join(unknown)}")
+    for name in (TABLE_NAME, *names):
+        if plant.HasModelInstanceNamed(name):
+            raise ValueError(f"the plant already has a model instance named {name!r}")
+    return frozenset(names) if weld_objects else welded
+
+
+def _add_table(
+    plant: MultibodyPlant, table: Table, contact: ContactConfig, thickness: float
+) -> ModelInstanceIndex:
+    """The table top: a box ``thickness`` thick welded with its top at the table's height."""
+    table_instance = plant.AddModelInstance(TABLE_NAME)
+    box = Box(table.length, table.width, thickness)
+    table_body = plant.AddRigidBody(
+        TABLE_NAME,
+        table_instance,
+        SpatialInertia(20.0, np.zeros(3), UnitInertia.SolidBox(table.length, table.width, thickness)),
+    )
+    plant.WeldFrames(
+        plant.world_frame(),
+        table_body.body_frame(),
+        RigidTransform([table.length / 2.0, 0.0, table.height - thickness / 2.0]),
+    )
+    properties = _contact_properties(contact, contact.table_friction)
+    plant.RegisterCollisionGeometry(table_body, RigidTransform(), box, "table_top_collision", properties)
+    plant.RegisterVisualGeometry(table_body, RigidTransform(), box, "table_top_visual", TABLE_COLOR)
+    return table_instance
 
 
 def object_body(plant: MultibodyPlant, name: str) -> RigidBody:

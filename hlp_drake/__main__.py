@@ -25,9 +25,9 @@ COMMANDS = {
     "run-scene": "hlp_drake.run_scene",
     "scene": "hlp_drake.scene.__main__",
     "experiments": "hlp_drake.experiments.cli",
-    "train": "hlp_drake.train",
-    "evaluate": "hlp_drake.evaluate",
-    "segment": "hlp_drake.segment",
+    "train": "hlp_drake.learners.cli",
+    "evaluate": "hlp_drake.evaluation.cli",
+    "segment": "hlp_drake.segmentation.cli",
     "dataset": "hlp_drake.dataset.__main__",
 }
 

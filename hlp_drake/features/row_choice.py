@@ -164,6 +164,21 @@ def _nearest(
     )
 
 
+def _candidate_points(
+    geometry: _RowGeometry, gap_union: list[int], obj_union: list[int], line: np.ndarray, width: float
+) -> np.ndarray:
+    """(B, n, 2) where each hand, whose line to the target is at ``line`` (B,) at the row's depth,
+    goes through the row's gaps ``gap_union`` (``_passage``) and to its obstacles ``obj_union``
+    (their centres); positions in the row, gaps first."""
+    gb, ob = geometry.gaps[gap_union], geometry.obstacles[obj_union]
+    n_gaps = len(gb)
+    points = np.empty((len(line), n_gaps + len(ob), 2))
+    points[:, :n_gaps, 0] = geometry.x
+    points[:, :n_gaps, 1] = _passage(gb[:, 1], gb[:, 3], line[:, None], width)
+    points[:, n_gaps:] = np.column_stack([(ob[:, 0] + ob[:, 2]) / 2.0, (ob[:, 1] + ob[:, 3]) / 2.0])[None]
+    return points
+
+
 ROUTE_OBSTACLES = 6
 """Obstacles in the route graph: every VR scene (structured and unstructured) has six. The graph's
 cost then no longer grows with the object count (``benchmarks/planning_time.py``: a two-row
@@ -235,24 +250,39 @@ class RowChoiceScene:
         """
         hands = np.asarray(hands, float).reshape(-1, 2)
         removed = [frozenset(r) for r in removed] if removed is not None else [frozenset()] * len(hands)
-        w, goal, geometry = self.width, self.goal, self.row(row)
-        line = line_at(hands, goal, geometry.x)  # (B,)
-        gap_keep, obj_keep = _nearest(geometry, line, w, limit)  # per hand, positions in the row
+        geometry = self.row(row)
+        line = line_at(hands, self.goal, geometry.x)  # (B,)
+        gap_keep, obj_keep = _nearest(geometry, line, self.width, limit)  # per hand, positions in the row
         gap_union, obj_union = sorted(set().union(*gap_keep)), sorted(set().union(*obj_keep))
+        points = _candidate_points(geometry, gap_union, obj_union, line, self.width)
+        X = self._features(row, hands, line, points, gap_union, obj_union, removed, mirror=mirror)
+        return self._per_hand(row, gap_union, obj_union, gap_keep, obj_keep, points, X)
+
+    def _features(
+        self,
+        row: int,
+        hands: np.ndarray,
+        line: np.ndarray,
+        points: np.ndarray,
+        gap_union: list[int],
+        obj_union: list[int],
+        removed: list[frozenset[int]],
+        *,
+        mirror: bool,
+    ) -> np.ndarray:
+        """(B, n, len(ROW_CHOICE_FEATURES)) the features Xr of the row's gaps ``gap_union`` and
+        obstacles ``obj_union`` (positions in the row) at ``points`` (B, n, 2), per hand (B, 2)
+        whose line to the target is at ``line`` (B,) at the row's depth."""
+        w, goal, geometry = self.width, self.goal, self.row(row)
         gb, ob = geometry.gaps[gap_union], geometry.obstacles[obj_union]
         members = geometry.members[obj_union]
         free = self._free[members].reshape(-1, 8)
-        n_gaps, n_obj = len(gb), len(ob)
-        n = n_gaps + n_obj
-        points = np.empty((len(hands), n, 2))
-        points[:, :n_gaps, 0] = geometry.x
-        points[:, :n_gaps, 1] = _passage(gb[:, 1], gb[:, 3], line[:, None], w)
-        points[:, n_gaps:] = np.column_stack([(ob[:, 0] + ob[:, 2]) / 2.0, (ob[:, 1] + ob[:, 3]) / 2.0])[None]
+        n_gaps = len(gb)
         lateral = points[..., 1] - line[:, None]
         depth = np.maximum(geometry.x - hands[:, 0], w / 2.0)[:, None]
         best_offset, best_width, block = geometry.best(hands, goal, w)
 
-        X = np.zeros((len(hands), n, len(ROW_CHOICE_FEATURES)))
+        X = np.zeros((len(hands), points.shape[1], len(ROW_CHOICE_FEATURES)))
         X[:, n_gaps:, 0] = 1.0
         X[:, :, 1] = np.minimum(np.concatenate([gb[:, 3] - gb[:, 1], ob[:, 3] - ob[:, 1]]) / w, CAP)
         X[:, n_gaps:, 2] = np.minimum((ob[:, 2] - ob[:, 0]) / w, CAP)
@@ -286,16 +316,31 @@ class RowChoiceScene:
         )
         X[:, :, 26] = np.minimum((goal[0] - geometry.x) / w, CAP)
         self._route_features(X, hands, points, members, n_gaps, removed)
+        return X
 
+    def _per_hand(
+        self,
+        row: int,
+        gap_union: list[int],
+        obj_union: list[int],
+        gap_keep: list[set[int]],
+        obj_keep: list[set[int]],
+        points: np.ndarray,
+        X: np.ndarray,
+    ) -> list[RowCandidates]:
+        """Per hand, its own candidates (``gap_keep``, ``obj_keep``: positions in the row) out of
+        the union ``gap_union`` + ``obj_union`` whose ``points`` and features ``X`` were computed."""
+        geometry = self.row(row)
+        n_gaps, n_obj = len(gap_union), len(obj_union)
         gaps = np.concatenate(
             [self.space.gap_table.index[geometry.gap_rows[gap_union]], np.zeros(n_obj, dtype=int)]
         )
-        obstacles = np.concatenate([np.full(n_gaps, -1), members]).astype(int)
+        obstacles = np.concatenate([np.full(n_gaps, -1), geometry.members[obj_union]]).astype(int)
         kinds = ("gap",) * n_gaps + ("object",) * n_obj
         at = {g: k for k, g in enumerate(gap_union)}
         at_obj = {o: n_gaps + k for k, o in enumerate(obj_union)}
         result = []
-        for b in range(len(hands)):
+        for b in range(len(points)):
             keep = np.array(
                 [at[g] for g in sorted(gap_keep[b])] + [at_obj[o] for o in sorted(obj_keep[b])], dtype=int
             )

@@ -289,8 +289,9 @@ def optimise(
             optimise_s=time.perf_counter() - started,
         )
     run = _Run(scenario, pool, budget, start)
-    (outcome,) = outcomes = run.roll([initial])
-    run.settle([initial], outcomes, [0])
+    outcomes = run.roll([initial])
+    run.settle([initial], outcomes, [0])  # may replace the outcome with its verification's
+    (outcome,) = outcomes
     result = StoResult(
         initial,
         outcome,

@@ -36,7 +36,7 @@ from hlp_drake.plotting import new_figure, save_png
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene, SceneObject
 from hlp_drake.systems.perception.accuracy import match_objects, perception_record, same_decisions
-from hlp_drake.systems.perception.cameras import CameraSettings, PerceptionConfig
+from hlp_drake.systems.perception.cameras import CameraConfig, PerceptionConfig
 from hlp_drake.systems.perception.system import ScenePerception
 from hlp_drake.systems.scenario import Scenario
 from hlp_drake.systems.world.world import make_world_diagram
@@ -77,7 +77,7 @@ def jitter(scene: Scene, seed: int) -> Scene:
     return replace(scene, table=table, target=target, obstacles=tuple(obstacles))
 
 
-def perceive_scene(kind_seed: tuple[int, int], camera: CameraSettings, models) -> tuple[dict, list[dict]]:
+def perceive_scene(kind_seed: tuple[int, int], camera: CameraConfig, models) -> tuple[dict, list[dict]]:
     """One scene's frame: its summary row and its objects' error rows."""
     objects, seed = kind_seed
     scene = generate_scene("gen2", seed, objects)
@@ -173,7 +173,7 @@ def main() -> None:
     args = parser.parse_args()
     if len(args.scenes) != len(args.objects):
         parser.error("give one --scenes per --objects")
-    camera = CameraSettings(width=args.width, height=args.height)
+    camera = CameraConfig(width=args.width, height=args.height)
     if args.roll is not None:
         roll = math.radians(args.roll)
         camera = replace(camera, up=(math.cos(roll), math.sin(roll), 0.0))

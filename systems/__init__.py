@@ -6,6 +6,7 @@ the scene from their ``scene`` input port (``SceneFromPlant`` reads it from a pl
 (``RolloutPool``) belong to the caller, who closes them.
 """
 
+from hlp_drake.systems.execution.command import GraspConfig
 from hlp_drake.systems.execution.diagram import ExecutionDiagram, make_execution_diagram
 from hlp_drake.systems.execution.meshcat_view import draw_perception, draw_plan, frame_table
 from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
@@ -18,7 +19,7 @@ from hlp_drake.systems.optimiser.pool import RolloutPool, SceneRollouts
 from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
 from hlp_drake.systems.optimiser.system import StochasticTrajectoryOptimiser
 from hlp_drake.systems.perception.accuracy import perception_record
-from hlp_drake.systems.perception.cameras import CameraSettings, PerceptionConfig
+from hlp_drake.systems.perception.cameras import CameraConfig, PerceptionConfig
 from hlp_drake.systems.perception.perception import PerceivedObject, Perception, perceive
 from hlp_drake.systems.perception.system import ScenePerception, add_scene_perception, perceive_world
 from hlp_drake.systems.planning.diagram import first_rollout, initial_sequence, make_planning_diagram
@@ -26,8 +27,7 @@ from hlp_drake.systems.planning.ik import KeypointIk
 from hlp_drake.systems.planning.keyframes import Keyframes, PlanningModel
 from hlp_drake.systems.planning.planners import HlpPlannerSystem, StraightLinePlanSystem, straight_line_plan
 from hlp_drake.systems.planning.transfer import RobotPlanTransfer
-from hlp_drake.systems.scenario import PlannerSettings, Scenario, load_scenario
-from hlp_drake.systems.world.config import GraspConfig
+from hlp_drake.systems.scenario import PlannerChoiceConfig, Scenario, load_scenario
 from hlp_drake.systems.world.robot import (
     ACTUATED_JOINTS,
     ARM_JOINTS,
@@ -80,7 +80,7 @@ __all__ = [
     "ROBOT_ACTIONS",
     "ROBOT_URL",
     "TCP_FRAME",
-    "CameraSettings",
+    "CameraConfig",
     "ControlSequence",
     "ExecutionDiagram",
     "ExecutionResult",
@@ -92,7 +92,7 @@ __all__ = [
     "PerceivedObject",
     "Perception",
     "PerceptionConfig",
-    "PlannerSettings",
+    "PlannerChoiceConfig",
     "PlanningModel",
     "PushRules",
     "RecedingHorizonController",

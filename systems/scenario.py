@@ -2,9 +2,12 @@
 
 A frozen dataclass tree (the pattern of manipulation's ``Scenario``): the scene, the planner, the
 plant and contact settings, how the scene becomes bodies, the robot's controller, keypoint IK,
-motion timing, the push transfer's margins, the optimiser and the grasp. Loaded once with Drake's
-typed loader (``load_scenario``; problems are located one-line errors), it is passed to the
-builders at construction. ``Scenario.key`` (computed once) identifies it, e.g. for rollout worlds.
+motion timing, the push transfer's margins, the optimiser and the grasp. Each section is a config
+dataclass beside the code that uses it, each field with its range (``hlp_drake.ranges``). Loaded
+with Drake's typed loader (``load_scenario``; problems are located one-line errors), it is passed to
+the builders at construction. A ``Scenario`` is checked once, when it is made (in Python too, and by
+``dataclasses.replace``): one that exists can be used. ``Scenario.key`` (computed once) identifies
+it, e.g. for rollout worlds.
 
 A scenario file gives only what it changes; ``scene:`` is a scene in the format of a scene file (read
 whole)::
@@ -20,41 +23,43 @@ whole)::
 
 from __future__ import annotations
 
+import contextvars
 import hashlib
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydrake.multibody.plant import MultibodyPlantConfig
 
 from hlp_drake.documents import parse_yaml, read_document
 from hlp_drake.errors import HlpError
 from hlp_drake.planner.config import PlannerConfig
+from hlp_drake.ranges import config_problems
 from hlp_drake.scene.io import default_scene
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.validation import scene_problems
+from hlp_drake.systems.execution.command import GraspConfig
 from hlp_drake.systems.optimiser.config import ClosedLoopConfig, StoConfig
-from hlp_drake.systems.perception.cameras import PerceptionConfig
-from hlp_drake.systems.scenario_checks import check_scenario, scenario_problems
-from hlp_drake.systems.world.config import (
-    BodiesConfig,
-    ContactConfig,
-    ControlConfig,
-    GraspConfig,
-    IkConfig,
-    MotionConfig,
-    default_plant_config,
-)
+from hlp_drake.systems.perception.cameras import MAX_CAMERAS, PerceptionConfig, camera_pose
+from hlp_drake.systems.planning.ik import IkConfig, MotionConfig
+from hlp_drake.systems.world.scene_models import BodiesConfig, ContactConfig
 from hlp_drake.systems.world.uncertainty import UncertaintyConfig
+from hlp_drake.systems.world.world import PLANT_RANGES, ControlConfig, default_plant_config
 from hlp_drake.transfer.rules import TransferConfig
 from hlp_drake.typed_yaml import dump_typed, load_typed
 
 PLANNERS = ("hlp", "sto")
+MAX_WORLD_OBSTACLES = 100
+"""Most obstacles in a simulated world (the planner alone, ``hlp_drake.planner.plan``, takes a scene's
+10,000): 100 on a 2 m table took 0.6 GB and 2 min to plan, verify and execute here; 400, 2.7 GB and
+a minute per simulated second; 2,500, 10 GB before the plan."""
+_LOADING = contextvars.ContextVar("loading", default=False)
+"""True while ``load_scenario`` lays sources over each other: it checks the result once, naming them."""
 
 
 @dataclass(frozen=True)
-class PlannerSettings:
+class PlannerChoiceConfig:
     """Which plan initialises the optimiser.
 
     Attributes:
@@ -77,7 +82,8 @@ class PlannerSettings:
 @dataclass(frozen=True)
 class Scenario:
     """Everything a run depends on (see the module's docstring). Frozen: derive variants with
-    ``updated`` (YAML text) or ``dataclasses.replace``.
+    ``updated`` (YAML text) or ``dataclasses.replace``. Checked when made: settings out of range
+    raise ``HlpError`` (one line each).
 
     Attributes:
         scene: the table, start, target and obstacles (default: the bundled default scene).
@@ -99,8 +105,8 @@ class Scenario:
     """
 
     scene: Scene = field(default_factory=default_scene)
-    planner: PlannerSettings = field(default_factory=PlannerSettings)
-    plant: MultibodyPlantConfig = field(default_factory=default_plant_config)
+    planner: PlannerChoiceConfig = field(default_factory=PlannerChoiceConfig)
+    plant: Annotated[MultibodyPlantConfig, PLANT_RANGES] = field(default_factory=default_plant_config)
     contact: ContactConfig = field(default_factory=ContactConfig)
     bodies: BodiesConfig = field(default_factory=BodiesConfig)
     controller: ControlConfig = field(default_factory=ControlConfig)
@@ -112,6 +118,34 @@ class Scenario:
     perception: PerceptionConfig = field(default_factory=PerceptionConfig)
     closed_loop: ClosedLoopConfig = field(default_factory=ClosedLoopConfig)
     uncertainty: UncertaintyConfig = field(default_factory=UncertaintyConfig)
+
+    def __post_init__(self) -> None:
+        """Refuse settings that cannot be used (the scene is checked on its own, ``validate_scene``).
+
+        Raises:
+            HlpError: one line per problem (``config_problems``), e.g. "optimiser.samples must be
+                between 1 and 1000, got 0".
+        """
+        if not _LOADING.get():
+            problems = config_problems(self)
+            if problems:
+                raise HlpError(*problems)
+
+    def problems(self, where: str = "") -> list[str]:
+        """The rules across sections: the world's obstacles, and the cameras' poses over the scene's table."""
+        problems = []
+        obstacles = getattr(self.scene, "obstacles", ())
+        if isinstance(obstacles, tuple | list) and len(obstacles) > MAX_WORLD_OBSTACLES:
+            problems.append(
+                f"scene: {len(obstacles)} obstacles, more than the {MAX_WORLD_OBSTACLES} a simulated world "
+                "takes (hlp_drake.planner.plan alone takes more)"
+            )
+        for i, camera in enumerate(self.perception.cameras[:MAX_CAMERAS]):
+            try:
+                camera_pose(camera, self.scene)
+            except (ValueError, RuntimeError) as error:  # RuntimeError: Drake's, e.g. a pose of NaN
+                problems.append(f"perception.cameras[{i}]: {str(error).splitlines()[0]}")
+        return problems
 
     @cached_property
     def yaml(self) -> str:
@@ -145,15 +179,20 @@ def load_scenario(
             know or a value of the wrong type, or a value out of range; one line per problem, each
             naming the file (or ``where``) and the field.
     """
-    scenario = Scenario() if defaults is None else defaults
     sources: list[tuple[str, str]] = []
     if filename is not None:
         sources.append((str(filename), read_document(filename, missing="scenario file not found")))
     if data is not None:
         sources.append((where or "overrides", data))
-    for name, text in sources:
-        scenario = load_typed(Scenario, parse_yaml(text, name), defaults=scenario, where=name, top="scenario")
-    problems = [f"scene: {p}" for p in scene_problems(scenario.scene)] + scenario_problems(scenario)
+    loading = _LOADING.set(True)
+    try:
+        scenario = Scenario() if defaults is None else defaults
+        for name, text in sources:
+            document = parse_yaml(text, name)
+            scenario = load_typed(Scenario, document, defaults=scenario, where=name, top="scenario")
+    finally:
+        _LOADING.reset(loading)
+    problems = [f"scene: {p}" for p in scene_problems(scenario.scene)] + config_problems(scenario)
     if problems:
         where = " + ".join(name for name, _ in sources) or "defaults"
         raise HlpError(*(f"{where}: {p}" for p in problems))
@@ -175,15 +214,21 @@ def with_conditions(
     Raises:
         HlpError: the settings do not fit together so (e.g. a camera source without a camera).
     """
+    changes = {}
     if execution is not None:
-        scenario = replace(scenario, closed_loop=replace(scenario.closed_loop, enabled=execution == "closed"))
+        changes["closed_loop"] = replace(scenario.closed_loop, enabled=execution == "closed")
     if uncertainty is not None:
-        scenario = replace(
-            scenario, uncertainty=replace(scenario.uncertainty, enabled=True, seed=int(uncertainty))
-        )
+        changes["uncertainty"] = replace(scenario.uncertainty, enabled=True, seed=int(uncertainty))
     if perception is not None:
-        scenario = replace(scenario, perception=replace(scenario.perception, source=perception))
-    return check_scenario(scenario)
+        changes["perception"] = replace(scenario.perception, source=perception)
+    return replace(scenario, **changes) if changes else scenario  # checked as it is made
 
 
-__all__ = ["PLANNERS", "PlannerSettings", "Scenario", "load_scenario", "with_conditions"]
+__all__ = [
+    "MAX_WORLD_OBSTACLES",
+    "PLANNERS",
+    "PlannerChoiceConfig",
+    "Scenario",
+    "load_scenario",
+    "with_conditions",
+]

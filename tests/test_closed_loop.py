@@ -19,7 +19,7 @@ from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
 from hlp_drake.systems.planning.diagram import ObservedScenePlanner
 from hlp_drake.systems.scenario import Scenario
 from hlp_drake.systems.world.robot import ROBOT_MODEL_NAME
-from hlp_drake.systems.world.uncertainty import UncertaintyConfig, sample_model_error
+from hlp_drake.systems.world.uncertainty import UncertaintyConfig, sample_perturbation
 from hlp_drake.systems.world.world import make_world_diagram, world_plant
 
 SETTINGS = (
@@ -80,9 +80,9 @@ def test_the_closed_loops_rollout_budget_ends_the_re_optimisations(scenario):
 def test_model_error_is_seeded_per_scene_and_changes_the_world(scenario):
     scene = scenario.scene
     config = UncertaintyConfig(enabled=True, seed=3)
-    error = sample_model_error(config, scene)
-    assert error == sample_model_error(config, scene)
-    assert error != sample_model_error(UncertaintyConfig(enabled=True, seed=4), scene)
+    error = sample_perturbation(config, scene)
+    assert error == sample_perturbation(config, scene)
+    assert error != sample_perturbation(UncertaintyConfig(enabled=True, seed=4), scene)
     offsets = np.array([[e.dx, e.dy] for e in error.objects.values()])
     assert 0 < np.max(np.abs(offsets)) < 5 * config.position_sigma
     assert all(0.5 <= e.mass_scale <= 2.0 and 0.7 <= e.friction_scale <= 1.3 for e in error.objects.values())

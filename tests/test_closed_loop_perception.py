@@ -18,7 +18,7 @@ from hlp_drake.systems.optimiser.cost import Prediction, RolloutOutcome
 from hlp_drake.systems.optimiser.optimiser import StoResult
 from hlp_drake.systems.optimiser.pool import RolloutPool
 from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
-from hlp_drake.systems.perception.cameras import CameraSettings, PerceptionConfig
+from hlp_drake.systems.perception.cameras import CameraConfig, PerceptionConfig
 from hlp_drake.systems.perception.perception import Perception, unperceived_scene
 from hlp_drake.systems.scenario import Scenario
 from hlp_drake.systems.world.world import make_world_diagram, world_plant
@@ -27,7 +27,7 @@ SETTINGS = (
     "optimiser: {samples: 2, workers: 1, verify: false}\n"
     "closed_loop: {replan_period: 0.4, iterations: 1, rollouts: 2}\n"
 )
-CAMERA = CameraSettings(width=320, height=240, depth_noise=0.001, dropout=0.01, seed=4)
+CAMERA = CameraConfig(width=320, height=240, depth_noise=0.001, dropout=0.01, seed=4)
 
 
 @pytest.fixture(scope="module")

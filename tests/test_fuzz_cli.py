@@ -110,7 +110,7 @@ def _check_scenario(text: str) -> None:
     checks of the intrinsics and depth range pass) and its model error can be drawn."""
     from hlp_drake.systems.perception.cameras import camera_pose, render_cameras
     from hlp_drake.systems.scenario import load_scenario
-    from hlp_drake.systems.world.uncertainty import sample_model_error
+    from hlp_drake.systems.world.uncertainty import sample_perturbation
 
     STATS["scenario files"] += 1
     try:
@@ -122,7 +122,7 @@ def _check_scenario(text: str) -> None:
     for camera in scenario.perception.cameras:
         camera_pose(camera, scenario.scene)
         render_cameras(camera)
-    sample_model_error(scenario.uncertainty, scenario.scene)
+    sample_perturbation(scenario.uncertainty, scenario.scene)
 
 
 @pytest.mark.parametrize("profile", PROFILES)

@@ -17,7 +17,7 @@ from hlp_drake.systems.perception.cameras import (
     ROBOT_LABEL,
     TABLE_LABEL,
     TARGET_LABEL,
-    CameraSettings,
+    CameraConfig,
     DepthNoise,
     PerceptionConfig,
     camera_pose,
@@ -25,10 +25,10 @@ from hlp_drake.systems.perception.cameras import (
 from hlp_drake.systems.perception.depth_points import view_points
 from hlp_drake.systems.perception.system import ScenePerception, add_scene_perception, perceive_world
 from hlp_drake.systems.scenario import Scenario, load_scenario
-from hlp_drake.systems.world.uncertainty import ModelError, ObjectError
+from hlp_drake.systems.world.uncertainty import ObjectPerturbation, WorldPerturbation
 from hlp_drake.systems.world.world import make_world_diagram, world_plant
 
-CAMERA = CameraSettings(width=320, height=240, depth_noise=0.001, dropout=0.01, seed=4)
+CAMERA = CameraConfig(width=320, height=240, depth_noise=0.001, dropout=0.01, seed=4)
 SCENE = Scene(
     name="perceived",
     table=Table(length=0.8, width=0.9, height=0.75),
@@ -204,7 +204,7 @@ def test_perception_record_reports_missed_and_invented_objects(frame):
 
 
 def test_depth_noise_is_seeded_by_the_time_and_drops_the_asked_share():
-    camera = CameraSettings(width=160, height=120, depth_noise=0.002, dropout=0.1, seed=7)
+    camera = CameraConfig(width=160, height=120, depth_noise=0.002, dropout=0.1, seed=7)
     block = DepthNoise(camera)
     context = block.CreateDefaultContext()
     clean = ImageDepth32F(160, 120)
@@ -225,15 +225,15 @@ def test_depth_noise_is_seeded_by_the_time_and_drops_the_asked_share():
 
 
 def test_camera_pose_looks_at_the_table_and_rejects_a_parallel_up():
-    pose = camera_pose(CameraSettings(up=(1.0, 0.0, 0.0)), SCENE)
+    pose = camera_pose(CameraConfig(up=(1.0, 0.0, 0.0)), SCENE)
     np.testing.assert_allclose(pose.translation(), [0.4, 0.0, 0.75 + 1.6])
     np.testing.assert_allclose(pose.rotation().matrix()[:, 2], [0, 0, -1], atol=1e-12)  # looking down
     np.testing.assert_allclose(pose.rotation().matrix()[:, 1], [-1, 0, 0], atol=1e-12)  # +x up the image
-    turned = camera_pose(CameraSettings(), SCENE).rotation().matrix()  # the default: 3 degrees off the grid
+    turned = camera_pose(CameraConfig(), SCENE).rotation().matrix()  # the default: 3 degrees off the grid
     np.testing.assert_allclose(turned[:, 2], [0, 0, -1], atol=1e-12)
     assert math.degrees(math.atan2(-turned[1, 1], -turned[0, 1])) == pytest.approx(3.0, abs=0.01)
     with pytest.raises(ValueError, match="parallel to its view"):
-        camera_pose(CameraSettings(up=(0.0, 0.0, 1.0)), SCENE)
+        camera_pose(CameraConfig(up=(0.0, 0.0, 1.0)), SCENE)
 
 
 def test_the_scenario_file_sets_the_cameras_and_the_perception_block_follows_it():
@@ -244,7 +244,7 @@ def test_the_scenario_file_sets_the_cameras_and_the_perception_block_follows_it(
         "top",
         "side",
     ]
-    assert scenario.perception.cameras[0].depth_noise == CameraSettings().depth_noise
+    assert scenario.perception.cameras[0].depth_noise == CameraConfig().depth_noise
     block = ScenePerception(scenario)
     ports = {block.get_input_port(i).get_name() for i in range(block.num_input_ports())}
     assert ports == {
@@ -297,8 +297,8 @@ def test_an_object_partly_hidden_by_a_taller_one_is_found_with_the_outline_that_
 
 def test_two_tilted_cameras_frames_are_perceived_together():
     cameras = (
-        CameraSettings(name="left", width=320, height=240, position=(0.0, 0.5, 1.5), look_at=(0.0, 0.1, 0.0)),
-        CameraSettings(
+        CameraConfig(name="left", width=320, height=240, position=(0.0, 0.5, 1.5), look_at=(0.0, 0.1, 0.0)),
+        CameraConfig(
             name="right", width=320, height=240, position=(0.0, -0.5, 1.5), look_at=(0.0, -0.1, 0.0), seed=1
         ),
     )
@@ -340,7 +340,9 @@ def test_the_perceived_scene_follows_an_object_moved_in_the_plant():
 
 def test_perceive_world_sees_the_true_world_not_the_believed_scene():
     """The one frame an open-loop run plans on: the world's cameras at the start, with its model error."""
-    error = ModelError({"can": ObjectError(dx=0.04, dy=-0.03, dyaw=0.0, mass_scale=1.0, friction_scale=1.0)})
+    error = WorldPerturbation(
+        {"can": ObjectPerturbation(dx=0.04, dy=-0.03, dyaw=0.0, mass_scale=1.0, friction_scale=1.0)}
+    )
     believed, _ = perceive_world(SCENARIO)
     true, seconds = perceive_world(SCENARIO, model_error=error)
     assert believed.ok and true.ok and seconds > 0.0

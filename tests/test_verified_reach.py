@@ -12,13 +12,13 @@ from test_closed_loop import forward  # the base moving along x
 
 from hlp_drake.run_scene import DEFAULT_SCENE
 from hlp_drake.scene.io import load_scene
+from hlp_drake.systems.execution.command import EXECUTION_SETTLE_S
 from hlp_drake.systems.execution.run import plan_and_execute, verified_reach
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.optimiser import StoResult
 from hlp_drake.systems.optimiser.pool import RolloutPool
 from hlp_drake.systems.optimiser.rollout_world import RolloutStart, RolloutWorld
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.world.config import EXECUTION_SETTLE_S
 from hlp_drake.systems.world.world import add_position_trajectory, make_world_diagram, world_plant
 
 

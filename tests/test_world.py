@@ -464,41 +464,27 @@ def test_a_camera_source_without_a_camera_is_refused_whichever_way_it_is_asked_f
         scenario_yamls(no_cameras, perception="camera")
 
 
-def test_a_scenario_made_in_python_is_checked_by_the_builders_and_blocks():
-    from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
-    from hlp_drake.systems.optimiser.system import StochasticTrajectoryOptimiser
-    from hlp_drake.systems.perception.cameras import CameraSettings, PerceptionConfig
-    from hlp_drake.systems.perception.system import ScenePerception
-    from hlp_drake.systems.planning.diagram import make_planning_diagram
-    from hlp_drake.systems.planning.ik import KeypointIk
-    from hlp_drake.systems.planning.transfer import RobotPlanTransfer
+def test_a_scenario_made_in_python_is_checked_as_it_is_made_so_no_builder_gets_a_bad_one():
+    from hlp_drake.systems.perception.cameras import CameraConfig, PerceptionConfig
 
-    bad = Scenario(perception=PerceptionConfig(source="camera", cameras=(CameraSettings(width=0),)))
-    for build in (
-        make_world_diagram,
-        make_planning_diagram,
-        ScenePerception,
-        KeypointIk,
-        RobotPlanTransfer,
-        lambda scenario: StochasticTrajectoryOptimiser(scenario, pool=None),
-        lambda scenario: RecedingHorizonController(scenario, plant=None, pool=None),
-    ):
-        with pytest.raises(HlpError, match=r"perception\.cameras\[0\]\.width must be between 8 and 4096"):
-            build(bad)
-    nan = Scenario(perception=PerceptionConfig(cameras=(CameraSettings(position=(math.nan, 0.0, 1.6)),)))
+    bad = PerceptionConfig(source="camera", cameras=(CameraConfig(width=0),))
+    with pytest.raises(HlpError, match=r"perception\.cameras\[0\]\.width must be between 8 and 4096"):
+        Scenario(perception=bad)
+    with pytest.raises(HlpError, match=r"perception\.cameras\[0\]\.width must be between 8 and 4096"):
+        replace(Scenario(), perception=bad)  # a variant is made too
+    nan = PerceptionConfig(cameras=(CameraConfig(position=(math.nan, 0.0, 1.6)),))
     with pytest.raises(HlpError, match=r"perception\.cameras\[0\]\.position must be finite"):
-        make_world_diagram(nan)  # the loader refuses NaN itself; a scenario made in Python is checked here
+        Scenario(perception=nan)  # the loader refuses NaN itself; a scenario made in Python is checked here
 
 
 def test_a_scene_of_more_obstacles_than_a_world_takes_is_refused_before_any_is_built():
     from hlp_drake.scene.model import SceneObject
-    from hlp_drake.systems.scenario_checks import MAX_WORLD_OBSTACLES
+    from hlp_drake.systems.scenario import MAX_WORLD_OBSTACLES
 
     scene = load_scenario().scene
     crowd = tuple(
         SceneObject(f"o{i}", "box", 0.05 + 0.02 * (i % 30), -0.45 + 0.03 * (i // 30), (0.01, 0.01, 0.05))
         for i in range(MAX_WORLD_OBSTACLES + 1)
     )
-    crowded = replace(Scenario(), scene=replace(scene, obstacles=crowd))
     with pytest.raises(HlpError, match=r"scene: 101 obstacles, more than the 100 a simulated world takes"):
-        make_world_diagram(crowded)
+        replace(Scenario(), scene=replace(scene, obstacles=crowd))

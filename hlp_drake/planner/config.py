@@ -1,12 +1,36 @@
-"""Typed settings of the human-like planner."""
+"""Typed settings of the human-like planner, each with its range (``hlp_drake.ranges``)."""
 
 from __future__ import annotations
 
 import typing
 from dataclasses import dataclass
+from typing import Annotated
 
 from hlp_drake.documents import brief
+from hlp_drake.ranges import Rule
 from hlp_drake.segmentation.modes import Mode
+
+
+def _is_number(value: object, upper: float = 1e6) -> bool:
+    """Whether ``value`` is a number from 0 to ``upper`` (not a bool; NaN is not)."""
+    return isinstance(value, int | float) and not isinstance(value, bool) and 0.0 <= value <= upper
+
+
+COUNT = Rule(
+    lambda v: isinstance(v, int) and not isinstance(v, bool) and 1 <= v <= 1000,
+    "{where} must be an integer between 1 and 1000, got {value}",
+    brief,
+)
+"""A count of candidates, paths or plans: 1 to 1000."""
+NUMBER = Rule(_is_number, "{where} must be a finite number in range, got {value}", brief)
+"""A length, evidence or weight: 0 to 1e6."""
+SHARE = Rule(lambda v: _is_number(v, 1.0), NUMBER.message, brief)
+POSITIVE_NUMBER = Rule(lambda v: _is_number(v) and v > 0.0, NUMBER.message, brief)
+MODE = Rule(
+    lambda v: v in typing.get_args(Mode),
+    f"{{where}} must be one of {', '.join(typing.get_args(Mode))}, got {{value}}",
+    brief,
+)
 
 
 @dataclass(frozen=True)
@@ -42,38 +66,15 @@ class PlannerConfig:
             keypoints inside obstacles (``row_plan.segment_collisions``).
     """
 
-    mode: Mode = "fixed"
-    max_gaps_per_row: int = 3
-    max_objects_per_row: int = 2
-    max_paths: int = 24
-    min_gap_width: float = 0.0
-    arm_band: float = 0.025
-    classify_per_row: int = 6
-    min_evidence: float = 0.05
-    hand_width: float | None = None
-    beam: int = 3
-    min_share: float = 0.05
-    collision_weight: float = 0.0
-
-
-def planner_config_problems(config: PlannerConfig) -> list[str]:
-    """Why ``config`` cannot be used (empty when it is fine): counts between 1 and 1000, lengths
-    and weights finite and non-negative, shares in [0, 1]."""
-    problems = []
-    for name in ("max_gaps_per_row", "max_objects_per_row", "max_paths", "classify_per_row", "beam"):
-        value = getattr(config, name)
-        if not isinstance(value, int) or isinstance(value, bool) or not 1 <= value <= 1000:
-            problems.append(f"{name} must be an integer between 1 and 1000, got {brief(value)}")
-    numbers = {
-        name: getattr(config, name)
-        for name in ("min_gap_width", "arm_band", "min_evidence", "min_share", "collision_weight")
-    }
-    if config.hand_width is not None:
-        numbers["hand_width"] = config.hand_width
-    for name, value in numbers.items():
-        ok = isinstance(value, int | float) and not isinstance(value, bool) and 0.0 <= value <= 1e6
-        if not ok or (name == "min_share" and value > 1.0) or (name == "hand_width" and value <= 0.0):
-            problems.append(f"{name} must be a finite number in range, got {brief(value)}")
-    if config.mode not in typing.get_args(Mode):
-        problems.append(f"mode must be one of {', '.join(typing.get_args(Mode))}, got {brief(config.mode)}")
-    return problems
+    mode: Annotated[Mode, MODE] = "fixed"
+    max_gaps_per_row: Annotated[int, COUNT] = 3
+    max_objects_per_row: Annotated[int, COUNT] = 2
+    max_paths: Annotated[int, COUNT] = 24
+    min_gap_width: Annotated[float, NUMBER] = 0.0
+    arm_band: Annotated[float, NUMBER] = 0.025
+    classify_per_row: Annotated[int, COUNT] = 6
+    min_evidence: Annotated[float, NUMBER] = 0.05
+    hand_width: Annotated[float | None, POSITIVE_NUMBER] = None
+    beam: Annotated[int, COUNT] = 3
+    min_share: Annotated[float, SHARE] = 0.05
+    collision_weight: Annotated[float, NUMBER] = 0.0

@@ -12,10 +12,11 @@ from hlp_drake.features.row_choice import HUMAN_HAND_WIDTH
 from hlp_drake.learners.models import DecisionModels
 from hlp_drake.planner.blas import single_blas_thread
 from hlp_drake.planner.candidates import classify, enumerate_paths, informed, row_candidates, segment_scores
-from hlp_drake.planner.config import PlannerConfig, planner_config_problems
+from hlp_drake.planner.config import PlannerConfig
 from hlp_drake.planner.plan import HighLevelPlan, PlanCandidate, PlanKeypoint
 from hlp_drake.planner.rollout import PrefixTree, arm_configurations, expected_collisions, path_keypoints
 from hlp_drake.planner.row_plan import plan_rows
+from hlp_drake.ranges import config_problems
 from hlp_drake.scene.generators import VR_TABLE
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.validation import scene_problems
@@ -61,10 +62,8 @@ def plan(
     if problems:
         return _no_plan(scene, "invalid scene: " + "; ".join(SceneError(*problems).problems), started)
     config = config or PlannerConfig(mode=models.mode_)
-    if not isinstance(config, PlannerConfig) or planner_config_problems(config):
-        reasons = (
-            planner_config_problems(config) if isinstance(config, PlannerConfig) else ["not a PlannerConfig"]
-        )
+    reasons = config_problems(config) if isinstance(config, PlannerConfig) else ["not a PlannerConfig"]
+    if reasons:
         return _no_plan(scene, "invalid planner settings: " + "; ".join(reasons), started)
     if config.mode != models.mode_:
         return _no_plan(

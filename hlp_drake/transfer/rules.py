@@ -11,16 +11,22 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from typing import Annotated
 
 import numpy as np
 
+from hlp_drake.ranges import NonNegativeFloat, Positive, PositiveFloat
+
+MIN_TRAVEL_STEP = 1e-4
+"""m: the finest step pushes and ways are measured in (their samples grow as its inverse)."""
 SIZE_RESOLUTION = 0.005
 """The robot's sizes are rounded up to this (m): the transfer's clearances are set to 5 mm."""
 
 
 @dataclass(frozen=True)
 class TransferConfig:
-    """The push transfer's margins and rules (m, rad), beside the robot's sizes (``GripperGeometry``).
+    """The push transfer's margins and rules (m, rad), beside the robot's sizes (``GripperGeometry``):
+    every margin may be 0, every length must be > 0.
 
     Attributes:
         forward_margin: free approach between the fingertips and an obstacle's face at the start of
@@ -43,20 +49,20 @@ class TransferConfig:
         gripper_behind: the gripper's footprint at that waypoint reaches this far behind the tcp.
     """
 
-    forward_margin: float = 0.03
-    sideways_margin: float = 0.02
-    corridor_margin: float = 0.025
-    min_push_travel: float = 0.01
-    edge_margin: float = 0.03
-    object_margin: float = 0.01
-    travel_step: float = 0.005
-    transit_margin: float = 0.025
-    wrist_shadow: float = 0.21
-    shadow_margin: float = 0.015
-    path_clearance: float = 0.02
-    approach_gap: float = 0.05
-    approach_angle: float = math.radians(15.0)
-    gripper_behind: float = 0.05
+    forward_margin: NonNegativeFloat = 0.03
+    sideways_margin: NonNegativeFloat = 0.02
+    corridor_margin: NonNegativeFloat = 0.025
+    min_push_travel: PositiveFloat = 0.01
+    edge_margin: NonNegativeFloat = 0.03
+    object_margin: NonNegativeFloat = 0.01
+    travel_step: Annotated[float, Positive(MIN_TRAVEL_STEP, 0.1)] = 0.005
+    transit_margin: NonNegativeFloat = 0.025
+    wrist_shadow: PositiveFloat = 0.21
+    shadow_margin: NonNegativeFloat = 0.015
+    path_clearance: PositiveFloat = 0.02
+    approach_gap: PositiveFloat = 0.05
+    approach_angle: Annotated[float, Positive()] = math.radians(15.0)
+    gripper_behind: PositiveFloat = 0.05
 
 
 @dataclass(frozen=True)

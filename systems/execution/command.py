@@ -1,17 +1,19 @@
 """How an execution commands the robot: open loop (a ``TrajectorySource``) or closed loop (a
-``RecedingHorizonController``), behind one interface the execution's reach and grasp use."""
+``RecedingHorizonController``), behind one interface the execution's reach and grasp use; the
+grasp's settings (a ``Scenario``'s ``grasp``, ``GraspConfig``)."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Annotated
 
 import numpy as np
 from pydrake.math import RotationMatrix
 from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.solvers import Solve
 
+from hlp_drake.ranges import MAX_DURATION, NonNegativeFloat, Positive, PositiveFloat
 from hlp_drake.systems.optimiser.control_sequence import BASE_COLUMNS, ControlSequence
-from hlp_drake.systems.world.config import EXECUTION_SETTLE_S, GraspConfig
 from hlp_drake.systems.world.robot import GRIPPER_CLOSED, GRIPPER_JOINTS, GRIPPER_MIMIC_JOINTS, TCP_FRAME
 from hlp_drake.systems.world.scene_models import object_body
 from hlp_drake.systems.world.start_pose import ik_solver_options, kinematic_robot, robot_position_names
@@ -22,6 +24,30 @@ if TYPE_CHECKING:
     from pydrake.systems.primitives import TrajectorySource
 
     from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
+
+EXECUTION_SETTLE_S = 1.0
+"""Simulated time the execution lets pass after the reach's trajectory ends before checking it, s."""
+PHASE = Positive(upper=MAX_DURATION)
+"""The time of a grasp phase, s."""
+
+
+@dataclass(frozen=True)
+class GraspConfig:
+    """The grasp after a successful reach: close the fingers, then lift the tcp straight up.
+
+    Attributes:
+        close_s: time to close the fingers, s.
+        lift_height: how far the tcp rises, m.
+        lift_s: time of the lift, s.
+        hold_s: time held at the top before the check, s.
+        held_height: the grasp held when the target rose at least this far, m.
+    """
+
+    close_s: Annotated[float, PHASE] = 1.0
+    lift_height: NonNegativeFloat = 0.10
+    lift_s: Annotated[float, PHASE] = 1.5
+    hold_s: Annotated[float, Positive(upper=MAX_DURATION, zero_ok=True)] = 0.5
+    held_height: PositiveFloat = 0.05
 
 
 class OpenLoopCommand:
@@ -68,7 +94,7 @@ class ClosedLoopCommand:
         self._controller.command(root_context, sequence, t0)
 
 
-__all__ = ["ClosedLoopCommand", "OpenLoopCommand"]
+__all__ = ["EXECUTION_SETTLE_S", "ClosedLoopCommand", "GraspConfig", "OpenLoopCommand"]
 
 
 # The grasp after a reach: close the fingers round the target, lift it, and check that it held.

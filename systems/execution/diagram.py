@@ -28,7 +28,7 @@ from hlp_drake.systems.optimiser.pool import RolloutPool
 from hlp_drake.systems.perception.system import ScenePerception, add_scene_perception
 from hlp_drake.systems.planning.diagram import ObservedScenePlanner, make_planning_diagram
 from hlp_drake.systems.world.scene_source import SCENE_PORT, SceneFromPlant
-from hlp_drake.systems.world.uncertainty import sample_model_error
+from hlp_drake.systems.world.uncertainty import sample_perturbation
 from hlp_drake.systems.world.world import (
     add_position_trajectory,
     connect_robot_command,
@@ -42,7 +42,7 @@ if TYPE_CHECKING:
     from pydrake.systems.primitives import TrajectorySource
 
     from hlp_drake.systems.scenario import Scenario
-    from hlp_drake.systems.world.uncertainty import ModelError
+    from hlp_drake.systems.world.uncertainty import WorldPerturbation
 
 
 @dataclass(frozen=True)
@@ -58,7 +58,7 @@ class ExecutionDiagram:
     planning: Diagram
     source: SceneFromPlant | ScenePerception
     planned_scene: Scene | None
-    model_error: ModelError | None
+    model_error: WorldPerturbation | None
     controller: RecedingHorizonController | None = None
     trajectory_source: TrajectorySource | None = None
 
@@ -73,9 +73,9 @@ class ExecutionDiagram:
         return isinstance(self.source, ScenePerception)
 
 
-def execution_model_error(scenario: Scenario) -> ModelError | None:
+def execution_model_error(scenario: Scenario) -> WorldPerturbation | None:
     """The executed world's seeded differences from ``scenario`` (``uncertainty``), if enabled."""
-    return sample_model_error(scenario.uncertainty, scenario.scene) if scenario.uncertainty.enabled else None
+    return sample_perturbation(scenario.uncertainty, scenario.scene) if scenario.uncertainty.enabled else None
 
 
 def make_execution_diagram(

@@ -52,7 +52,6 @@ from hlp_drake.systems.optimiser.optimiser import EMPTY_RESULT, Budget, StoResul
 from hlp_drake.systems.optimiser.rollout_world import RolloutStart
 from hlp_drake.systems.perception.accuracy import largest_displacement
 from hlp_drake.systems.perception.perception import Perception
-from hlp_drake.systems.scenario_checks import check_scenario
 from hlp_drake.systems.world.robot import ROBOT_MODEL_NAME
 from hlp_drake.systems.world.scene_source import declare_scene_input_port, scene_input, with_scene
 
@@ -140,7 +139,6 @@ class RecedingHorizonController(LeafSystem):
         initialiser: Initialiser | None = None,
     ) -> None:
         super().__init__()
-        check_scenario(scenario)
         self._scenario, self._pool, self._initialiser = scenario, pool, initialiser
         self._plant = plant
         objects = () if scenario.perception.source == "camera" else scenario.scene.objects

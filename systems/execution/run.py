@@ -24,6 +24,7 @@ from hlp_drake.learners.models import DecisionModels
 from hlp_drake.planner import HighLevelPlan
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.execution.command import (
+    EXECUTION_SETTLE_S,
     ClosedLoopCommand,
     OpenLoopCommand,
     advance_through_reach,
@@ -42,7 +43,6 @@ from hlp_drake.systems.optimiser.rollout_world import simulation_failure
 from hlp_drake.systems.perception.accuracy import perception_record
 from hlp_drake.systems.perception.system import perceive_world
 from hlp_drake.systems.planning.keyframes import Keyframes
-from hlp_drake.systems.world.config import EXECUTION_SETTLE_S
 from hlp_drake.systems.world.robot import TCP_FRAME
 from hlp_drake.systems.world.scene_models import fallen_objects, object_planar_poses
 from hlp_drake.systems.world.scene_source import SCENE_PORT

@@ -13,8 +13,28 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Annotated, Literal
 
+from hlp_drake.ranges import (
+    MAX_DURATION,
+    MAX_TIME_STEP,
+    MIN_PERIOD,
+    MIN_TIME_STEP,
+    Count,
+    NonNegativeFloat,
+    Positive,
+    PositiveFloat,
+    Rule,
+)
+from hlp_drake.scene.generators import MAX_SEED
+
+MAX_WORKERS = 64
+"""Most rollout processes."""
+PERIOD = Positive(MIN_PERIOD, MAX_DURATION)
+"""A control step, sampling or re-planning period, s."""
+FRACTION = Rule(lambda v: 0.0 <= v <= 1.0, "{where} must be in [0, 1], got {value}")
+RIM_SPHERES = Rule(lambda v: not (v < 0 or v in (1, 2)), "{where} must be 0 or >= 3, got {value}")
+"""Spheres on a cylinder's rim: none, or at least 3."""
 UPDATES = ("greedy", "mppi")
 PERCEIVED_CHECKS = 2
 """``StoConfig.displaced_checks`` when it is None and the scene is perceived (``perception.source:
@@ -29,10 +49,10 @@ class BaseNoise:
     joint motion of the sequence being improved, so the whole gripper shifts in the table plane.
     """
 
-    vx: float = 0.04  # m/s
-    vy: float = 0.04  # m/s
-    yaw_rate: float = 0.02  # rad/s
-    end_fraction: float = 0.25
+    vx: NonNegativeFloat = 0.04  # m/s
+    vy: NonNegativeFloat = 0.04  # m/s
+    yaw_rate: NonNegativeFloat = 0.02  # rad/s
+    end_fraction: Annotated[float, FRACTION] = 0.25
     """Share of the noise's accumulated drift kept at the end of the sequence: the rest is taken out
     evenly over the steps, so a detour returns towards the end point the sequence aims at."""
 
@@ -55,17 +75,17 @@ class StoCost:
         effort_weight: per (rad/s)^2 or (m/s)^2, times seconds, of the commanded joint velocities.
     """
 
-    pregrasp_margin: float = 0.03
-    goal_weight: float = 2000.0
-    off_table: float = 300.0
-    table_contact: float = 300.0
-    force_limit: float = 60.0
-    force_weight: float = 50.0
-    disturbance_weight: float = 100.0
-    target_disturbance_weight: float = 1000.0
-    near_obstacle: float = 500.0
-    near_distance: float = 0.01
-    effort_weight: float = 0.05
+    pregrasp_margin: NonNegativeFloat = 0.03
+    goal_weight: NonNegativeFloat = 2000.0
+    off_table: NonNegativeFloat = 300.0
+    table_contact: NonNegativeFloat = 300.0
+    force_limit: NonNegativeFloat = 60.0
+    force_weight: NonNegativeFloat = 50.0
+    disturbance_weight: NonNegativeFloat = 100.0
+    target_disturbance_weight: NonNegativeFloat = 1000.0
+    near_obstacle: NonNegativeFloat = 500.0
+    near_distance: NonNegativeFloat = 0.01
+    effort_weight: NonNegativeFloat = 0.05
 
 
 @dataclass(frozen=True)
@@ -84,7 +104,7 @@ class RolloutTrims:
     """
 
     top_spheres: bool = False
-    rim_spheres: int = 4
+    rim_spheres: Annotated[int, RIM_SPHERES] = 4
     robot_self_contact: bool = False
     sampled_output_ports: bool = False
 
@@ -154,35 +174,42 @@ class StoConfig:
         displaced_yaw_sigma: see ``displaced_checks``, rad.
     """
 
-    samples: int = 8
-    max_iterations: int = 20
-    max_rollouts: int = 100
-    time_budget_s: float = 0.0
-    step_duration: float = 0.5
+    samples: Annotated[int, Count(1, 1000)] = 8
+    max_iterations: Annotated[int, Count(1, 10_000)] = 20
+    max_rollouts: Annotated[int, Count(1, 1_000_000)] = 100
+    time_budget_s: NonNegativeFloat = 0.0
+    step_duration: Annotated[float, PERIOD] = 0.5
     noise: BaseNoise = field(default_factory=BaseNoise)
     update: Literal["greedy", "mppi"] = "greedy"
-    mppi_temperature: float = 10.0
-    workers: int = 2
-    seed: int = 0
-    rollout_time_step: float = 0.02
+    mppi_temperature: PositiveFloat = 10.0
+    workers: Annotated[int, Count(1, MAX_WORKERS)] = 2
+    seed: Annotated[int, Count(0, MAX_SEED)] = 0
+    rollout_time_step: Annotated[float, Positive(MIN_TIME_STEP, MAX_TIME_STEP)] = 0.02
     rollout_trims: RolloutTrims = field(default_factory=RolloutTrims)
     reduced_model: bool = True
-    weld_clearance: float = 0.15
-    weld_lookahead: float = 0.5
-    weld_margin: float = 0.01
-    sleep_speed: float = 0.005
-    settle_s: float = 0.5
-    sample_period: float = 0.1
-    rollout_sample_period: float = 0.2
-    max_object_speed: float = 5.0
-    max_sink: float = 0.03
+    weld_clearance: PositiveFloat = 0.15
+    weld_lookahead: Annotated[float, Positive(upper=MAX_DURATION, zero_ok=True)] = 0.5
+    weld_margin: NonNegativeFloat = 0.01
+    sleep_speed: NonNegativeFloat = 0.005
+    settle_s: Annotated[float, Positive(upper=MAX_DURATION, zero_ok=True)] = 0.5
+    sample_period: Annotated[float, PERIOD] = 0.1
+    rollout_sample_period: Annotated[float, PERIOD] = 0.2
+    max_object_speed: PositiveFloat = 5.0
+    max_sink: PositiveFloat = 0.03
     cost: StoCost = field(default_factory=StoCost)
     verify: bool = True
-    max_verifications: int = 8
-    alternatives: int = 3
-    displaced_checks: int | None = None
-    displaced_sigma: float = 0.001
-    displaced_yaw_sigma: float = math.radians(0.5)
+    max_verifications: Annotated[int, Count(0, 1000)] = 8
+    alternatives: Annotated[int, Count(0, 100)] = 3
+    displaced_checks: Annotated[int | None, Count(0, 100)] = None
+    displaced_sigma: Annotated[float, Positive(upper=0.1, zero_ok=True)] = 0.001
+    displaced_yaw_sigma: Annotated[float, Positive(upper=math.pi, zero_ok=True)] = math.radians(0.5)
+
+    def problems(self, where: str) -> list[str]:
+        """The rules across the fields (``where``: the section's path)."""
+        margin, clearance = self.weld_margin, self.weld_clearance
+        if not margin > clearance:
+            return []
+        return [f"{where}.weld_margin ({margin}) must not exceed {where}.weld_clearance ({clearance})"]
 
 
 @dataclass(frozen=True)
@@ -204,9 +231,9 @@ class ClosedLoopConfig:
     """
 
     enabled: bool = False
-    replan_period: float = 0.5
-    iterations: int = 1
-    rollouts: int = 9
-    replan_distance: float = 0.05
-    track_distance: float = 0.005
-    max_rollouts: int = 300
+    replan_period: Annotated[float, PERIOD] = 0.5
+    iterations: Annotated[int, Count(0, 10_000)] = 1
+    rollouts: Annotated[int, Count(1, 1_000_000)] = 9
+    replan_distance: PositiveFloat = 0.05
+    track_distance: NonNegativeFloat = 0.005
+    max_rollouts: Annotated[int, Count(1, 100_000_000)] = 300

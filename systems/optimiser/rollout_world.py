@@ -27,6 +27,7 @@ from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
+from hlp_drake.systems.execution.command import EXECUTION_SETTLE_S
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.cost import (
     FinalState,
@@ -46,7 +47,6 @@ from hlp_drake.systems.optimiser.sampler import (
     sample_rollout,
 )
 from hlp_drake.systems.optimiser.sleep import AWAKE, ProximityContext
-from hlp_drake.systems.world.config import EXECUTION_SETTLE_S
 from hlp_drake.systems.world.robot import TCP_FRAME
 from hlp_drake.systems.world.scene_models import TABLE_NAME, object_body, over_table_mask
 from hlp_drake.systems.world.start_pose import tcp_keypoint_height

@@ -25,7 +25,6 @@ from pydrake.trajectories import PiecewisePolynomial
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.optimiser import EMPTY_RESULT, StoResult, optimise
 from hlp_drake.systems.optimiser.pool import RolloutPool
-from hlp_drake.systems.scenario_checks import check_scenario
 from hlp_drake.systems.world.scene_source import declare_scene_input_port, scene_input, with_scene
 
 if TYPE_CHECKING:
@@ -43,7 +42,6 @@ class StochasticTrajectoryOptimiser(LeafSystem):
 
     def __init__(self, scenario: Scenario, pool: RolloutPool) -> None:
         super().__init__()
-        check_scenario(scenario)
         self._scenario = scenario
         self._pool = pool
         self._scene = declare_scene_input_port(self)

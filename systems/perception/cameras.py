@@ -1,7 +1,7 @@
 """The world's RGB-D cameras: Drake ``RgbdSensor``s rendered with VTK, seeded depth noise and dropout,
 and a label image of semantic classes.
 
-``add_cameras`` (called by ``make_world_diagram``) adds one sensor per ``CameraSettings`` of the
+``add_cameras`` (called by ``make_world_diagram``) adds one sensor per ``CameraConfig`` of the
 scenario's ``perception.cameras``, fixed in the world, and exports for a camera named N:
 
 - ``N.depth_image``: ``ImageDepth32F``, metres along the optical axis, with the camera's noise and
@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Annotated, Literal
 
 import numpy as np
 from pydrake.common.value import AbstractValue
@@ -43,7 +43,10 @@ from pydrake.multibody.tree import ModelInstanceIndex
 from pydrake.systems.framework import Context, DiagramBuilder, LeafSystem
 from pydrake.systems.sensors import CameraInfo, ImageDepth32F, RgbdSensor
 
+from hlp_drake.ranges import Between, First, Rule
+from hlp_drake.scene.generators import MAX_SEED
 from hlp_drake.scene.model import Scene
+from hlp_drake.scene.validation import name_problem
 from hlp_drake.systems.world.scene_models import SceneModels
 
 if TYPE_CHECKING:
@@ -57,7 +60,7 @@ CLIPPING = (0.01, 10.0)
 """The render cameras' clipping range, m (the depth range lies inside it)."""
 
 
-def camera_pose(camera: CameraSettings, scene: Scene) -> RigidTransform:
+def camera_pose(camera: CameraConfig, scene: Scene) -> RigidTransform:
     """The camera's optical frame in the world (+z along the view, +x right, +y down the image).
 
     Raises:
@@ -79,12 +82,12 @@ def camera_pose(camera: CameraSettings, scene: Scene) -> RigidTransform:
     return RigidTransform(RotationMatrix(np.column_stack([np.cross(y, z), y, z])), eye)
 
 
-def camera_info(camera: CameraSettings) -> CameraInfo:
+def camera_info(camera: CameraConfig) -> CameraInfo:
     """The camera's pinhole intrinsics: square pixels, the principal point at the image centre."""
     return CameraInfo(width=camera.width, height=camera.height, fov_y=math.radians(camera.fov_y))
 
 
-def render_cameras(camera: CameraSettings) -> tuple[ColorRenderCamera, DepthRenderCamera]:
+def render_cameras(camera: CameraConfig) -> tuple[ColorRenderCamera, DepthRenderCamera]:
     """The colour/label and depth render cameras of ``camera`` (sharing intrinsics and pose)."""
     core = RenderCameraCore(RENDERER, camera_info(camera), ClippingRange(*CLIPPING), RigidTransform())
     return ColorRenderCamera(core), DepthRenderCamera(core, DepthRange(camera.min_depth, camera.max_depth))
@@ -98,7 +101,7 @@ class DepthNoise(LeafSystem):
     the context's time only: the same frame is the same image, and frames at other times differ.
     """
 
-    def __init__(self, camera: CameraSettings) -> None:
+    def __init__(self, camera: CameraConfig) -> None:
         super().__init__()
         self._noise, self._dropout, self._seed = camera.depth_noise, camera.dropout, camera.seed
         model = AbstractValue.Make(ImageDepth32F(camera.width, camera.height))
@@ -176,20 +179,6 @@ def add_cameras(builder: DiagramBuilder, scene_graph: SceneGraph, scenario: Scen
         builder.ExportOutput(sensor.body_pose_in_world_output_port(), f"{camera.name}.camera_pose")
 
 
-__all__ = [
-    "OBSTACLE_LABEL",
-    "ROBOT_LABEL",
-    "TABLE_LABEL",
-    "TARGET_LABEL",
-    "DepthNoise",
-    "add_cameras",
-    "camera_info",
-    "camera_pose",
-    "label_classes",
-    "render_cameras",
-]
-
-
 # The scenario's ``perception`` section: where the planning blocks' scene comes from, the cameras and
 # the settings of ``ScenePerception``.
 #
@@ -201,10 +190,21 @@ __all__ = [
 #       - {name: table_camera, position: [0.0, 0.0, 1.6], depth_noise: 0.002, dropout: 0.05, seed: 3}
 #       cluster_radius: 0.005
 PERCEPTION_SOURCES = ("truth", "camera")
+MAX_PIXELS = 4096
+"""The widest and tallest camera image, pixels; its square is the most pixels of all cameras together
+(memory per frame grows with them)."""
+MAX_CAMERAS = 8
+"""Most cameras in a world."""
+FINITE = Rule(lambda v: all(map(math.isfinite, v)), "{where} must be finite, got {value}", list)
+DROPOUT = Rule(lambda v: 0.0 <= v < 1.0, "{where} must be in [0, 1), got {value:g}")
+SOURCE = Rule(
+    lambda v: v in PERCEPTION_SOURCES,
+    f"{{where}} must be one of {', '.join(PERCEPTION_SOURCES)}, got {{value!r}}",
+)
 
 
 @dataclass(frozen=True)
-class CameraSettings:
+class CameraConfig:
     """One simulated RGB-D camera (Drake's ``RgbdSensor``, rendered with VTK): pinhole intrinsics,
     a pose given by where it is and what it looks at, and seeded depth noise and dropout.
 
@@ -230,18 +230,32 @@ class CameraSettings:
     """
 
     name: str = "table_camera"
-    width: int = 640
-    height: int = 480
-    fov_y: float = 42.0
+    width: Annotated[int, Between(8, MAX_PIXELS, "pixels")] = 640
+    height: Annotated[int, Between(8, MAX_PIXELS, "pixels")] = 480
+    fov_y: Annotated[float, Between(1.0, 170.0, "degrees")] = 42.0
     frame: Literal["table", "world"] = "table"
-    position: tuple[float, float, float] = (0.0, 0.0, 1.6)
-    look_at: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    up: tuple[float, float, float] = (1.0, 0.0524, 0.0)  # tan(3 degrees)
+    position: Annotated[tuple[float, float, float], FINITE] = (0.0, 0.0, 1.6)
+    look_at: Annotated[tuple[float, float, float], FINITE] = (0.0, 0.0, 0.0)
+    up: Annotated[tuple[float, float, float], FINITE] = (1.0, 0.0524, 0.0)  # tan(3 degrees)
     min_depth: float = 0.1
     max_depth: float = 4.0
-    depth_noise: float = 0.001
-    dropout: float = 0.01
-    seed: int = 0
+    depth_noise: Annotated[float, Between(0.0, 0.1, "m")] = 0.001
+    dropout: Annotated[float, DROPOUT] = 0.01
+    seed: Annotated[int, Between(0, MAX_SEED)] = 0
+
+    def problems(self, where: str) -> list[str]:
+        """The rules across the fields (``where``: the camera's path); its pose: ``Scenario.problems``."""
+        problems = []
+        named = name_problem(self.name) or ("name is empty" if not self.name else None)
+        if named:
+            problems.append(f"{where}: {named}")
+        near, far = CLIPPING
+        if not near <= self.min_depth < self.max_depth <= far:
+            problems.append(
+                f"{where}: the depth range must satisfy {near:g} <= min_depth < max_depth <= {far:g} m, "
+                f"got {self.min_depth:g} and {self.max_depth:g}"
+            )
+        return problems
 
 
 @dataclass(frozen=True)
@@ -269,17 +283,52 @@ class PerceptionConfig:
         seed: seed of the RANSAC fit.
     """
 
-    source: Literal["truth", "camera"] = "truth"
-    cameras: tuple[CameraSettings, ...] = field(default_factory=lambda: (CameraSettings(),))
-    table_tolerance: float = 0.005
-    min_height: float = 0.01
-    cluster_radius: float = 0.004
-    min_points: int = 40
-    cylinder_fill: float = 0.9
-    border_margin: int = 2
-    table_margin: float = 0.02
-    ransac_points: int = 1000
-    seed: int = 0
+    source: Annotated[Literal["truth", "camera"], SOURCE] = "truth"
+    cameras: Annotated[tuple[CameraConfig, ...], First(MAX_CAMERAS)] = field(
+        default_factory=lambda: (CameraConfig(),)
+    )
+    table_tolerance: Annotated[float, Between(1e-5, 0.1)] = 0.005
+    min_height: Annotated[float, Between(1e-4, 1.0)] = 0.01
+    cluster_radius: Annotated[float, Between(0.0, 0.5)] = 0.004
+    min_points: Annotated[int, Between(1, 1_000_000)] = 40
+    cylinder_fill: Annotated[float, Between(0.5, 1.0)] = 0.9
+    border_margin: Annotated[int, Between(0, MAX_PIXELS // 2)] = 2
+    table_margin: Annotated[float, Between(0.0, 1.0)] = 0.02
+    ransac_points: Annotated[int, Between(3, 1_000_000)] = 1000
+    seed: Annotated[int, Between(0, MAX_SEED)] = 0
+
+    def problems(self, where: str) -> list[str]:
+        """The rules across the fields and the cameras (``where``: the section's path)."""
+        problems, cameras = [], self.cameras
+        if self.source == "camera" and not cameras:
+            problems.append(
+                f"{where}.cameras is empty, but {where}.source is camera: the scene needs a camera"
+            )
+        if len(cameras) > MAX_CAMERAS:
+            problems.append(f"{where}.cameras: at most {MAX_CAMERAS} cameras, got {len(cameras)}")
+        pixels = sum(camera.width * camera.height for camera in cameras)
+        if pixels > MAX_PIXELS**2:
+            problems.append(f"{where}.cameras: at most {MAX_PIXELS**2} pixels in all, got {pixels}")
+        names = [camera.name for camera in cameras]
+        for name in sorted({n for n in names if names.count(n) > 1}):
+            problems.append(f"{where}.cameras: two cameras are named {name!r}")
+        return problems
 
 
-__all__ = ["PERCEPTION_SOURCES", "CameraSettings", "PerceptionConfig"]
+__all__ = [
+    "MAX_CAMERAS",
+    "MAX_PIXELS",
+    "OBSTACLE_LABEL",
+    "PERCEPTION_SOURCES",
+    "ROBOT_LABEL",
+    "TABLE_LABEL",
+    "TARGET_LABEL",
+    "CameraConfig",
+    "DepthNoise",
+    "PerceptionConfig",
+    "add_cameras",
+    "camera_info",
+    "camera_pose",
+    "label_classes",
+    "render_cameras",
+]

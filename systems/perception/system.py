@@ -20,13 +20,12 @@ from pydrake.systems.sensors import ImageDepth32F, ImageLabel16I
 from hlp_drake.systems.perception.cameras import camera_info
 from hlp_drake.systems.perception.depth_points import CameraView
 from hlp_drake.systems.perception.perception import Perception, perceive, unperceived_scene
-from hlp_drake.systems.scenario_checks import check_scenario
 from hlp_drake.systems.world.scene_source import MODEL_SCENE, SCENE_PORT
 from hlp_drake.systems.world.world import make_world_diagram
 
 if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
-    from hlp_drake.systems.world.uncertainty import ModelError
+    from hlp_drake.systems.world.uncertainty import WorldPerturbation
 
 CAMERA_PORTS = ("depth_image", "label_image", "camera_pose")
 CLASS_COLOURS = np.array([[150, 150, 150], [230, 120, 20], [20, 20, 20], [60, 60, 200]], dtype=np.uint8)
@@ -56,7 +55,6 @@ class ScenePerception(LeafSystem):
 
     def __init__(self, scenario: Scenario) -> None:
         super().__init__()
-        check_scenario(scenario)
         self._config = scenario.perception
         self._template = scenario.scene
         self._cameras = self._config.cameras
@@ -150,7 +148,9 @@ def add_scene_perception(builder: DiagramBuilder, world: Diagram, scenario: Scen
     return block
 
 
-def perceive_world(scenario: Scenario, *, model_error: ModelError | None = None) -> tuple[Perception, float]:
+def perceive_world(
+    scenario: Scenario, *, model_error: WorldPerturbation | None = None
+) -> tuple[Perception, float]:
     """One frame of ``scenario``'s cameras on its world at the start (``model_error``: the world's
     own differences from the scenario) and the seconds its rendering and perception took; the
     world is built for this frame only, so a world executed open loop need not carry the cameras."""

@@ -25,7 +25,6 @@ from hlp_drake.systems.optimiser.system import StochasticTrajectoryOptimiser
 from hlp_drake.systems.planning.ik import KeypointIk
 from hlp_drake.systems.planning.planners import HlpPlannerSystem, StraightLinePlanSystem
 from hlp_drake.systems.planning.transfer import RobotPlanTransfer
-from hlp_drake.systems.scenario_checks import check_scenario
 from hlp_drake.systems.world.scene_source import SCENE_PORT
 
 if TYPE_CHECKING:
@@ -68,11 +67,7 @@ def make_planning_diagram(
         models: the decision models (default: ``scenario_models(scenario)``).
         plan: a person's plan to use instead of the planner block's (written out, or planned
             elsewhere): a constant source feeds it to the transfer, whatever the scene.
-
-    Raises:
-        HlpError: settings that cannot be used (``check_scenario``: a scenario made in Python).
     """
-    check_scenario(scenario)
     kind = "given" if plan is not None else scenario.planner.kind
     builder = DiagramBuilder()
     transfer = builder.AddNamedSystem("robot_plan_transfer", RobotPlanTransfer(scenario))

@@ -16,7 +16,6 @@ from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem
 
 from hlp_drake.planner import HighLevelPlan
-from hlp_drake.systems.scenario_checks import check_scenario
 from hlp_drake.systems.world.scene_source import declare_scene_input_port, scene_input
 from hlp_drake.transfer.push import robot_alternatives, robot_plan
 from hlp_drake.transfer.rules import PushRules, gripper_geometry, push_rules
@@ -30,7 +29,6 @@ class RobotPlanTransfer(LeafSystem):
 
     def __init__(self, scenario: Scenario) -> None:
         super().__init__()
-        check_scenario(scenario)
         rules = push_rules(scenario.transfer, gripper_geometry())
         limit = scenario.optimiser.alternatives
         self._rules = rules

@@ -1,10 +1,9 @@
 """A ``Scene`` as Drake bodies: a welded table top and the target and obstacles as free bodies.
 
 Everything is built programmatically (no model files). The table is a box ``length x width x
-table_thickness`` whose top surface is at the table's height, welded to the world; it has no legs,
-so the robot's base may drive under its top. Every scene object becomes a model instance and a
-body, both named after the object, with a box or cylinder for collision and illustration. The
-objects' masses follow a density, clipped to a range (``BodiesConfig``).
+table_thickness`` whose top surface is at the table's height, welded to the world; it has no legs, so
+the robot's base may drive under its top. Every scene object becomes a model instance and a body,
+both named after the object, with a box or cylinder for collision and illustration (``BodiesConfig``).
 
 Contact (point contact, see the project's Drake notes section F): every collision geometry gets an
 explicit stiffness and dissipation, and each object carries small contact spheres in its corners
@@ -18,6 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
+from typing import Annotated
 
 import numpy as np
 from pydrake.geometry import (
@@ -34,14 +34,61 @@ from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
 from pydrake.multibody.tree import ModelInstanceIndex, RigidBody, SpatialInertia, UnitInertia
 from pydrake.systems.framework import Context
 
+from hlp_drake.ranges import NonNegativeFloat, PositiveFloat, Rule
 from hlp_drake.scene.model import Scene, SceneObject, Table, plan_view_order
-from hlp_drake.systems.world.config import BodiesConfig, ContactConfig
 
 TABLE_NAME = "table"
 TABLE_COLOR = np.array([0.55, 0.40, 0.25, 1.0])
 TARGET_COLOR = np.array([0.85, 0.15, 0.15, 1.0])
 OBSTACLE_COLOR = np.array([0.25, 0.45, 0.80, 1.0])
 SPHERE_COLOR = np.array([0.1, 0.1, 0.1, 1.0])
+RIM_SPHERES = Rule(
+    lambda v: not (v < 0 or v in (1, 2) or v > 64), "{where} must be 0 or between 3 and 64, got {value}"
+)
+
+
+@dataclass(frozen=True)
+class ContactConfig:
+    """Contact materials of the table, the scene objects and the gripper (point contact).
+
+    Attributes:
+        stiffness: point-contact stiffness of the table, objects and robot, N/m (Drake's default: soft).
+        hunt_crossley_dissipation, relaxation_time: dissipation of "lagged", "similar" (s/m) and "sap" (s).
+        corner_sphere_radius: the support spheres' radius, m (0: none); ``rim_spheres``: spheres per
+            cylinder rim; ``top_spheres``: on the top corners and rim too, not just the bottom ones.
+        robot_self_contact: contact between the robot's links (the plant filters links one joint apart).
+        table_friction, object_friction, gripper_friction: Coulomb coefficients (static = dynamic, two
+            surfaces combined as 2 a b / (a + b)).
+    """
+
+    stiffness: PositiveFloat = 1.0e6
+    hunt_crossley_dissipation: NonNegativeFloat = 10.0
+    relaxation_time: NonNegativeFloat = 0.01
+    corner_sphere_radius: NonNegativeFloat = 0.001
+    rim_spheres: Annotated[int, RIM_SPHERES] = 8
+    top_spheres: bool = True
+    robot_self_contact: bool = True
+    table_friction: PositiveFloat = 0.3
+    object_friction: PositiveFloat = 0.4
+    gripper_friction: PositiveFloat = 0.8
+
+
+@dataclass(frozen=True)
+class BodiesConfig:
+    """How a ``Scene`` becomes bodies: a table top ``table_thickness`` m thick (its top at the table's
+    height), objects of ``object_density`` kg/m^3, masses clipped to [object_min_mass, object_max_mass] kg."""
+
+    table_thickness: PositiveFloat = 0.04
+    object_density: PositiveFloat = 400.0
+    object_min_mass: PositiveFloat = 0.1
+    object_max_mass: float = 0.5
+
+    def problems(self, where: str) -> list[str]:
+        """The rule across the fields (``where``: the section's path)."""
+        low, high = self.object_min_mass, self.object_max_mass
+        if not high < low:
+            return []
+        return [f"{where}.object_max_mass ({high}) is below {where}.object_min_mass ({low})"]
 
 
 @dataclass(frozen=True)
@@ -74,9 +121,8 @@ def object_mass(obj: SceneObject, config: BodiesConfig) -> float:
 
 def object_pose(obj: SceneObject, table_height: float) -> RigidTransform:
     """The pose of an object's body frame (its centre) standing upright on the table top."""
-    return RigidTransform(
-        RotationMatrix.MakeZRotation(obj.yaw), [obj.x, obj.y, table_height + obj.height / 2.0]
-    )
+    centre = [obj.x, obj.y, table_height + obj.height / 2.0]
+    return RigidTransform(RotationMatrix.MakeZRotation(obj.yaw), centre)
 
 
 def _contact_properties(contact: ContactConfig, friction: float) -> ProximityProperties:
@@ -257,9 +303,8 @@ def set_object_poses(plant: MultibodyPlant, context: Context, scene: Scene) -> N
     for obj in scene.objects:
         body = object_body(plant, obj.name)
         plant.SetFreeBodyPose(context, body, object_pose(obj, scene.table.height))
-        plant.SetVelocities(
-            context, body.model_instance(), np.zeros(plant.num_velocities(body.model_instance()))
-        )
+        instance = body.model_instance()
+        plant.SetVelocities(context, instance, np.zeros(plant.num_velocities(instance)))
 
 
 def object_poses(plant: MultibodyPlant, context: Context, names) -> dict[str, RigidTransform]:
@@ -336,6 +381,8 @@ def scene_from_plant(plant: MultibodyPlant, context: Context, scene: Scene) -> S
 
 __all__ = [
     "TABLE_NAME",
+    "BodiesConfig",
+    "ContactConfig",
     "SceneModels",
     "add_scene",
     "fallen_objects",

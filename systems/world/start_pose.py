@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import functools
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 from pydrake.math import RotationMatrix
@@ -20,7 +21,6 @@ from pydrake.solvers import SnoptSolver, Solve, SolverOptions
 
 from hlp_drake.errors import HlpError
 from hlp_drake.scene.model import Scene
-from hlp_drake.systems.world.config import IkConfig
 from hlp_drake.systems.world.robot import (
     ARM_JOINTS,
     BASE_FOOTPRINT,
@@ -32,6 +32,9 @@ from hlp_drake.systems.world.robot import (
     TCP_FRAME,
     add_robot,
 )
+
+if TYPE_CHECKING:
+    from hlp_drake.systems.planning.ik import IkConfig
 
 
 def robot_position_names() -> tuple[str, ...]:

@@ -14,14 +14,25 @@ from __future__ import annotations
 import hashlib
 import math
 from dataclasses import dataclass, replace
+from typing import Annotated
 
 import numpy as np
 
+from hlp_drake.ranges import Between, Rule
+from hlp_drake.scene.generators import MAX_SEED
 from hlp_drake.scene.model import Scene, SceneObject
 from hlp_drake.scene.validation import scene_problems
 
 SHRINKS = 4
 """Halvings of an offset that makes the scene invalid before the object is left where it was."""
+MAX_SCALE = 100.0
+"""The largest factor of ``uncertainty``'s mass and friction ranges."""
+SCALE = Rule(
+    lambda v: 1.0 / MAX_SCALE <= v[0] <= v[1] <= MAX_SCALE,
+    f"{{where}} must be [low, high] with {1.0 / MAX_SCALE:g} <= low <= high <= {MAX_SCALE:g}, "
+    "got [{value[0]:g}, {value[1]:g}]",
+)
+"""A range of factors: [low, high], within [1 / MAX_SCALE, MAX_SCALE]."""
 
 
 @dataclass(frozen=True)
@@ -38,15 +49,15 @@ class UncertaintyConfig:
     """
 
     enabled: bool = False
-    seed: int = 0
-    position_sigma: float = 0.01
-    yaw_sigma: float = math.radians(3.0)
-    mass_scale: tuple[float, float] = (0.5, 2.0)
-    friction_scale: tuple[float, float] = (0.7, 1.3)
+    seed: Annotated[int, Between(0, MAX_SEED)] = 0
+    position_sigma: Annotated[float, Between(0.0, 0.5, "m")] = 0.01
+    yaw_sigma: Annotated[float, Between(0.0, math.pi, "rad")] = math.radians(3.0)
+    mass_scale: Annotated[tuple[float, float], SCALE] = (0.5, 2.0)
+    friction_scale: Annotated[tuple[float, float], SCALE] = (0.7, 1.3)
 
 
 @dataclass(frozen=True)
-class ObjectError:
+class ObjectPerturbation:
     """How one object of the world differs from the believed one."""
 
     dx: float
@@ -57,10 +68,10 @@ class ObjectError:
 
 
 @dataclass(frozen=True)
-class ModelError:
-    """The world's differences from the believed scene, per object name."""
+class WorldPerturbation:
+    """The world's differences from the believed scene (its model error), per object name."""
 
-    objects: dict[str, ObjectError]
+    objects: dict[str, ObjectPerturbation]
 
     def true_scene(self, scene: Scene) -> Scene:
         """``scene`` with every object where the world has it."""
@@ -81,12 +92,12 @@ def _seed(config: UncertaintyConfig, scene: Scene) -> np.random.Generator:
     return np.random.default_rng([int(config.seed), digest])
 
 
-def sample_model_error(config: UncertaintyConfig, scene: Scene) -> ModelError:
-    """The seeded error of ``scene``'s world (see the module's docstring)."""
+def sample_perturbation(config: UncertaintyConfig, scene: Scene) -> WorldPerturbation:
+    """The seeded perturbation (model error) of ``scene``'s world (see the module's docstring)."""
     rng = _seed(config, scene)
     low_m, high_m = config.mass_scale
     low_f, high_f = config.friction_scale
-    errors: dict[str, ObjectError] = {}
+    drawn: dict[str, ObjectPerturbation] = {}
     placed = scene
     for obj in scene.objects:
         dx, dy = rng.normal(0.0, config.position_sigma, size=2)
@@ -96,24 +107,30 @@ def sample_model_error(config: UncertaintyConfig, scene: Scene) -> ModelError:
         before = set(scene_problems(placed))
         for shrink in range(SHRINKS + 1):
             factor = 0.5**shrink if shrink < SHRINKS else 0.0
-            error = ObjectError(float(factor * dx), float(factor * dy), factor * dyaw, mass, friction)
-            trial = ModelError({**errors, obj.name: error}).true_scene(scene)
+            offset = ObjectPerturbation(float(factor * dx), float(factor * dy), factor * dyaw, mass, friction)
+            trial = WorldPerturbation({**drawn, obj.name: offset}).true_scene(scene)
             if set(scene_problems(trial)) <= before:
                 break
-        errors[obj.name] = error
-        placed = ModelError(errors).true_scene(scene)
-    return ModelError(errors)
+        drawn[obj.name] = offset
+        placed = WorldPerturbation(drawn).true_scene(scene)
+    return WorldPerturbation(drawn)
 
 
 def displaced_scenes(scene: Scene, count: int, position_sigma: float, yaw_sigma: float) -> list[Scene]:
-    """``count`` copies of ``scene`` with every object displaced (``sample_model_error`` with seeds
+    """``count`` copies of ``scene`` with every object displaced (``sample_perturbation`` with seeds
     1 ... count, positions and yaw only: masses and friction as believed)."""
     return [
-        sample_model_error(
+        sample_perturbation(
             UncertaintyConfig(True, seed, position_sigma, yaw_sigma, (1.0, 1.0), (1.0, 1.0)), scene
         ).true_scene(scene)
         for seed in range(1, count + 1)
     ]
 
 
-__all__ = ["ModelError", "ObjectError", "UncertaintyConfig", "displaced_scenes", "sample_model_error"]
+__all__ = [
+    "ObjectPerturbation",
+    "UncertaintyConfig",
+    "WorldPerturbation",
+    "displaced_scenes",
+    "sample_perturbation",
+]

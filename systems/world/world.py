@@ -25,6 +25,7 @@ table at its scene pose.
 from __future__ import annotations
 
 from collections.abc import Iterable
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -40,27 +41,89 @@ from pydrake.geometry import (
     SceneGraph,
 )
 from pydrake.multibody.meshcat import ContactVisualizer, ContactVisualizerParams
-from pydrake.multibody.plant import AddMultibodyPlant, CoulombFriction, MultibodyPlant
+from pydrake.multibody.plant import AddMultibodyPlant, CoulombFriction, MultibodyPlant, MultibodyPlantConfig
 from pydrake.multibody.tree import JointActuatorIndex, ModelInstanceIndex, PdControllerGains
 from pydrake.systems.controllers import InverseDynamics
 from pydrake.systems.framework import Diagram, DiagramBuilder, OutputPort
 from pydrake.systems.primitives import MatrixGain, TrajectorySource
 from pydrake.trajectories import Trajectory
 
+from hlp_drake.ranges import MAX_TIME_STEP, MIN_TIME_STEP, Fields, NonNegativeFloat, Positive, Rule
 from hlp_drake.systems.perception.cameras import add_cameras, label_classes
-from hlp_drake.systems.scenario_checks import check_scenario
-from hlp_drake.systems.world.config import ContactConfig, ControlConfig
 from hlp_drake.systems.world.robot import ARM_JOINTS, BASE_JOINTS, GRIPPER_JOINTS, ROBOT_MODEL_NAME, add_robot
-from hlp_drake.systems.world.scene_models import add_scene
+from hlp_drake.systems.world.scene_models import ContactConfig, add_scene
 from hlp_drake.systems.world.start_pose import robot_position_names, start_configuration
 
 if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
-    from hlp_drake.systems.world.uncertainty import ModelError
+    from hlp_drake.systems.world.uncertainty import WorldPerturbation
 
 GRIPPER_BODIES = ("gripper_base_link", "left_finger_link", "right_finger_link")
 WRIST_JOINTS = ARM_JOINTS[3:]
 DESIRED_STATE_PORT = "robot.desired_state"
+SAP_APPROXIMATIONS = ("sap", "lagged", "similar")
+"""Discrete contact approximations solved by SAP (TAMSI, "tamsi", cannot simulate the mimic finger)."""
+CONTACT_MODELS = ("point", "hydroelastic", "hydroelastic_with_fallback")
+PLANT_RANGES = Fields(
+    {
+        "time_step": Positive(MIN_TIME_STEP, MAX_TIME_STEP),
+        "discrete_contact_approximation": Rule(
+            lambda v: v in SAP_APPROXIMATIONS,
+            f"{{where}} must be one of {', '.join(SAP_APPROXIMATIONS)} (the robot's mimic finger needs SAP), "
+            "got {value!r}",
+        ),
+        "contact_model": Rule(
+            lambda v: v in CONTACT_MODELS,
+            f"{{where}} must be one of {', '.join(CONTACT_MODELS)}, got {{value!r}}",
+        ),
+    }
+)
+"""The ranges of a ``Scenario``'s ``plant`` (Drake's ``MultibodyPlantConfig`` declares none)."""
+
+
+def default_plant_config() -> MultibodyPlantConfig:
+    """The plant settings of the world: 2 ms steps, point contact, the SAP solver and approximation.
+
+    SAP simulates the gripper's mimic finger (a coupler constraint); see the project's Drake notes
+    (section F) for the measurements behind the defaults here and in ``ContactConfig``.
+    """
+    return MultibodyPlantConfig(
+        time_step=0.002,
+        penetration_allowance=0.001,
+        stiction_tolerance=1e-4,
+        contact_model="point",
+        discrete_contact_approximation="sap",
+    )
+
+
+@dataclass(frozen=True)
+class PdGains:
+    """Gains of a joint PD controller (SI units: N/m and N s/m, or N m/rad and N m s/rad)."""
+
+    kp: NonNegativeFloat = 0.0
+    kd: NonNegativeFloat = 0.0
+
+
+@dataclass(frozen=True)
+class ControlConfig:
+    """The robot's joint PD controllers (Drake's PD-controlled actuators, implicit in SAP).
+
+    Attributes:
+        base: gains of the base's x and y joints (N/m, N s/m).
+        base_yaw: gains of the base's yaw joint.
+        arm: gains of the UR5's shoulder and elbow joints.
+        wrist: gains of the UR5's three wrist joints.
+        gripper: gains of the actuated finger.
+        gravity_compensation: add the robot's gravity torques as feed-forward actuation (computed on
+            a robot-only model), so the arm holds its commanded pose without steady-state sag.
+    """
+
+    base: PdGains = field(default_factory=lambda: PdGains(kp=2.0e4, kd=4.0e3))
+    base_yaw: PdGains = field(default_factory=lambda: PdGains(kp=1.0e4, kd=2.0e3))
+    arm: PdGains = field(default_factory=lambda: PdGains(kp=2.0e3, kd=150.0))
+    wrist: PdGains = field(default_factory=lambda: PdGains(kp=300.0, kd=10.0))
+    gripper: PdGains = field(default_factory=lambda: PdGains(kp=2.0e3, kd=20.0))
+    gravity_compensation: bool = True
 
 
 def _set_robot_contact(
@@ -191,7 +254,7 @@ def make_world_diagram(
     contact_forces: bool = False,
     welded_objects: Iterable[str] = (),
     cameras: bool | None = None,
-    model_error: ModelError | None = None,
+    model_error: WorldPerturbation | None = None,
 ) -> Diagram:
     """Build the world of ``scenario`` (its scene, plant, contact, bodies, controller and start pose):
     see the module's docstring for the ports.
@@ -207,13 +270,9 @@ def make_world_diagram(
             default): when the scenario perceives the scene through them (``perception.source:
             camera``). Even unrendered, a camera costs ~10 % of the simulation's time (the render
             engine follows every pose).
-        model_error: the world differs from the scenario so (``sample_model_error``): its objects
+        model_error: the world differs from the scenario so (``sample_perturbation``): its objects
             stand where ``model_error.true_scene`` has them, with its mass and friction factors.
-
-    Raises:
-        HlpError: settings that cannot be used (``check_scenario``: a scenario made in Python).
     """
-    check_scenario(scenario)
     scene = scenario.scene if model_error is None else model_error.true_scene(scenario.scene)
     scales = None if model_error is None else model_error.scales()
     builder = DiagramBuilder()
@@ -291,10 +350,16 @@ def add_position_trajectory(
 
 
 __all__ = [
+    "CONTACT_MODELS",
     "DESIRED_STATE_PORT",
+    "PLANT_RANGES",
+    "SAP_APPROXIMATIONS",
+    "ControlConfig",
+    "PdGains",
     "actuated_state_selector",
     "add_position_trajectory",
     "connect_robot_command",
+    "default_plant_config",
     "desired_state_from_robot_state",
     "make_world_diagram",
     "robot_position_names",

@@ -26,7 +26,7 @@ from hlp_drake.systems.planning.diagram import first_rollout, initial_sequence, 
 from hlp_drake.systems.planning.ik import KeypointIk
 from hlp_drake.systems.planning.keyframes import Keyframes, PlanningModel
 from hlp_drake.systems.planning.planners import HlpPlannerSystem, StraightLinePlanSystem, straight_line_plan
-from hlp_drake.systems.planning.transfer import RobotPlanTransfer
+from hlp_drake.systems.planning.transfer import RobotPlanTransfer, gripper_geometry
 from hlp_drake.systems.scenario import PlannerChoiceConfig, Scenario, load_scenario
 from hlp_drake.systems.world.robot import (
     ACTUATED_JOINTS,
@@ -65,7 +65,6 @@ from hlp_drake.transfer.rules import (
     GripperGeometry,
     PushRules,
     TransferConfig,
-    gripper_geometry,
     push_rules,
 )
 

@@ -376,8 +376,9 @@ def test_a_persons_plan_wired_straight_into_ik_is_refused_not_executed(system):
     """A person's "move" keypoints are the obstacles' centres; only RobotPlanTransfer's plan is solved."""
     from hlp_drake.learners.bundled import default_models
     from hlp_drake.planner import plan as human_plan
+    from hlp_drake.systems.planning.transfer import gripper_geometry
     from hlp_drake.transfer.push import robot_plan
-    from hlp_drake.transfer.rules import gripper_geometry, push_rules
+    from hlp_drake.transfer.rules import push_rules
 
     scene = generate_scene("gen1", 3)
     person = human_plan(scene, default_models())

@@ -19,10 +19,11 @@ from hlp_drake.planner import plan
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import scene_to_dict
 from hlp_drake.systems.planning.diagram import make_planning_diagram
+from hlp_drake.systems.planning.transfer import gripper_geometry
 from hlp_drake.systems.scenario import Scenario
 from hlp_drake.taskspace import DIRECTION_VECTORS, TaskSpace
 from hlp_drake.transfer.push import ROBOT_ACTIONS, robot_alternatives, robot_plan
-from hlp_drake.transfer.rules import TransferConfig, gripper_geometry, push_rules
+from hlp_drake.transfer.rules import TransferConfig, push_rules
 
 RULES = push_rules(TransferConfig(), gripper_geometry())
 

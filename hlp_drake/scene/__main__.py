@@ -65,9 +65,10 @@ def _plans(scene) -> dict:
     """The human-like plan of ``scene`` and the pushing robot's plan of it (imports Drake)."""
     from hlp_drake.learners.bundled import default_models
     from hlp_drake.planner import plan
+    from hlp_drake.systems.planning.transfer import gripper_geometry
     from hlp_drake.systems.scenario import Scenario
     from hlp_drake.transfer.push import robot_plan
-    from hlp_drake.transfer.rules import gripper_geometry, push_rules
+    from hlp_drake.transfer.rules import push_rules
 
     human = plan(scene, default_models())
     return {

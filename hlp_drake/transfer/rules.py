@@ -2,18 +2,16 @@
 
 The sizes (the tcp's offset from the flange, how far the fingertips reach ahead of the tcp, the open
 fingers' half-width, the wrist's radius) are read from the robot model's collision geometry, where
-they live, and rounded up to ``SIZE_RESOLUTION``; ``push_rules`` combines them with the margins
+they live, and rounded up to ``SIZE_RESOLUTION`` (``hlp_drake.systems.planning.transfer.gripper_geometry``,
+on the Drake side); ``push_rules`` combines them with the margins
 into the clearances ``hlp_drake.transfer.push`` works with.
 """
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 from typing import Annotated
-
-import numpy as np
 
 from hlp_drake.ranges import NonNegativeFloat, Positive, PositiveFloat
 
@@ -117,7 +115,8 @@ class PushRules:
     approach_angle: float
 
 
-def _length(value: float) -> float:
+def length(value: float) -> float:
+    """``value`` rounded to the micrometre: sums of sizes and margins as the decimal numbers they are."""
     return round(value, 6)  # sums of sizes and margins as the decimal numbers they are
 
 
@@ -125,12 +124,12 @@ def push_rules(config: TransferConfig, geometry: GripperGeometry) -> PushRules:
     """The clearances of ``config`` for a robot of ``geometry``."""
     g = geometry
     return PushRules(
-        forward_clearance=_length(g.fingertip_reach + config.forward_margin),
-        sideways_clearance=_length(g.finger_half_width + config.sideways_margin),
-        corridor_half_width=_length(g.finger_half_width + config.corridor_margin),
-        transit_clearance=_length(g.wrist_radius + config.transit_margin),
-        arm_shadow_length=_length(g.tcp_offset + config.wrist_shadow),
-        arm_shadow_half_width=_length(g.wrist_radius + config.shadow_margin),
+        forward_clearance=length(g.fingertip_reach + config.forward_margin),
+        sideways_clearance=length(g.finger_half_width + config.sideways_margin),
+        corridor_half_width=length(g.finger_half_width + config.corridor_margin),
+        transit_clearance=length(g.wrist_radius + config.transit_margin),
+        arm_shadow_length=length(g.tcp_offset + config.wrist_shadow),
+        arm_shadow_half_width=length(g.wrist_radius + config.shadow_margin),
         gripper_ahead=g.fingertip_reach,
         gripper_half_width=g.finger_half_width,
         gripper_behind=config.gripper_behind,
@@ -142,61 +141,4 @@ def push_rules(config: TransferConfig, geometry: GripperGeometry) -> PushRules:
         path_clearance=config.path_clearance,
         approach_gap=config.approach_gap,
         approach_angle=config.approach_angle,
-    )
-
-
-def _rounded_up(value: float) -> float:
-    return _length(math.ceil(value / SIZE_RESOLUTION - 1e-6) * SIZE_RESOLUTION)
-
-
-def _extent(plant, scene_graph, context, bodies, frame) -> np.ndarray:
-    """(2, 3) lower and upper corners, in ``frame``, of the box holding the bodies' collision geometry."""
-    inspector = scene_graph.model_inspector()
-    X_FW = frame.CalcPoseInWorld(context).inverse()
-    corners = []
-    signs = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)], dtype=float)
-    for body in bodies:
-        X_FB = X_FW @ plant.EvalBodyPoseInWorld(context, body)
-        for geometry in plant.GetCollisionGeometriesForBody(body):
-            box = inspector.GetObbInGeometryFrame(geometry)
-            X_FO = X_FB @ inspector.GetPoseInFrame(geometry) @ box.pose()
-            corners += [X_FO @ (s * box.half_width()) for s in signs]
-    corners = np.array(corners)
-    return np.array([corners.min(axis=0), corners.max(axis=0)])
-
-
-@functools.cache
-def gripper_geometry() -> GripperGeometry:
-    """The robot's sizes, read from its model's collision geometry with the fingers open (once)."""
-    from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
-    from pydrake.systems.framework import DiagramBuilder
-
-    from hlp_drake.systems.world.robot import (
-        FLANGE_FRAME,
-        GRIPPER_JOINTS,
-        GRIPPER_MIMIC_JOINTS,
-        GRIPPER_OPEN,
-        TCP_FRAME,
-        add_robot,
-    )
-
-    builder = DiagramBuilder()
-    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-    robot = add_robot(plant)
-    plant.Finalize()
-    diagram = builder.Build()
-    context = plant.GetMyMutableContextFromRoot(diagram.CreateDefaultContext())
-    for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS:
-        plant.GetJointByName(name, robot).set_translation(context, GRIPPER_OPEN)
-    tcp = plant.GetFrameByName(TCP_FRAME, robot)
-    fingers = [plant.GetBodyByName(name, robot) for name in ("left_finger_link", "right_finger_link")]
-    finger_box = _extent(plant, scene_graph, context, fingers, tcp)
-    offset = plant.GetFrameByName(FLANGE_FRAME, robot).CalcPose(context, tcp).translation()
-    wrist = plant.GetBodyByName("wrist_3_link", robot)
-    wrist_box = _extent(plant, scene_graph, context, [wrist], plant.GetFrameByName(FLANGE_FRAME, robot))
-    return GripperGeometry(
-        tcp_offset=_rounded_up(float(np.linalg.norm(offset))),
-        fingertip_reach=_rounded_up(float(finger_box[1, 2])),
-        finger_half_width=_rounded_up(float(np.max(np.abs(finger_box[:, 1])))),
-        wrist_radius=_rounded_up(float(np.max(wrist_box[1, :2]))),
     )

@@ -10,18 +10,75 @@ read from its model once (``transfer_geometry``).
 
 from __future__ import annotations
 
+import functools
+import math
 from typing import TYPE_CHECKING
 
+import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.systems.framework import LeafSystem
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
 from hlp_drake.planner import HighLevelPlan
+from hlp_drake.systems.world.robot import (
+    FLANGE_FRAME,
+    GRIPPER_JOINTS,
+    GRIPPER_MIMIC_JOINTS,
+    GRIPPER_OPEN,
+    TCP_FRAME,
+    add_robot,
+)
 from hlp_drake.systems.world.scene_source import declare_scene_input_port, scene_input
 from hlp_drake.transfer.push import robot_alternatives, robot_plan
-from hlp_drake.transfer.rules import PushRules, gripper_geometry, push_rules
+from hlp_drake.transfer.rules import SIZE_RESOLUTION, GripperGeometry, PushRules, length, push_rules
 
 if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
+
+
+def _rounded_up(value: float) -> float:
+    return length(math.ceil(value / SIZE_RESOLUTION - 1e-6) * SIZE_RESOLUTION)
+
+
+def _extent(plant, scene_graph, context, bodies, frame) -> np.ndarray:
+    """(2, 3) lower and upper corners, in ``frame``, of the box holding the bodies' collision geometry."""
+    inspector = scene_graph.model_inspector()
+    X_FW = frame.CalcPoseInWorld(context).inverse()
+    corners = []
+    signs = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)], dtype=float)
+    for body in bodies:
+        X_FB = X_FW @ plant.EvalBodyPoseInWorld(context, body)
+        for geometry in plant.GetCollisionGeometriesForBody(body):
+            box = inspector.GetObbInGeometryFrame(geometry)
+            X_FO = X_FB @ inspector.GetPoseInFrame(geometry) @ box.pose()
+            corners += [X_FO @ (s * box.half_width()) for s in signs]
+    corners = np.array(corners)
+    return np.array([corners.min(axis=0), corners.max(axis=0)])
+
+
+@functools.cache
+def gripper_geometry() -> GripperGeometry:
+    """The robot's sizes, read from its model's collision geometry with the fingers open (once)."""
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    robot = add_robot(plant)
+    plant.Finalize()
+    diagram = builder.Build()
+    context = plant.GetMyMutableContextFromRoot(diagram.CreateDefaultContext())
+    for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS:
+        plant.GetJointByName(name, robot).set_translation(context, GRIPPER_OPEN)
+    tcp = plant.GetFrameByName(TCP_FRAME, robot)
+    fingers = [plant.GetBodyByName(name, robot) for name in ("left_finger_link", "right_finger_link")]
+    finger_box = _extent(plant, scene_graph, context, fingers, tcp)
+    offset = plant.GetFrameByName(FLANGE_FRAME, robot).CalcPose(context, tcp).translation()
+    wrist = plant.GetBodyByName("wrist_3_link", robot)
+    wrist_box = _extent(plant, scene_graph, context, [wrist], plant.GetFrameByName(FLANGE_FRAME, robot))
+    return GripperGeometry(
+        tcp_offset=_rounded_up(float(np.linalg.norm(offset))),
+        fingertip_reach=_rounded_up(float(finger_box[1, 2])),
+        finger_half_width=_rounded_up(float(np.max(np.abs(finger_box[:, 1])))),
+        wrist_radius=_rounded_up(float(np.max(wrist_box[1, :2]))),
+    )
 
 
 class RobotPlanTransfer(LeafSystem):

@@ -8,6 +8,7 @@ the scene from their ``scene`` input port (``SceneFromPlant`` reads it from a pl
 
 from hlp_drake.systems.execution.command import GraspConfig
 from hlp_drake.systems.execution.diagram import ExecutionDiagram, make_execution_diagram
+from hlp_drake.systems.execution.job import run_job, scenario_yamls
 from hlp_drake.systems.execution.meshcat_view import draw_perception, draw_plan, frame_table
 from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
 from hlp_drake.systems.execution.run import ExecutionResult, RunListener, plan_and_execute, run_execution
@@ -141,6 +142,8 @@ __all__ = [
     "robot_plan",
     "robot_position_names",
     "run_execution",
+    "run_job",
+    "scenario_yamls",
     "scene_from_plant",
     "set_object_poses",
     "set_robot_positions",

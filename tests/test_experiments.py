@@ -20,9 +20,10 @@ import pandas as pd
 import pytest
 from conftest import run_module
 
+from hlp_drake import experiments
 from hlp_drake.cli import run_cli
 from hlp_drake.errors import HlpError
-from hlp_drake.experiments import ExperimentSettings, Job, make_row, run_experiment
+from hlp_drake.experiments import ExperimentSettings, Job, make_row
 from hlp_drake.experiments.cli import main
 from hlp_drake.experiments.results import (
     COLUMNS,
@@ -31,7 +32,9 @@ from hlp_drake.experiments.results import (
     results_csv,
     write_durable,
 )
+from hlp_drake.experiments.runner import JobFunction
 from hlp_drake.experiments.summary import summarise
+from hlp_drake.systems import scenario_yamls
 
 # fmt: off
 REQUIRED_COLUMNS = ["scene", "objects", "planner", "success", "failure_reason", "init_s", "optimise_s",
@@ -100,6 +103,11 @@ def never_called(job: Job) -> dict:
 def settings(kind: str = "gen1", **changes) -> ExperimentSettings:
     defaults = {"scenes": 3, "seed": 10, "workers": 1, "progress": False}
     return ExperimentSettings(kind=kind, **{**defaults, **changes})
+
+
+def run_experiment(settings: ExperimentSettings, out: Path, *, job: JobFunction) -> dict:
+    """``hlp_drake.experiments.run_experiment`` with the real scenario reading and the test's ``job``."""
+    return experiments.run_experiment(settings, out, job=job, scenario=scenario_yamls)
 
 
 def read_rows(path: Path) -> list[dict[str, str]]:
@@ -526,8 +534,7 @@ def test_rows_finishing_in_any_order_are_written_sorted(tmp_path):
 
 
 def test_a_drake_check_failing_in_a_job_is_that_jobs_crash_and_a_real_exit_is_not(monkeypatch):
-    from hlp_drake.experiments.runner import run_job
-    from hlp_drake.systems.execution import run as execution
+    from hlp_drake.systems.execution import job as job_module
     from hlp_drake.systems.scenario import Scenario
 
     job = Job("gen1", 0, 6, "gen1-0", "hlp", Scenario().updated("optimiser: {workers: 1}").yaml)
@@ -536,8 +543,8 @@ def test_a_drake_check_failing_in_a_job_is_that_jobs_crash_and_a_real_exit_is_no
         assert scenario.scene.name == "gen1-0" and scenario.planner.kind == "hlp" and pool.workers == 1
         raise SystemExit("Failure at plant.h:1 in SetPositions(): condition 'AllFinite(q)' failed.")
 
-    monkeypatch.setattr(execution, "plan_and_execute", failing_check)
-    row = run_job(job)
+    monkeypatch.setattr(job_module, "plan_and_execute", failing_check)
+    row = job_module.run_job(job)
     assert row["success"] is False and row["rollouts"] == 0
     assert row["failure_reason"] == (
         "crashed: SystemExit: Failure at plant.h:1 in SetPositions(): condition 'AllFinite(q)' failed."
@@ -546,9 +553,9 @@ def test_a_drake_check_failing_in_a_job_is_that_jobs_crash_and_a_real_exit_is_no
     def exiting(*args, **kwargs):
         raise SystemExit(3)
 
-    monkeypatch.setattr(execution, "plan_and_execute", exiting)
+    monkeypatch.setattr(job_module, "plan_and_execute", exiting)
     with pytest.raises(SystemExit):
-        run_job(job)
+        job_module.run_job(job)
 
 
 def test_perception_camera_is_part_of_the_runs_scenario_and_summary(tmp_path, capsys):

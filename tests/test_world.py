@@ -451,7 +451,7 @@ def test_meshcat_visualisation_is_optional(monkeypatch):
 
 
 def test_a_camera_source_without_a_camera_is_refused_whichever_way_it_is_asked_for():
-    from hlp_drake.experiments.experiment import scenario_yamls
+    from hlp_drake.systems.execution.job import scenario_yamls
     from hlp_drake.systems.scenario import with_conditions
 
     no_cameras = "perception: {cameras: []}\n"

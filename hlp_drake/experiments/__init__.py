@@ -1,6 +1,7 @@
 """The paper's Generalization I and II experiments (Tables II and III): ``python -m hlp_drake.experiments``.
 
-- ``runner``: one (scene, planner) job -> a ``results.csv`` row (``run_job`` runs the real planners);
+- ``runner``: one (scene, planner) job -> a ``results.csv`` row (the real job, with Drake, is
+  ``hlp_drake.systems.run_job``; ``hlp_drake.systems.scenario_yamls`` reads the scenario);
 - ``executors``: run jobs in this process, a local process pool or on dask;
 - ``results``: ``results.csv`` (columns, reading back, atomic rewrites);
 - ``experiment``: ``run_experiment``: resumable runs into a directory;
@@ -9,6 +10,6 @@
 """
 
 from hlp_drake.experiments.experiment import ExperimentSettings, run_experiment
-from hlp_drake.experiments.runner import Job, make_row, run_job
+from hlp_drake.experiments.runner import Job, ScenarioYamls, make_row
 
-__all__ = ["ExperimentSettings", "Job", "make_row", "run_experiment", "run_job"]
+__all__ = ["ExperimentSettings", "Job", "ScenarioYamls", "make_row", "run_experiment"]

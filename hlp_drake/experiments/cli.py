@@ -34,7 +34,7 @@ from hlp_drake.cli import (
 from hlp_drake.documents import read_document
 from hlp_drake.experiments.executors import EXECUTORS
 from hlp_drake.experiments.experiment import DERIVED, RESULTS, ExperimentSettings, run_experiment
-from hlp_drake.experiments.runner import KINDS, JobFunction, run_job
+from hlp_drake.experiments.runner import KINDS, JobFunction, ScenarioResolver
 from hlp_drake.experiments.summary import summary_markdown
 from hlp_drake.scene.generators import MAX_GENERATED
 
@@ -95,8 +95,14 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: Sequence[str] | None = None, *, job: JobFunction = run_job) -> int:
-    """Run the experiment of ``argv``; ``job`` replaces the real (scene, planner) job, e.g. in tests."""
+def main(
+    argv: Sequence[str] | None = None,
+    *,
+    job: JobFunction | None = None,
+    scenario: ScenarioResolver | None = None,
+) -> int:
+    """Run the experiment of ``argv``; ``job`` and ``scenario`` replace the real (scene, planner) job
+    and scenario reading (``hlp_drake.systems.execution.job``'s, which import Drake), e.g. in tests."""
     args = _parser().parse_args(argv)
     config_yaml = None
     if args.config:
@@ -104,8 +110,8 @@ def main(argv: Sequence[str] | None = None, *, job: JobFunction = run_job) -> in
     if args.execution is not None or args.uncertainty is not None:
         from hlp_drake.systems.scenario import load_scenario, with_conditions
 
-        scenario = load_scenario(data=config_yaml, where=args.config or "--config")
-        config_yaml = with_conditions(scenario, execution=args.execution, uncertainty=args.uncertainty).yaml
+        loaded = load_scenario(data=config_yaml, where=args.config or "--config")
+        config_yaml = with_conditions(loaded, execution=args.execution, uncertainty=args.uncertainty).yaml
     settings = ExperimentSettings(
         kind=args.kind,
         scenes=args.scenes,
@@ -120,7 +126,12 @@ def main(argv: Sequence[str] | None = None, *, job: JobFunction = run_job) -> in
         progress=not args.quiet,
     )
     command = f"{PROG} {shlex.join(sys.argv[1:] if argv is None else argv)}"
-    summary = run_experiment(settings, args.out, job=job, command=command)
+    if job is None or scenario is None:
+        from hlp_drake.systems.execution import job as drake_side  # Drake is imported from here on
+
+        job = job or drake_side.run_job
+        scenario = scenario or drake_side.scenario_yamls
+    summary = run_experiment(settings, args.out, job=job, scenario=scenario, command=command)
     print(summary_markdown(summary), end="")
     print(f"wrote {', '.join(str(Path(args.out) / name) for name in (RESULTS, 'run.json', *DERIVED))}")
     return 0

@@ -15,7 +15,7 @@ import time
 from contextlib import closing
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from tqdm import tqdm
 
@@ -25,11 +25,8 @@ from hlp_drake.experiments.executors import EXECUTORS, check_executor, run_jobs
 from hlp_drake.experiments.metadata import git_commit, machine_info, software_versions, utc_now
 from hlp_drake.experiments.plots import write_plots
 from hlp_drake.experiments.results import START_OVER, ResultsFile, read_results, read_run_file, row_key
-from hlp_drake.experiments.runner import KINDS, Job, JobFunction, make_jobs, run_job
+from hlp_drake.experiments.runner import KINDS, Job, JobFunction, ScenarioResolver, make_jobs
 from hlp_drake.experiments.summary import summarise, write_summary
-
-if TYPE_CHECKING:
-    from hlp_drake.systems.scenario import Scenario
 
 RESULTS, CONFIG, RUN = "results.csv", "config.json", "run.json"
 DERIVED = ("summary.md", "summary.json", "success.png", "times.png")
@@ -95,25 +92,6 @@ class ExperimentSettings:
         if self.scheduler is not None and self.executor != "dask":
             problems.append("--scheduler needs --executor dask")
         return problems
-
-
-def scenario_yamls(
-    text: str | None, *, single_process_rollouts: bool = False, perception: str | None = None
-) -> tuple[Scenario, str]:
-    """The scenario of ``text`` (None: the defaults; ``perception.source`` set to ``perception``
-    unless None), read once: the scenario (its ``yaml`` is the run's identity) and, written out in full,
-    as the jobs run it (``optimiser.workers = 1`` if ``single_process_rollouts``)."""
-    from dataclasses import replace
-
-    from hlp_drake.systems.scenario import load_scenario, with_conditions
-
-    scenario = with_conditions(load_scenario(data=text, where="--config"), perception=perception)
-    jobs = (
-        replace(scenario, optimiser=replace(scenario.optimiser, workers=1))
-        if single_process_rollouts
-        else scenario
-    )
-    return scenario, jobs.yaml
 
 
 def _check_directory(out: Path, identity: dict[str, Any], fresh: bool) -> None:
@@ -248,14 +226,16 @@ def run_experiment(
     settings: ExperimentSettings,
     out: str | os.PathLike[str],
     *,
-    job: JobFunction = run_job,
+    job: JobFunction,
+    scenario: ScenarioResolver,
     command: str | None = None,
 ) -> dict[str, Any]:
     """Run every job of ``settings`` not yet in ``out/results.csv``; write the summary and plots.
 
     Every check (settings, scenario, scene generation, the directory's earlier run) happens
-    before anything is written. ``job`` must be a picklable module-level function for the process
-    pool and dask executors.
+    before anything is written. ``job`` runs one job (``hlp_drake.systems.run_job``: the real
+    planners); it must be a picklable module-level function for the process pool and dask
+    executors. ``scenario`` reads ``settings.config_yaml`` (``hlp_drake.systems.scenario_yamls``).
 
     Returns:
         The summary (as written to ``summary.json``).
@@ -269,12 +249,12 @@ def run_experiment(
         raise HlpError(*problems)
     check_executor(settings.executor, settings.scheduler)
     out = Path(out)
-    scenario, job_yaml = scenario_yamls(
+    yamls = scenario(
         settings.config_yaml, single_process_rollouts=settings.parallel, perception=settings.perception
     )
-    config_yaml = scenario.yaml
+    config_yaml = yamls.identity
     jobs = make_jobs(
-        settings.kind, range(settings.seed, settings.seed + settings.scenes), settings.objects, job_yaml
+        settings.kind, range(settings.seed, settings.seed + settings.scenes), settings.objects, yamls.job
     )
     identity = {"kind": settings.kind, "seed": settings.seed, "scenario": config_yaml}
     _check_directory(out, identity, settings.fresh)
@@ -303,7 +283,7 @@ def run_experiment(
         )
         write_text_atomic(out / RUN, json.dumps(record, indent=2) + "\n")
     measured_on = _measured_on(record["machine"], settings)
-    if scenario.perception.source == "camera":
+    if yamls.perception_source == "camera":
         measured_on += "; the planners saw the scenes through the cameras (perception: camera)"
     summary = summarise(settings.kind, results.rows.values(), measured_on)
     write_summary(out, summary)

@@ -1,15 +1,16 @@
 """One experiment job: plan and execute one scene with one planner, reduced to a ``results.csv`` row.
 
 A job is a pure function of its ``Job`` (kind, seed, object count, planner, scenario YAML), so the
-same job gives the same outcome in this process, a local worker process or a dask worker. Drake is
-imported inside ``run_job`` only: worker processes are spawned and import what they run.
+same job gives the same outcome in this process, a local worker process or a dask worker. The real
+job and the scenario reading are Drake's (``hlp_drake.systems.execution.job``): this module only
+defines what they take and give, and worker processes are spawned and import what they run.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, replace
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, Protocol
 
 from hlp_drake.errors import SceneError
 from hlp_drake.scene.generators import generate_scene
@@ -45,7 +46,36 @@ class Job:
 
 
 JobFunction = Callable[[Job], Row]
-"""What an experiment runs per job: a picklable module-level function ``Job -> Row``."""
+"""What an experiment runs per job: a picklable module-level function ``Job -> Row``
+(``hlp_drake.systems.run_job`` runs the real planners)."""
+
+
+@dataclass(frozen=True)
+class ScenarioYamls:
+    """A run's scenario, read once, as plain values.
+
+    Attributes:
+        identity: the scenario as YAML (the run's identity, in ``config.json`` and ``run.json``).
+        job: the scenario as the jobs run it, as YAML (``Job.config_yaml``).
+        perception_source: its ``perception.source`` ("truth" or "camera").
+    """
+
+    identity: str
+    job: str
+    perception_source: str
+
+
+class ScenarioResolver(Protocol):
+    """Reads a run's scenario (``hlp_drake.systems.scenario_yamls`` is the real one).
+
+    ``text``: the scenario settings as YAML (None: the defaults); ``perception`` overrides its
+    ``perception.source`` unless None; ``single_process_rollouts``: the jobs' optimiser rolls out in
+    its own process (``optimiser.workers = 1``). Raises ``HlpError`` for an invalid scenario.
+    """
+
+    def __call__(
+        self, text: str | None, *, single_process_rollouts: bool, perception: str | None
+    ) -> ScenarioYamls: ...
 
 
 def make_jobs(kind: str, seeds: Iterable[int], objects: Iterable[int], config_yaml: str) -> list[Job]:
@@ -118,67 +148,3 @@ def make_row(
         "replan_rollouts": int(replan_rollouts),
         "execute_s": execute_s,
     }
-
-
-def run_job(job: Job) -> Row:
-    """Plan and execute ``job``'s scene in the Drake world.
-
-    An exception (or one of Drake's internal checks failing, which pydrake raises as ``SystemExit``)
-    is recorded as this planner's failure on this scene ("crashed: ..."), its times as NaN (left
-    out of the means), rather than ending the run. The bundled decision models are loaded
-    before the timed call, so a worker's first scene is not charged for loading them, and
-    every job has a rollout pool of its own: no job uses rollout worlds an earlier one (maybe the
-    other planner on the same scene) built.
-    """
-    from hlp_drake.learners.bundled import default_models
-    from hlp_drake.systems.execution.run import plan_and_execute
-    from hlp_drake.systems.optimiser.pool import RolloutPool
-    from hlp_drake.systems.optimiser.rollout_world import simulation_failure
-    from hlp_drake.systems.scenario import load_scenario
-
-    settings = load_scenario(data=job.config_yaml, where="the job's scenario")
-    try:
-        scenario = replace(
-            settings, scene=job.make_scene(), planner=replace(settings.planner, kind=job.planner)
-        )
-        with RolloutPool(scenario.optimiser.workers) as pool:
-            result = plan_and_execute(scenario, pool=pool, models=default_models())
-    except (Exception, SystemExit) as error:  # noqa: BLE001 - a crash is this planner's failure here
-        if isinstance(error, SystemExit):
-            simulation_failure(error)  # raises it again unless it is Drake's
-        reason = " ".join(f"crashed: {type(error).__name__}: {error}".split())[:300]
-        nan = float("nan")
-        return make_row(
-            job,
-            success=False,
-            failure_reason=reason,
-            plan_s=nan,
-            ik_s=nan,
-            optimise_s=nan,
-            execute_s=nan,
-            verify_s=nan,
-            rollouts=0,
-            iterations=0,
-            objects_moved=0,
-            objects_dropped=0,
-        )
-    t = result.timings
-    return make_row(
-        job,
-        success=result.success,
-        failure_reason=result.failure_reason,
-        plan_s=t["plan_s"],
-        ik_s=t["ik_s"],
-        optimise_s=t.get("optimise_s", 0.0),
-        execute_s=t.get("execute_s", 0.0),
-        rollouts=result.rollouts,
-        iterations=result.iterations,
-        objects_moved=len(result.objects_moved),
-        objects_dropped=len(result.objects_dropped),
-        verifications=result.optimisation.get("verifications", 0),
-        rejected=result.optimisation.get("rejected", 0),
-        verify_s=result.optimisation.get("verify_s", 0.0),
-        passed_then_failed=result.rollout_passed_execution_failed,
-        replans=result.closed_loop.get("replans", 0),
-        replan_rollouts=result.closed_loop.get("rollouts", 0),
-    )

@@ -4,7 +4,7 @@
         [--config SCENARIO.yaml] [--workers 2] [--json OUT]
 
 Plans each seeded scene, solves IK and rolls the initial trajectory out once, as the optimiser's
-first rollout (``systems.planning_diagram.first_rollout``: reduced model, rollout time step). Prints the
+first rollout (``hlp_drake.systems.planning.diagram.first_rollout``: reduced model, rollout time step). Prints the
 passes per object count and every failing scene with its reason. The optimiser stops at a passing
 first rollout, so this count decides most of the planning time; comparing two configurations
 (``--config`` with, say, ``motion: {closed_among_obstacles: false}``) shows what a planning or

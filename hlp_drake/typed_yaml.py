@@ -1,22 +1,18 @@
-"""Typed YAML files: frozen dataclass schemas read with Drake's ``yaml_load_typed``, errors located.
+"""Typed YAML documents: frozen dataclass schemas, every problem located on its own line.
 
 A schema is a frozen dataclass whose fields are floats, ints, bools, strings, ``Literal`` strings,
 tuples (``tuple[float, float]`` of a fixed length or ``tuple[X, ...]``), ``X | None``, other schemas
-or Drake's bound config structs (e.g. ``MultibodyPlantConfig``). Drake's loader writes into mutable
-objects and knows lists, not tuples, so a document is read into a mutable twin of the schema (lists
-for tuples, ``str`` for ``Literal``) and frozen again.
+or Drake's bound config structs (e.g. ``MultibodyPlantConfig``).
 
-Before that, the document is checked against the schema and every problem is reported at its
-place, one line each (``obstacles[0].size: expected a list of 3 numbers, got [1, 2]``), which
-Drake's loader cannot do: types, finite numbers (at most ``MAX_FLOAT``), 64-bit integers. A
-schema with a field without a default (a scene, an object) is read whole: such a mapping must give
-every required field and does not merge into a default. A schema whose every field has a default
-merges into the defaults: a file gives only what it changes. A whole schema without Drake structs
-(a scene) is then built directly from the checked document, the rest by Drake's loader. Documents
-come from ``hlp_drake.documents`` (``parse_yaml``: limits on size, depth, aliases, duplicate keys).
-
-Drake's YAML module is imported on the first load or dump only (it costs ~0.3 s), so the Drake-free
-half of the package stays quick to import.
+A document (``hlp_drake.documents.parse_yaml``: limits on size, depth, aliases, duplicate keys) is
+checked against the schema first, every problem reported at its place, one line each
+(``obstacles[0].size: expected a list of 3 numbers, got [1, 2]``): types, finite numbers (at most
+``MAX_FLOAT``), 64-bit integers, unknown and missing fields. The checked document is then read over
+the defaults: a schema whose every field has a default merges into its default (a file gives only
+what it changes); a schema with a required field (a scene, an object) is read whole from its
+mapping, as is an item of a list (fields it omits take their class defaults); a list replaces the
+default one. A Drake struct is merged by Drake's ``yaml_load_typed`` (imported then: it costs
+~0.3 s). ``dump_typed`` writes the layout of Drake's ``yaml_dump_typed``.
 """
 
 from __future__ import annotations
@@ -36,15 +32,11 @@ T = TypeVar("T")
 NoneType = type(None)
 MAX_FLOAT = 1e300
 """Largest magnitude of a number in a document (inf, nan and integers beyond it are refused)."""
+MAX_INT = 2**63 - 1
+"""Largest integer a document may give (Drake reads 64-bit integers)."""
 
 
 # --- Schema types -------------------------------------------------------------------------------
-
-
-@functools.cache
-def _hints(schema: type) -> dict[str, Any]:
-    """A schema's field types, with string annotations resolved."""
-    return typing.get_type_hints(schema)
 
 
 def _is_schema(kind: Any) -> bool:
@@ -56,6 +48,26 @@ def _is_drake_struct(kind: Any) -> bool:
 
 
 @functools.cache
+def _fields(kind: type) -> dict[str, Any]:
+    """The field types of a schema (string annotations resolved) or of a Drake struct."""
+    if _is_schema(kind):
+        return typing.get_type_hints(kind)
+    return {f.name: f.type for f in kind.__fields__}
+
+
+@functools.cache
+def _required(kind: type) -> list[str]:
+    """The fields of a schema that have no default (a schema with any is read whole)."""
+    if not _is_schema(kind):
+        return []
+    return [
+        f.name
+        for f in dataclasses.fields(kind)
+        if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+    ]
+
+
+@functools.cache
 def _optional(kind: Any) -> Any:
     """``X`` for ``X | None``, else None."""
     if typing.get_origin(kind) in (typing.Union, types.UnionType):
@@ -63,21 +75,6 @@ def _optional(kind: Any) -> Any:
         if len(args) == 1 and len(typing.get_args(kind)) == 2:
             return args[0]
     return None
-
-
-@functools.cache
-def _required(schema: type) -> list[str]:
-    """The fields of ``schema`` that have no default."""
-    return [
-        f.name
-        for f in dataclasses.fields(schema)
-        if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
-    ]
-
-
-def _whole(schema: type) -> bool:
-    """Whether a mapping of ``schema`` is read whole (it has required fields) rather than merged."""
-    return bool(_required(schema))
 
 
 @functools.cache
@@ -93,69 +90,7 @@ def _tuple_items(kind: Any) -> tuple[Any, int | None] | None:
     return args[0], len(args)
 
 
-@functools.cache
-def _thawed(schema: type) -> type:
-    """A mutable dataclass with the fields of ``schema``: lists for tuples, ``str`` for literals,
-    None as the default of a required field (filled by the document, else reported missing)."""
-    fields = []
-    for f in dataclasses.fields(schema):
-        kind = _thawed_type(_hints(schema)[f.name])
-        if f.default is not dataclasses.MISSING:
-            default = _thaw(f.default)
-            spec = dataclasses.field(default_factory=functools.partial(_thaw, default))
-        elif f.default_factory is not dataclasses.MISSING:
-            spec = dataclasses.field(default_factory=lambda factory=f.default_factory: _thaw(factory()))
-        else:
-            kind, spec = kind | None, dataclasses.field(default=None)
-        fields.append((f.name, kind, spec))
-    return dataclasses.make_dataclass(schema.__name__, fields)
-
-
-def _thawed_type(kind: Any) -> Any:
-    inner = _optional(kind)
-    if inner is not None:
-        return _thawed_type(inner) | None
-    if typing.get_origin(kind) is Literal:
-        return str
-    items = _tuple_items(kind)
-    if items is not None:
-        return list[_thawed_type(items[0])]
-    return _thawed(kind) if _is_schema(kind) else kind
-
-
-def _thaw(value: Any) -> Any:
-    """``value`` as its mutable twin (a copy: a default is never shared)."""
-    if _is_schema(type(value)):
-        twin = _thawed(type(value))
-        return twin(**{f.name: _thaw(getattr(value, f.name)) for f in dataclasses.fields(value)})
-    if isinstance(value, tuple | list):
-        return [_thaw(v) for v in value]
-    if _is_drake_struct(type(value)):
-        return type(value)(**{f.name: getattr(value, f.name) for f in type(value).__fields__})
-    return value
-
-
-def _freeze(schema: Any, value: Any) -> Any:
-    """The mutable twin ``value`` as an instance of ``schema``."""
-    inner = _optional(schema)
-    if inner is not None:
-        return None if value is None else _freeze(inner, value)
-    if _is_schema(schema):
-        hints = _hints(schema)
-        return schema(
-            **{f.name: _freeze(hints[f.name], getattr(value, f.name)) for f in dataclasses.fields(schema)}
-        )
-    items = _tuple_items(schema)
-    if items is not None:
-        return tuple(_freeze(items[0], v) for v in value)
-    return value
-
-
 # --- Located problems -------------------------------------------------------------------------------
-
-
-MAX_INT = 2**63 - 1
-"""Largest integer a document may give (Drake reads 64-bit integers)."""
 
 
 def _scalar_problem(kind: Any, value: Any) -> str | None:
@@ -209,12 +144,9 @@ def document_problems(schema: Any, value: Any, where: str = "", *, top: str = "d
     if _is_schema(schema) or _is_drake_struct(schema):
         if not isinstance(value, dict):
             return [f"{label}: expected a mapping, got {type(value).__name__}"]
-        if _is_schema(schema):
-            hints, required = _hints(schema), _required(schema)
-        else:
-            hints, required = {f.name: f.type for f in schema.__fields__}, []
+        hints = _fields(schema)
         problems = [f"{label}: unknown field {key!r}" for key in value if key not in hints]
-        problems += [f"{label}: missing field {name!r}" for name in required if name not in value]
+        problems += [f"{label}: missing field {name!r}" for name in _required(schema) if name not in value]
         for name, sub in value.items():
             if name in hints:
                 problems += document_problems(hints[name], sub, _join(where, name), top=top)
@@ -226,46 +158,30 @@ def document_problems(schema: Any, value: Any, where: str = "", *, top: str = "d
 # --- Loading and dumping -------------------------------------------------------------------------------
 
 
-@functools.cache
-def _plain(kind: Any) -> bool:
-    """Whether values of ``kind`` hold no Drake struct (so they are built without Drake's loader)."""
+def _read(kind: Any, default: Any, value: Any) -> Any:
+    """The checked document ``value`` as a ``kind`` over ``default`` (None: the class defaults)."""
     inner = _optional(kind)
     if inner is not None:
-        return _plain(inner)
+        return None if value is None else _read(inner, default, value)
     items = _tuple_items(kind)
     if items is not None:
-        return _plain(items[0])
-    if _is_schema(kind):
-        return all(_plain(hint) for hint in _hints(kind).values())
-    return not _is_drake_struct(kind)
+        return tuple(_read(items[0], None, v) for v in value)
+    if _is_drake_struct(kind):
+        from pydrake.common.yaml import yaml_load_typed
 
-
-def _build(kind: Any, value: Any) -> Any:
-    """The checked document ``value`` as an instance of the plain type ``kind`` (fields it does not
-    give take their defaults, as Drake's loader fills them)."""
-    inner = _optional(kind)
-    if inner is not None:
-        return None if value is None else _build(inner, value)
-    items = _tuple_items(kind)
-    if items is not None:
-        return tuple(_build(items[0], v) for v in value)
-    if _is_schema(kind):
-        hints = _hints(kind)
-        return kind(**{name: _build(hints[name], v) for name, v in value.items()})
-    return float(value) if kind is float else value
-
-
-def _clear_whole(schema: type, base: Any, document: Any) -> None:
-    """Replace every default in ``base`` that ``document`` gives a whole value for by a blank one."""
-    if not isinstance(document, dict):
-        return
-    for name, kind in _hints(schema).items():
-        kind = _optional(kind) or kind
-        if name in document and _is_schema(kind):
-            if _whole(kind):
-                setattr(base, name, _thawed(kind)())
-            elif getattr(base, name) is not None:
-                _clear_whole(kind, getattr(base, name), document[name])
+        return yaml_load_typed(schema=kind, data=yaml.safe_dump(value), defaults=default)
+    if not _is_schema(kind):
+        return float(value) if kind is float else value
+    hints = _fields(kind)
+    if default is None or _required(kind):
+        return kind(**{name: _read(hints[name], None, v) for name, v in value.items()})
+    # A Drake struct is mutable: each read gets its own copy, as Drake's loader gives.
+    changes = {
+        name: _read(hint, getattr(default, name), value.get(name, {}))
+        for name, hint in hints.items()
+        if name in value or _is_drake_struct(hint)
+    }
+    return dataclasses.replace(default, **changes)
 
 
 def load_typed(
@@ -291,30 +207,37 @@ def load_typed(
     problems = document_problems(schema, document, top=top)
     if problems:
         raise error(*(prefix + p for p in problems))
-    if defaults is None and _plain(schema):
-        return _build(schema, document)
-    # Whole plain fields (a scenario's scene) are built directly: Drake's loader would take ~1 s
-    # per thousand objects to read what is already checked.
-    from pydrake.common.yaml import yaml_load_typed
+    return _read(schema, defaults, document)
 
-    hints = _hints(schema)
-    direct = {
-        name: _build(hints[name], sub)
-        for name, sub in (document or {}).items()
-        if _is_schema(hints[name]) and _whole(hints[name]) and _plain(hints[name])
-    }
-    document = {name: sub for name, sub in (document or {}).items() if name not in direct}
-    base = _thaw(defaults) if defaults is not None else _thawed(schema)()
-    _clear_whole(schema, base, document)
-    try:
-        loaded = yaml_load_typed(schema=_thawed(schema), data=yaml.safe_dump(document), defaults=base)
-    except (RuntimeError, ValueError, TypeError, KeyError, AssertionError) as problem:
-        raise error(prefix + " ".join(str(problem).split())) from None
-    return dataclasses.replace(_freeze(schema, loaded), **direct)
+
+def _plain(kind: Any, value: Any) -> Any:
+    """``value`` of type ``kind`` as plain data, as Drake's ``yaml_dump_typed`` gives it (a None
+    is left out where the field may be None or is required)."""
+    inner = _optional(kind)
+    if inner is not None:
+        return None if value is None else _plain(inner, value)
+    items = _tuple_items(kind)
+    if items is not None:
+        return [_plain(items[0], v) for v in value]
+    if _is_schema(kind) or _is_drake_struct(kind):
+        data = {}
+        for name, hint in _fields(kind).items():
+            item = getattr(value, name)
+            if item is not None or (_optional(hint) is None and name not in _required(kind)):
+                data[name] = _plain(hint, item)
+        return data
+    return str(value) if typing.get_origin(kind) is Literal else kind(value)
+
+
+class _Dumper(yaml.SafeDumper):
+    """The layout of Drake's ``yaml_dump_typed``: a mapping on one line only when it is empty."""
+
+    def serialize_node(self, node: yaml.Node, parent: Any, index: Any) -> None:
+        if isinstance(node, yaml.MappingNode):
+            node.flow_style = not node.value
+        return super().serialize_node(node, parent, index)
 
 
 def dump_typed(value: Any) -> str:
     """``value`` (a schema instance) as YAML text that ``load_typed`` reads back to an equal value."""
-    from pydrake.common.yaml import yaml_dump_typed
-
-    return yaml_dump_typed(_thaw(value))
+    return yaml.dump(_plain(type(value), value), Dumper=_Dumper, default_flow_style=None, sort_keys=False)

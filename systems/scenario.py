@@ -4,7 +4,7 @@ A frozen dataclass tree (the pattern of manipulation's ``Scenario``): the scene,
 plant and contact settings, how the scene becomes bodies, the robot's controller, keypoint IK,
 motion timing, the push transfer's margins, the optimiser and the grasp. Each section is a config
 dataclass beside the code that uses it, each field with its range (``hlp_drake.ranges``). Loaded
-with Drake's typed loader (``load_scenario``; problems are located one-line errors), it is passed to
+by ``load_scenario`` (``hlp_drake.typed_yaml``; problems are located one-line errors), it is passed to
 the builders at construction. A ``Scenario`` is checked once, when it is made (in Python too, and by
 ``dataclasses.replace``): one that exists can be used. ``Scenario.key`` (computed once) identifies
 it, e.g. for rollout worlds.

@@ -1,7 +1,7 @@
 """Scene files: YAML or JSON, chosen by the file extension. Loading validates; saving is atomic.
 
-The format is the ``Scene`` dataclass itself, read with Drake's typed loader (``hlp_drake.typed_yaml``),
-the same way a scenario file's ``scene:`` is read.
+The format is the ``Scene`` dataclass itself, read by ``hlp_drake.typed_yaml`` the same way a scenario
+file's ``scene:`` is read.
 """
 
 from __future__ import annotations
@@ -55,8 +55,8 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
 
 
 def scene_from_dict(data: Any, *, where: str = "") -> Scene:
-    """Read and validate a Scene from parsed YAML or JSON (``Scene`` is the schema, read with Drake's
-    typed loader; see ``hlp_drake.typed_yaml``).
+    """Read and validate a Scene from parsed YAML or JSON (``Scene`` is the schema; see
+    ``hlp_drake.typed_yaml``).
 
     Raises:
         SceneError: every problem on its own line, located (``obstacles[0].x: expected a number``)

@@ -395,9 +395,10 @@ RUN_SETTINGS = {"kind": "gen1", "seed": 10, "scenes": 2, "workers": 1, "progress
 def _run_folder() -> dict[str, bytes]:
     """The records of a finished (cheap) experiment: results.csv, run.json, config.json."""
     from hlp_drake.experiments import ExperimentSettings, run_experiment
+    from hlp_drake.systems import scenario_yamls
 
     with tempfile.TemporaryDirectory() as folder:
-        run_experiment(ExperimentSettings(**RUN_SETTINGS), folder, job=_cheap_job)
+        run_experiment(ExperimentSettings(**RUN_SETTINGS), folder, job=_cheap_job, scenario=scenario_yamls)
         return {
             name: (Path(folder) / name).read_bytes() for name in ("results.csv", "run.json", "config.json")
         }
@@ -433,6 +434,7 @@ def damaged_run_folder(draw) -> dict[str, bytes]:
 def _check_resume(files: dict[str, bytes]) -> None:
     from hlp_drake.experiments import ExperimentSettings, run_experiment
     from hlp_drake.experiments.results import COLUMNS, read_results
+    from hlp_drake.systems import scenario_yamls
 
     STATS["run folders damaged"] += 1
     with tempfile.TemporaryDirectory() as folder:
@@ -440,7 +442,7 @@ def _check_resume(files: dict[str, bytes]) -> None:
         for name, data in files.items():
             (out / name).write_bytes(data)
         try:
-            run_experiment(ExperimentSettings(**RUN_SETTINGS), out, job=_cheap_job)
+            run_experiment(ExperimentSettings(**RUN_SETTINGS), out, job=_cheap_job, scenario=scenario_yamls)
         except HlpError as error:
             check_error(error)
             assert {name: (out / name).read_bytes() for name in files} == files  # left as it was

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from hlp_drake.features.direction import DirectionTable
-from hlp_drake.features.row_choice import free_space
+from hlp_drake.features.row_geometry import free_space
 from hlp_drake.lazy import LazyRows
 from hlp_drake.planner import PlanKeypoint
 from hlp_drake.planner.row_plan import plans_segment_collisions, segment_collisions

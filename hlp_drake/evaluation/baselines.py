@@ -16,7 +16,7 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from hlp_drake.features.row_choice import line_at
+from hlp_drake.features.row_geometry import line_at
 from hlp_drake.planner.plan import HighLevelPlan, PlanKeypoint
 from hlp_drake.scene.model import Scene
 from hlp_drake.segmentation.demonstration import GAP, NONE, OBJECT, Demonstration

@@ -23,10 +23,16 @@ from hlp_drake.systems.perception.accuracy import perception_record
 from hlp_drake.systems.perception.cameras import CameraConfig, PerceptionConfig
 from hlp_drake.systems.perception.perception import PerceivedObject, Perception, perceive
 from hlp_drake.systems.perception.system import ScenePerception, add_scene_perception, perceive_world
-from hlp_drake.systems.planning.diagram import first_rollout, initial_sequence, make_planning_diagram
+from hlp_drake.systems.planning.diagram import (
+    HlpPlannerSystem,
+    StraightLinePlanSystem,
+    first_rollout,
+    initial_sequence,
+    make_planning_diagram,
+    straight_line_plan,
+)
 from hlp_drake.systems.planning.ik import KeypointIk
 from hlp_drake.systems.planning.keyframes import Keyframes, PlanningModel
-from hlp_drake.systems.planning.planners import HlpPlannerSystem, StraightLinePlanSystem, straight_line_plan
 from hlp_drake.systems.planning.transfer import RobotPlanTransfer, gripper_geometry
 from hlp_drake.systems.scenario import PlannerChoiceConfig, Scenario, load_scenario
 from hlp_drake.systems.world.robot import (

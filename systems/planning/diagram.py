@@ -2,6 +2,9 @@
 
 The diagram's one input is ``scene``: fix it, or feed it from a plant's body poses through
 ``SceneFromPlant`` (as ``plan_and_execute`` does), and the diagram plans again when the scene changes.
+Its planner blocks are here too: ``HlpPlannerSystem`` (the human-like planner) and
+``StraightLinePlanSystem`` (the baseline's straight line), and ``ObservedScenePlanner``, which runs the
+same planning again on a measured scene for the receding-horizon controller.
 """
 
 from __future__ import annotations
@@ -12,20 +15,20 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.systems.framework import Diagram, DiagramBuilder
+from pydrake.systems.framework import Context, Diagram, DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import ConstantValueSource
 
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.learners.models import DecisionModels
-from hlp_drake.planner.plan import HighLevelPlan
+from hlp_drake.planner import HighLevelPlan, PlanKeypoint, PlannerConfig, plan
+from hlp_drake.scene.model import Scene
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.cost import RolloutOutcome
 from hlp_drake.systems.optimiser.pool import RolloutPool, SceneRollouts
 from hlp_drake.systems.optimiser.system import StochasticTrajectoryOptimiser
 from hlp_drake.systems.planning.ik import KeypointIk
-from hlp_drake.systems.planning.planners import HlpPlannerSystem, StraightLinePlanSystem
 from hlp_drake.systems.planning.transfer import RobotPlanTransfer
-from hlp_drake.systems.world.scene_source import SCENE_PORT
+from hlp_drake.systems.world.scene_source import SCENE_PORT, declare_scene_input_port, scene_input
 
 if TYPE_CHECKING:
     from hlp_drake.scene.model import Scene
@@ -155,3 +158,74 @@ class ObservedScenePlanner:
 
 
 __all__ = ["ObservedScenePlanner"]
+
+
+# ``HlpPlannerSystem``: the human-like planner as a Drake LeafSystem (scene in, HighLevelPlan out).
+class HlpPlannerSystem(LeafSystem):
+    """Plans with the human-like planner (``hlp_drake.planner.plan``).
+
+    Input port ``scene`` (abstract ``Scene``; from ``SceneFromPlant`` to plan on a plant's body
+    poses). Output port ``plan`` (abstract ``HighLevelPlan``), in Drake's cache: planned again only
+    when the scene changes (to plan at a fixed rate in a simulation, put Drake's ``ZeroOrderHold``
+    on the scene).
+
+    Args:
+        models: decision models (default: the bundled ones).
+        config: planner settings (default: the models' mode).
+    """
+
+    def __init__(self, *, models: DecisionModels | None = None, config: PlannerConfig | None = None) -> None:
+        super().__init__()
+        self._models = models or default_models()
+        self._config = config or PlannerConfig(mode=self._models.mode_)
+        self._scene_port = declare_scene_input_port(self)
+        self._plan_port = self.DeclareAbstractOutputPort(
+            name="plan",
+            alloc=lambda: AbstractValue.Make(HighLevelPlan("", ())),
+            calc=self._calc_plan,
+            prerequisites_of_calc={self.all_input_ports_ticket()},
+        )
+
+    def get_scene_input_port(self):
+        return self._scene_port
+
+    def get_plan_output_port(self):
+        return self._plan_port
+
+    def _calc_plan(self, context: Context, output: AbstractValue) -> None:
+        output.set_value(plan(scene_input(self._scene_port, context), self._models, self._config))
+
+
+# The straight-line baseline's planner block: from the start straight to the target.
+def straight_line_plan(scene: Scene) -> HighLevelPlan:
+    """The baseline's initial plan: from the start straight to the target."""
+    return HighLevelPlan(
+        scene.name,
+        (
+            PlanKeypoint("start", (float(scene.start[0]), float(scene.start[1]))),
+            PlanKeypoint("target", (float(scene.target.x), float(scene.target.y)), None, scene.target.name),
+        ),
+    )
+
+
+class StraightLinePlanSystem(LeafSystem):
+    """The straight-line baseline's planner block, with ``HlpPlannerSystem``'s ports: input ``scene``
+    (abstract ``Scene``), output ``plan`` (abstract ``HighLevelPlan``)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._scene_port = declare_scene_input_port(self)
+        self._plan_port = self.DeclareAbstractOutputPort(
+            name="plan",
+            alloc=lambda: AbstractValue.Make(HighLevelPlan("", ())),
+            calc=lambda context, output: output.set_value(
+                straight_line_plan(scene_input(self._scene_port, context))
+            ),
+            prerequisites_of_calc={self.all_input_ports_ticket()},
+        )
+
+    def get_scene_input_port(self):
+        return self._scene_port
+
+    def get_plan_output_port(self):
+        return self._plan_port

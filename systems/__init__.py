@@ -3,7 +3,8 @@
 Every builder and block takes one typed ``Scenario`` (``load_scenario``); the planning blocks take
 the scene from their ``scene`` input port (``SceneFromPlant`` reads it from a plant,
 ``ScenePerception`` from the world's depth cameras). Resources
-(``RolloutPool``) belong to the caller, who closes them.
+(``RolloutPool``) belong to the caller, who closes them. Subpackages: ``world``, ``planning``,
+``optimiser``, ``perception`` and ``execution``; the names below are the public API.
 """
 
 from hlp_drake.systems.execution.command import GraspConfig

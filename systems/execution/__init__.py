@@ -1,1 +1,2 @@
-"""Execution: the reach, grasp and closed-loop control in the world, and MeshCat drawing."""
+"""Execution: the execution diagram and its run (reach, grasp), closed-loop control, MeshCat drawing and
+the experiments' job."""

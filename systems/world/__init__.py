@@ -1,1 +1,1 @@
-"""The simulated world: the robot, the scene's bodies, cameras, model error and the world diagram."""
+"""The simulated world: the robot, the scene's bodies and scene source, model error and the world diagram."""

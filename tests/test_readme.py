@@ -101,3 +101,19 @@ def test_the_yaml_blocks_load_as_a_scenario_and_a_scene(tmp_path):
 )
 def test_the_readmes_links_into_the_repository_exist(link):
     assert (REPO / link).exists(), link
+
+
+def _docs_links() -> list[tuple[str, str]]:
+    """(document, relative link target) of every link from docs/*.md into the repository."""
+    found = set()
+    for doc in sorted((REPO / "docs").glob("*.md")):
+        for target in re.findall(r"\]\(([^)#\s]+)(?:#[^)]*)?\)", doc.read_text()):
+            if not re.match(r"[a-z]+:", target):
+                found.add((doc.name, target))
+    return sorted(found)
+
+
+@pytest.mark.parametrize(("doc", "link"), _docs_links())
+def test_the_docs_links_into_the_repository_exist(doc, link):
+    # the results and limits moved from the README to docs/: their links are checked here
+    assert (REPO / "docs" / link).resolve().exists(), (doc, link)

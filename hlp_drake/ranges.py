@@ -28,6 +28,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Annotated, Any
 
+from hlp_drake.typed_yaml import join_path
+
 MAX_SETTING = 1e9
 """Largest value of any number in the settings (a stiffness of 1e6 N/m is typical)."""
 MAX_TIME_STEP = 0.1
@@ -122,7 +124,7 @@ class Fields(Check):
         return [
             p
             for name, check in self.checks.items()
-            for p in check.problems(_join(where, name), getattr(value, name))
+            for p in check.problems(join_path(where, name), getattr(value, name))
         ]
 
 
@@ -135,10 +137,6 @@ class First:
 
 PositiveFloat = Annotated[float, Positive()]
 NonNegativeFloat = Annotated[float, Positive(zero_ok=True)]
-
-
-def _join(where: str, name: str) -> str:
-    return f"{where}.{name}" if where else name
 
 
 @dataclass(frozen=True)
@@ -208,7 +206,7 @@ def config_problems(config: Any, where: str = "") -> list[str]:
     """
     problems: list[str] = []
     for spec in _fields(type(config)):
-        value, path = getattr(config, spec.name), _join(where, spec.name)
+        value, path = getattr(config, spec.name), join_path(where, spec.name)
         if value is None and spec.optional:
             continue
         for check in spec.checks:

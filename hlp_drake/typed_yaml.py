@@ -117,7 +117,8 @@ def _scalar_problem(kind: Any, value: Any) -> str | None:
     return None
 
 
-def _join(where: str, name: str) -> str:
+def join_path(where: str, name: str) -> str:
+    """The path of the field ``name`` below ``where`` ("" at the top), as messages name it."""
     return f"{where}.{name}" if where else name
 
 
@@ -149,7 +150,7 @@ def document_problems(schema: Any, value: Any, where: str = "", *, top: str = "d
         problems += [f"{label}: missing field {name!r}" for name in _required(schema) if name not in value]
         for name, sub in value.items():
             if name in hints:
-                problems += document_problems(hints[name], sub, _join(where, name), top=top)
+                problems += document_problems(hints[name], sub, join_path(where, name), top=top)
         return problems
     problem = _scalar_problem(schema, value)
     return [] if problem is None else [f"{label}: {problem}"]

@@ -117,7 +117,7 @@ class PushRules:
 
 def length(value: float) -> float:
     """``value`` rounded to the micrometre: sums of sizes and margins as the decimal numbers they are."""
-    return round(value, 6)  # sums of sizes and margins as the decimal numbers they are
+    return round(value, 6)
 
 
 def push_rules(config: TransferConfig, geometry: GripperGeometry) -> PushRules:

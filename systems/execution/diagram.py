@@ -58,7 +58,6 @@ class ExecutionDiagram:
     planning: Diagram
     source: SceneFromPlant | ScenePerception
     planned_scene: Scene | None
-    model_error: WorldPerturbation | None
     controller: RecedingHorizonController | None = None
     trajectory_source: TrajectorySource | None = None
 
@@ -119,16 +118,15 @@ def make_execution_diagram(
         hold = ControlSequence(np.array([0.0, 1.0]), np.vstack([start, start]))
         trajectory_source = add_position_trajectory(builder, world, hold.to_trajectory())
     return ExecutionDiagram(
-        builder.Build(),
-        world,
-        plant,
-        robot,
-        planning,
-        source,
-        planned_scene,
-        error,
-        controller,
-        trajectory_source,
+        diagram=builder.Build(),
+        world=world,
+        plant=plant,
+        robot=robot,
+        planning=planning,
+        source=source,
+        planned_scene=planned_scene,
+        controller=controller,
+        trajectory_source=trajectory_source,
     )
 
 

@@ -207,7 +207,7 @@ def run_execution(
     reached = None
     if (
         handles.execution == "open"
-        and handles.model_error is None
+        and not scenario.uncertainty.enabled
         and meshcat is None
         and result.failure_reason is None
     ):

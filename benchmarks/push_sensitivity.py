@@ -4,7 +4,8 @@ displaced by 0.1 and 1 mm, and the scene the default camera perceives).
 
     python benchmarks/push_sensitivity.py [--seed 33] [--objects 9] [--planner sto] [--csv OUT]
 
-Prints and writes one row per variant: whether the rollout model and the execution model pass,
+Prints and writes one row per variant: whether the rollout (on the reduced model where
+``optimiser.reduced_model`` is on) and the execution model pass,
 the execution model's cost and failure reason.
 """
 

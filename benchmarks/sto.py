@@ -1,18 +1,15 @@
 """Benchmarks of the stochastic trajectory optimiser (STO).
 
     python benchmarks/sto.py [--out DIR] [--gen1 10] [--throughput-rollouts 16] [--throughput-repeats 2]
-                             [--agreement-sequences 8] [--validation-scenes 2] [--skip-comparison]
+                             [--skip-comparison]
 
 1. Rollout throughput: rollouts of a 3 s horizon per second on a 9-object Generalization II scene,
-   on 1 and on 2 worker processes (the same noisy sequences), with the full and with the reduced
-   rollout model (``sto.reduced_model``: objects nothing comes near asleep) side by side, repeated; and
-   the real-time factor of one rollout at the rollout time steps and at the execution time step.
-2. The rollout models against each other: the same sequences (noisy copies of both planners'
-   initial sequences on the default scene, the throughput scene's noisy 3 s sequences, and both
-   planners' initial sequences with a noisy copy on Generalization I and II scenes) rolled out on
-   the full and the reduced model at each rollout time step, and on the full model at the
-   execution time step; how often the success verdicts agree, and how far the costs are apart.
-3. HLP-initialised vs straight-line-initialised optimisation, side by side in one run, on the
+   on 1 and on 2 worker processes (the same noisy sequences), on the execution model and on its
+   reduced approximation (``sto.reduced_model``: objects nothing comes near asleep) side by side,
+   repeated, at the plant's time step and at 10 ms; and the real-time factor of one rollout at those
+   steps. Which execution model, and the validation sequences it is checked on
+   (``validation_sequences``): ``physics_models.py``.
+2. HLP-initialised vs straight-line-initialised optimisation, side by side in one run, on the
    bundled default scene and the Generalization I scenes of seeds 0..N-1: success (after execution)
    and optimisation time per scene, with medians, means and the ratio.
 
@@ -37,9 +34,8 @@ from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import load_scene
 from hlp_drake.systems.execution.run import plan_and_execute
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
-from hlp_drake.systems.optimiser.cost import RolloutOutcome
 from hlp_drake.systems.optimiser.optimiser import sample_base_noise
-from hlp_drake.systems.optimiser.pool import RolloutPool, SceneRollouts
+from hlp_drake.systems.optimiser.pool import RolloutPool
 from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
 from hlp_drake.systems.planning.diagram import initial_sequence
 from hlp_drake.systems.scenario import Scenario
@@ -78,8 +74,10 @@ def throughput_sequences(count: int) -> tuple:
 
 
 def model_config(config: Scenario, step: float, reduced: bool) -> Scenario:
-    """``config`` with the rollout time step ``step`` and the reduced model on or off."""
-    return config.updated(f"optimiser: {{rollout_time_step: {step}, reduced_model: {str(reduced).lower()}}}")
+    """``config`` with the plant's time step ``step`` and the reduced model on or off."""
+    return config.updated(
+        f"plant: {{time_step: {step}}}\noptimiser: {{reduced_model: {str(reduced).lower()}}}"
+    )
 
 
 def throughput(count: int, steps: tuple[float, ...], repeats: int) -> dict:
@@ -124,7 +122,7 @@ def throughput(count: int, steps: tuple[float, ...], repeats: int) -> dict:
                     run for w in (1, 2) for rerun in ("cold", "warm") for run in entry[f"workers_{w}"][rerun]
                 ]
                 entry["same_costs_everywhere"] = all(run["costs"] == runs[0]["costs"] for run in runs)
-    for step in (*steps, Scenario().plant.time_step):
+    for step in steps:
         world = RolloutWorld(model_config(config, step, False))
         world.rollout(sequences[0])
         walls = [world.rollout(s).wall_s for s in sequences[:4]]
@@ -165,87 +163,6 @@ def nudged(sequence: ControlSequence, offset: float = 1e-6) -> ControlSequence:
     knots = sequence.knots.copy()
     knots[1:, 0] += offset
     return ControlSequence(sequence.times, knots)
-
-
-def _cost_gap(a: RolloutOutcome, b: RolloutOutcome) -> dict:
-    """Absolute differences of two outcomes' costs and terms (None where one blew up)."""
-    if "blew_up" in a.terms or "blew_up" in b.terms:
-        return {"cost": None}
-    return {"cost": abs(a.cost - b.cost), **{k: abs(a.terms[k] - b.terms[k]) for k in a.terms}}
-
-
-def model_agreement(triples: list[tuple], steps: tuple[float, ...]) -> dict:
-    """Success verdicts and costs of every sequence on the full and the reduced model at each rollout
-    time step, and on the full model at the execution time step (the reference); and, as the scale
-    of the differences, the full model's own sensitivity: the sequence nudged by 1 um (``nudged``)."""
-    full_step = Scenario().plant.time_step
-    rows = []
-    models: dict = {}
-
-    def rollouts(scene, step: float, settle: bool) -> SceneRollouts:
-        key = (id(scene), step, settle)
-        if key not in models:
-            config = model_config(Scenario(scene=scene), step, True)
-            if not settle:
-                config = config.updated("optimiser: {settle_s: 0.0}")
-            models[key] = SceneRollouts(config)
-        return models[key]
-
-    for scene, label, sequence, settle in tqdm(triples, desc="model agreement", unit="sequence"):
-        row = {"sequence": label, "objects": len(scene.objects), "duration_s": sequence.duration}
-        row["reference"] = rollouts(scene, full_step, settle).full.rollout(sequence)
-        for step in steps:
-            model = rollouts(scene, step, settle)
-            row[f"full_{step * 1000:g}ms"] = model.full.rollout(sequence)
-            row[f"reduced_{step * 1000:g}ms"] = model.rollout(sequence)
-            row[f"nudged_{step * 1000:g}ms"] = model.full.rollout(nudged(sequence))
-        rows.append(row)
-    summary = {"sequences": len(rows), "successes_reference": int(sum(r["reference"].success for r in rows))}
-    for step in steps:
-        full, reduced, nudge = (f"{m}_{step * 1000:g}ms" for m in ("full", "reduced", "nudged"))
-        entry = summary[f"step_{step * 1000:g}ms"] = {
-            "full_vs_reference": int(sum(r[full].success == r["reference"].success for r in rows)),
-            "reduced_vs_reference": int(sum(r[reduced].success == r["reference"].success for r in rows)),
-            "successes_full": int(sum(r[full].success for r in rows)),
-            "successes_reduced": int(sum(r[reduced].success for r in rows)),
-            "asleep_at_end_mean": float(np.mean([len(r[reduced].asleep) for r in rows])),
-            "objects_mean": float(np.mean([r["objects"] for r in rows])),
-            "switches": int(sum(r[reduced].switches for r in rows)),
-            "wall_s_full": float(sum(r[full].wall_s for r in rows)),
-            "wall_s_reduced": float(sum(r[reduced].wall_s for r in rows)),
-        }
-        for other, name in ((reduced, "reduced_vs_full"), (nudge, "nudged_vs_full")):
-            gaps = [_cost_gap(r[other], r[full]) for r in rows]
-            sane = [g for g in gaps if g["cost"] is not None]
-            costs = [g["cost"] for g in sane]
-            entry[name] = {
-                "verdicts_agree": int(sum(r[other].success == r[full].success for r in rows)),
-                "blown_up_pairs": len(gaps) - len(sane),
-                "cost_gap_median": float(np.median(costs)) if sane else 0.0,
-                "cost_gap_p90": float(np.percentile(costs, 90)) if sane else 0.0,
-                "cost_gap_max": max(costs, default=0.0),
-                "term_gap_max": {k: max(g[k] for g in sane) for k in sane[0] if k != "cost"} if sane else {},
-            }
-    summary["rows"] = [
-        {
-            "sequence": r["sequence"],
-            "objects": r["objects"],
-            "duration_s": r["duration_s"],
-            **{
-                k: {
-                    "success": o.success,
-                    "cost": o.cost,
-                    "asleep": len(o.asleep),
-                    "switches": o.switches,
-                    "wall_s": o.wall_s,
-                }
-                for k, o in r.items()
-                if isinstance(o, RolloutOutcome)
-            },
-        }
-        for r in rows
-    ]
-    return summary
 
 
 def comparison(config: Scenario, seeds: int, out: Path) -> dict:
@@ -367,28 +284,6 @@ def print_throughput(t: dict, steps: tuple[float, ...]) -> None:
     )
 
 
-def print_agreement(a: dict, steps: tuple[float, ...]) -> None:
-    n = a["sequences"]
-    print(
-        f"rollout models vs the full model at the execution step ({n} sequences, "
-        f"{a['successes_reference']} successes):"
-    )
-    for step in steps:
-        e = a[f"step_{step * 1000:g}ms"]
-        print(
-            f"  {step * 1000:g} ms: verdicts agree with the reference: full {e['full_vs_reference']}/{n}, "
-            f"reduced {e['reduced_vs_reference']}/{n}; asleep at the end {e['asleep_at_end_mean']:.1f} of "
-            f"{e['objects_mean']:.1f} objects, {e['switches']} switches; wall {e['wall_s_full']:.0f} s full, "
-            f"{e['wall_s_reduced']:.0f} s reduced"
-        )
-        for name in ("reduced_vs_full", "nudged_vs_full"):
-            g = e[name]
-            print(
-                f"    {name.replace('_', ' ')}: verdicts agree {g['verdicts_agree']}/{n}, |cost gap| median "
-                f"{g['cost_gap_median']:.3g}, p90 {g['cost_gap_p90']:.3g}, max {g['cost_gap_max']:.3g}"
-            )
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--out", default="benchmark-results", help="output directory")
@@ -397,14 +292,6 @@ def main() -> None:
     parser.add_argument(
         "--throughput-repeats", type=int, default=2, help="throughput measurements per setting"
     )
-    parser.add_argument("--agreement-sequences", type=int, default=8, help="noisy sequences per planner")
-    parser.add_argument(
-        "--validation-scenes",
-        type=int,
-        default=2,
-        help="Generalization I and II scenes (seeds 0..N-1) in the model agreement",
-    )
-    parser.add_argument("--skip-agreement", action="store_true", help="skip the rollout models' agreement")
     parser.add_argument("--skip-comparison", action="store_true")
     args = parser.parse_args()
     out = Path(args.out)
@@ -416,14 +303,9 @@ def main() -> None:
             "python": platform.python_version(),
         }
     }
-    steps = (Scenario().optimiser.rollout_time_step, 0.01)
+    steps = (Scenario().plant.time_step, 0.01)
     report["throughput"] = throughput(args.throughput_rollouts, steps, args.throughput_repeats)
     print_throughput(report["throughput"], steps)
-    if not args.skip_agreement:
-        report["model_agreement"] = model_agreement(
-            validation_sequences(args.agreement_sequences, args.validation_scenes), steps
-        )
-        print_agreement(report["model_agreement"], steps)
     if not args.skip_comparison:
         report["comparison"] = c = comparison(Scenario(), args.gen1, out)
         for planner in ("hlp", "sto"):

@@ -210,10 +210,8 @@ def _run(scenario, args, started: float):
     listener = ProgressListener(quiet=args.quiet, stream=sys.stderr)
     workers = scenario.optimiser.workers
     if workers > 1:
-        _print(f"starting {workers} rollout workers ...")
+        _print(f"starting {workers} rollout workers in the background")
     with contextlib.closing(listener), RolloutPool(workers, on_rollout=listener.rollout) as pool:
-        if workers > 1:
-            _print(f"rollout workers ready ({pool.startup_s:.1f} s)")
         result = plan_and_execute(
             scenario,
             pool=pool,

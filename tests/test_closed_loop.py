@@ -12,7 +12,6 @@ from hlp_drake.errors import HlpError
 from hlp_drake.run_scene import DEFAULT_SCENE
 from hlp_drake.scene.io import load_scene
 from hlp_drake.systems.execution.receding_horizon import remainder
-from hlp_drake.systems.execution.run import SETTLE_S
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.cost import Prediction, RolloutOutcome
 from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
@@ -172,6 +171,9 @@ class _MovingEnd:
         return self._ends.pop(0) if len(self._ends) > 1 else self._ends[0]
 
 
+SETTLE_S = 0.7
+
+
 @pytest.mark.parametrize(
     "ends, settled",
     [
@@ -187,5 +189,5 @@ def test_the_reach_is_simulated_to_its_end_wherever_a_re_plan_moves_it(ends, set
     from hlp_drake.systems.execution.command import advance_through_reach
 
     simulator = Simulator(ConstantVectorSource([0.0]))
-    assert advance_through_reach(simulator, _MovingEnd(*ends)) == pytest.approx(settled)
+    assert advance_through_reach(simulator, _MovingEnd(*ends), settle_s=SETTLE_S) == pytest.approx(settled)
     assert simulator.get_context().get_time() == pytest.approx(settled)

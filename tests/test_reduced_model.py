@@ -13,6 +13,10 @@ from hlp_drake.systems.optimiser.rollout_world import RolloutStart, RolloutWorld
 from hlp_drake.systems.optimiser.sampler import OBJECT, ROBOT, TABLE, contact_summary
 from hlp_drake.systems.optimiser.sleep import ProximityContext, Sweep
 
+REDUCED = "optimiser: {reduced_model: true}"
+"""The reduced model, an approximation of the execution model (off by default)."""
+
+
 # --- The reduced rollout model ---------------------------------------------------------------------
 
 PUSHING_HORIZON = 3.0
@@ -60,7 +64,7 @@ def _gaps_within_own_spread(
 
 
 def test_the_reduced_model_lets_only_objects_nothing_comes_near_sleep(scene, trajectories, world):
-    config = on(scene)
+    config = on(scene, REDUCED)
     reduced = SceneRollouts(config)
     sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), PUSHING_HORIZON)
     full, samples = world.simulate(sequence), reduced.simulate(sequence)
@@ -90,7 +94,9 @@ def test_the_reduced_model_lets_only_objects_nothing_comes_near_sleep(scene, tra
 def test_an_object_pushed_towards_a_sleeping_one_wakes_it_from_the_sample_before(scene, trajectories, world):
     sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), PUSHING_HORIZON)
     chained = CHAINED
-    config = on(scene, "optimiser: {weld_clearance: 0.01, weld_lookahead: 0.0}")  # the schedule wakes late...
+    config = on(
+        scene, "optimiser: {reduced_model: true, weld_clearance: 0.01, weld_lookahead: 0.0}"
+    )  # the schedule wakes late...
     reduced = SceneRollouts(config)
     assert chained in reduced.sleep_schedule(sequence).initially_asleep()
     samples = reduced.simulate(sequence)  # ...so the check during the rollout must
@@ -104,7 +110,7 @@ def test_an_object_come_to_rest_after_a_push_goes_back_to_sleep(scene, trajector
     sequence = ControlSequence(
         times, np.vstack([pushing.knots, pushing.knots[-2], pushing.knots[0]])
     )  # ...back
-    samples = SceneRollouts(on(scene)).simulate(sequence)
+    samples = SceneRollouts(on(scene, REDUCED)).simulate(sequence)
     pushed = scene.objects.index(next(o for o in scene.objects if o.name == "FailOnTouchObstacleLong"))
     assert np.linalg.norm(samples.positions[-1, pushed] - samples.positions[0, pushed]) > 0.05
     assert set(samples.asleep) == {obj.name for obj in scene.objects}  # it too, once the robot is away
@@ -118,7 +124,7 @@ def test_a_rollout_restarted_from_its_states_goes_on_exactly(scene, trajectories
     end = world.states()
     world.begin(sequence)
     world.advance_to(1.0)
-    other = RolloutWorld(on(scene))
+    other = RolloutWorld(on(scene, REDUCED))
     other.begin(sequence, time=1.0, states=world.states())
     other.advance_to(2.0)
     assert other.states().keys() == end.keys()
@@ -133,7 +139,7 @@ def test_a_rollout_from_a_given_state_starts_there(scene, trajectories, world):
     obstacle = scene.obstacles[0].name
     states[obstacle] = states[obstacle].copy()
     states[obstacle][4:6] += [0.0, 0.02]  # the obstacle 2 cm to the left (x, y, z follow the quaternion)
-    samples = SceneRollouts(on(scene)).simulate(sequence, RolloutStart(states))
+    samples = SceneRollouts(on(scene, REDUCED)).simulate(sequence, RolloutStart(states))
     assert samples.positions[0, 1, 1] == pytest.approx(scene.obstacles[0].y + 0.02, abs=1e-6)
     assert samples.positions[-1, 1, 1] == pytest.approx(scene.obstacles[0].y + 0.02, abs=1e-3)
 

@@ -16,7 +16,7 @@ import time
 
 import pytest
 
-_READY = "rollout workers ready"
+_STARTING = "starting 2 rollout workers"
 
 
 def _interrupt(
@@ -31,7 +31,9 @@ def _interrupt(
 ) -> None:
     out = tmp_path / "run.json"
     process = subprocess.Popen(
-        [sys.executable, "-m", "hlp_drake.run_scene", "--workers", "2", "--quiet", "--json", str(out)],
+        # the straight line: several batches of rollouts on the workers (the HLP's one runs here)
+        [sys.executable, "-m", "hlp_drake.run_scene", "--planner", "sto", "--workers", "2", "--quiet"]
+        + ["--json", str(out)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -68,14 +70,14 @@ def _group_alive(group: int) -> bool:
 
 
 def test_ctrl_c_while_optimising_is_one_line_and_exit_130(tmp_path):
-    _interrupt(tmp_path, after=_READY, delay=1.5)
+    _interrupt(tmp_path, after=_STARTING, delay=2.0)
 
 
 def test_sigterm_to_the_command_alone_stops_its_workers_one_line_and_exit_143(tmp_path):
     _interrupt(
         tmp_path,
-        after=_READY,
-        delay=1.5,
+        after=_STARTING,
+        delay=2.0,
         signum=signal.SIGTERM,
         group=False,
         status=143,
@@ -89,12 +91,12 @@ def test_sigterm_to_the_command_alone_stops_its_workers_one_line_and_exit_143(tm
     [
         (None, 0.3),
         (None, 1.5),
-        ("starting", 0.5),
-        ("starting", 2.5),
-        (_READY, 0.0),
-        (_READY, 3.0),
-        (_READY, 6.0),
-        (_READY, 9.0),
+        (_STARTING, 0.0),
+        (_STARTING, 0.5),
+        (_STARTING, 1.5),
+        (_STARTING, 3.0),
+        (_STARTING, 4.5),
+        (_STARTING, 6.0),
     ],
 )
 def test_ctrl_c_at_any_moment_is_one_line_and_exit_130(tmp_path, after, delay):

@@ -1,4 +1,4 @@
-"""The execution starts where the optimiser's verification on the execution model ended."""
+"""The execution starts where the optimiser's accepted rollout on the execution model ended."""
 
 from __future__ import annotations
 
@@ -12,11 +12,10 @@ from test_closed_loop import forward  # the base moving along x
 
 from hlp_drake.run_scene import DEFAULT_SCENE
 from hlp_drake.scene.io import load_scene
-from hlp_drake.systems.execution.command import EXECUTION_SETTLE_S
 from hlp_drake.systems.execution.run import plan_and_execute, verified_reach
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.optimiser import StoResult
-from hlp_drake.systems.optimiser.pool import RolloutPool
+from hlp_drake.systems.optimiser.pool import RolloutPool, SceneRollouts
 from hlp_drake.systems.optimiser.rollout_world import RolloutStart, RolloutWorld
 from hlp_drake.systems.scenario import Scenario
 from hlp_drake.systems.world.world import add_position_trajectory, make_world_diagram, world_plant
@@ -28,11 +27,13 @@ def scenario():
 
 
 def test_a_rollout_on_the_execution_model_ends_exactly_where_the_execution_does(scenario):
-    verifier = RolloutWorld(scenario, execution=True)
+    verifier = RolloutWorld(scenario)
     sequence = forward(verifier.start_positions, 0.3, 1.3)  # into the first row: it pushes
     outcome = verifier.rollout(sequence)
     final = outcome.final
-    assert final.scenario_key == scenario.key and final.time == sequence.duration + EXECUTION_SETTLE_S
+    assert (
+        final.scenario_key == scenario.key and final.time == sequence.duration + scenario.optimiser.settle_s
+    )
     # The execution's world (its own diagram, simulated in one go) reaches the very same state.
     builder = DiagramBuilder()
     world = builder.AddSystem(make_world_diagram(scenario))
@@ -55,13 +56,14 @@ def test_a_rollout_on_the_execution_model_ends_exactly_where_the_execution_does(
                 ),
             )
     assert moved > 1e-3  # an object was pushed: the state is not just the start's
-    # The rollout model keeps no end state, nor does a rollout from another start.
-    assert RolloutWorld(scenario).rollout(sequence).final is None
+    # A rollout from another start keeps no end state, nor does one on the reduced model.
     assert verifier.rollout(sequence, RolloutStart(verifier.states())).final is None
+    reduced = SceneRollouts(scenario.updated("optimiser: {reduced_model: true}"))
+    assert reduced.rollout(sequence).final is None and reduced.verify(sequence).final is not None
 
 
 def test_only_a_verification_in_the_executed_scenarios_world_is_reused(scenario):
-    verifier = RolloutWorld(scenario, execution=True)
+    verifier = RolloutWorld(scenario)
     verified = verifier.rollout(forward(verifier.start_positions, 0.05, 0.5))
     passed = replace(verified, verification=verified)
     result = StoResult(ControlSequence(np.array([0.0, 1.0]), np.zeros((2, 11))), passed, True, None)
@@ -71,7 +73,7 @@ def test_only_a_verification_in_the_executed_scenarios_world_is_reused(scenario)
     assert verified_reach(replace(result, outcome=replace(passed, verification=None)), scenario) is None
 
 
-@pytest.mark.slow  # ~30 s of CPU: the default scene executed twice at 2 ms
+@pytest.mark.slow  # the default scene executed twice
 def test_an_execution_from_the_verified_reach_gives_the_simulated_executions_result(scenario):
     with RolloutPool(1) as pool:
         reused = plan_and_execute(scenario, pool=pool)

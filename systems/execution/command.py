@@ -25,8 +25,6 @@ if TYPE_CHECKING:
 
     from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
 
-EXECUTION_SETTLE_S = 1.0
-"""Simulated time the execution lets pass after the reach's trajectory ends before checking it, s."""
 PHASE = Positive(upper=MAX_DURATION)
 """The time of a grasp phase, s."""
 
@@ -94,7 +92,7 @@ class ClosedLoopCommand:
         self._controller.command(root_context, sequence, t0)
 
 
-__all__ = ["EXECUTION_SETTLE_S", "ClosedLoopCommand", "GraspConfig", "OpenLoopCommand"]
+__all__ = ["ClosedLoopCommand", "GraspConfig", "OpenLoopCommand"]
 
 
 # The grasp after a reach: close the fingers round the target, lift it, and check that it held.
@@ -134,8 +132,11 @@ def grasp_knots(q_end: np.ndarray, grasp: GraspConfig) -> tuple[np.ndarray, np.n
     return times, np.vstack([closed, lifted, lifted])
 
 
-def advance_through_reach(simulator: Simulator, command: OpenLoopCommand | ClosedLoopCommand) -> float:
-    """Simulate to the end of the commanded reach, then ``EXECUTION_SETTLE_S`` more; return that time. A closed
+def advance_through_reach(
+    simulator: Simulator, command: OpenLoopCommand | ClosedLoopCommand, *, settle_s: float
+) -> float:
+    """Simulate to the end of the commanded reach, then ``settle_s`` more (``optimiser.settle_s``, as
+    a rollout settles); return that time. A closed
     loop's re-plan may move the end while the simulation goes there: later (it goes on), or earlier
     than the time already simulated (the robot has held the reach's last pose since; the settling
     ends no earlier than now: going back would be Drake's "boundary_time >= context time" failure)."""
@@ -144,7 +145,7 @@ def advance_through_reach(simulator: Simulator, command: OpenLoopCommand | Close
     while root.get_time() < end:
         simulator.AdvanceTo(end)
         end = command.end(root)
-    settled = max(end + EXECUTION_SETTLE_S, root.get_time())
+    settled = max(end + settle_s, root.get_time())
     simulator.AdvanceTo(settled)
     return settled
 

@@ -24,7 +24,6 @@ from hlp_drake.learners.models import DecisionModels
 from hlp_drake.planner import HighLevelPlan
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.execution.command import (
-    EXECUTION_SETTLE_S,
     ClosedLoopCommand,
     OpenLoopCommand,
     advance_through_reach,
@@ -56,7 +55,6 @@ if TYPE_CHECKING:
     from hlp_drake.systems.perception.perception import Perception
     from hlp_drake.systems.scenario import Scenario
 
-SETTLE_S = EXECUTION_SETTLE_S  # simulated time after the trajectory ends, before objects are checked
 MOVED_TOLERANCE = 0.01  # m: an object displaced further than this counts as moved
 RECORDING_FPS = 32.0  # frames per second of a MeshCat recording
 
@@ -315,7 +313,8 @@ def _execute(
     grasp = scenario.grasp
     simulator.Initialize()
     root = simulator.get_mutable_context()
-    listener.executing(command.end(root) + SETTLE_S + grasp.close_s + grasp.lift_s + grasp.hold_s)
+    settle_s = scenario.optimiser.settle_s  # after the trajectory ends, before objects are checked
+    listener.executing(command.end(root) + settle_s + grasp.close_s + grasp.lift_s + grasp.hold_s)
     simulator.set_monitor(lambda context: listener.simulated(context.get_time()) or EventStatus.DidNothing())
     plant_context = plant.GetMyContextFromRoot(simulator.get_context())
     names = [o.name for o in scene.objects]
@@ -324,7 +323,7 @@ def _execute(
         meshcat.StartRecording(frames_per_second=RECORDING_FPS)
     try:
         end = command.end(root)
-        if reached is not None and reached.time == end + SETTLE_S:  # the verification was this reach
+        if reached is not None and reached.time == end + settle_s:  # the verification was this reach
             root.SetTime(reached.time)
             state = plant.GetMyMutableContextFromRoot(root)
             for name, x in reached.states.items():
@@ -334,7 +333,7 @@ def _execute(
             settled = reached.time
         else:
             result.reach_reused = False
-            settled = advance_through_reach(simulator, command)
+            settled = advance_through_reach(simulator, command, settle_s=settle_s)
         after = object_planar_poses(plant, plant_context, names)
         result.objects_moved = [
             n

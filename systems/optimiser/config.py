@@ -17,9 +17,7 @@ from typing import Annotated, Literal
 
 from hlp_drake.ranges import (
     MAX_DURATION,
-    MAX_TIME_STEP,
     MIN_PERIOD,
-    MIN_TIME_STEP,
     Count,
     NonNegativeFloat,
     Positive,
@@ -33,8 +31,6 @@ MAX_WORKERS = 64
 PERIOD = Positive(MIN_PERIOD, MAX_DURATION)
 """A control step, sampling or re-planning period, s."""
 FRACTION = Rule(lambda v: 0.0 <= v <= 1.0, "{where} must be in [0, 1], got {value}")
-RIM_SPHERES = Rule(lambda v: not (v < 0 or v in (1, 2)), "{where} must be 0 or >= 3, got {value}")
-"""Spheres on a cylinder's rim: none, or at least 3."""
 UPDATES = ("greedy", "mppi")
 PERCEIVED_CHECKS = 2
 """``StoConfig.displaced_checks`` when it is None and the scene is perceived (``perception.source:
@@ -89,27 +85,6 @@ class StoCost:
 
 
 @dataclass(frozen=True)
-class RolloutTrims:
-    """How the rollout model's contact geometry and plant differ from the world's (the execution
-    model), besides its time step and the sleeping objects; chosen with ``benchmarks/rollout_models.py``.
-
-    Attributes:
-        top_spheres: keep the contact spheres on the objects' top corners and rims (the objects
-            stand upright: only the bottom ones carry them on the table).
-        rim_spheres: spheres on each rim of a cylinder (the world's ``contact.rim_spheres``: 8).
-        robot_self_contact: keep contact between the robot's own links (the world filters only
-            links one joint apart).
-        sampled_output_ports: the plant's ``use_sampled_output_ports`` (False: outputs from the
-            current state, no sampled copy kept per step).
-    """
-
-    top_spheres: bool = False
-    rim_spheres: Annotated[int, RIM_SPHERES] = 4
-    robot_self_contact: bool = False
-    sampled_output_ports: bool = False
-
-
-@dataclass(frozen=True)
 class StoConfig:
     """The stochastic trajectory optimiser (``hlp_drake.systems.optimiser.optimiser``).
 
@@ -128,13 +103,11 @@ class StoConfig:
         mppi_temperature: h in w_k = exp(-h (c_k - c_min) / (c_max - c_min)).
         workers: rollout processes (1: roll out in this process).
         seed: seed of the noise.
-        rollout_time_step: plant time step of the rollouts, s (coarser than the execution's; an
-            accepted rollout is verified on the execution model, see ``verify``).
-        rollout_trims: how else the rollout model is cheaper than the world.
-        reduced_model: let the objects sleep (their joints locked) while nothing comes near them,
-            and again once they have come to rest with nothing near (fewer degrees of freedom and
-            contacts; every cost term still covers every object); off: every object is awake in
-            every rollout (the full model).
+        reduced_model: an approximation of the execution model for rollouts: let the objects sleep
+            (their joints locked) while nothing comes near them, and again once they have come to
+            rest with nothing near (fewer degrees of freedom and contacts; every cost term still
+            covers every object; a passing rollout is then verified, see ``verify``); off (the
+            default): the rollouts run on the execution model itself, every object awake.
         weld_clearance: an object is woken ``weld_lookahead`` before the robot's collision geometry,
             following the commanded motion, first comes within this of it, and goes back to sleep
             only with neither the robot nor a moving object this close, m.
@@ -143,21 +116,22 @@ class StoConfig:
             (plus the largest motion of a body since the previous sample) of a sleeping object, the
             rollout goes back to the previous sample and on with it awake, m.
         sleep_speed: an awake object slower than this at two samples in a row has come to rest, m/s.
-        settle_s: simulated time after the last control step before the final state is read, s.
-        sample_period: how often a rollout's state is read for the cost on the execution model
-            (verifying), s.
-        rollout_sample_period: the same on the rollout model (the cost terms are per second, the
-            sleep checks' margins grow with the motion between samples), s.
+        settle_s: simulated time after the last control step before the final state is read, s,
+            in a rollout and in the execution alike (a rollout's end is where the execution of the
+            same sequence ends).
+        sample_period: how often a rollout's state is read for the cost, s (the cost terms are per
+            second; the reduced model's sleep checks' margins grow with the motion between samples).
         max_object_speed: an object faster than this (m/s) means the simulation blew up.
         max_sink: an object's centre more than this below the table top while over it means it
             tunnelled into the table, m.
         cost: the cost weights.
-        verify: before declaring success, simulate a passing rollout's sequence again on the
-            execution model (the world at the plant's time step, every object free, settling as the
-            execution does); only if it passes there too does the optimisation succeed, else that
-            outcome (and cost) replaces the rollout's and the optimisation goes on.
-        max_verifications: verifications per optimisation at most (they do not count in
-            ``max_rollouts``: each costs several rollouts' time, reported apart). Once they are
+        verify: with ``reduced_model``, before declaring success, simulate a passing rollout's
+            sequence again on the execution model (every object awake); only if it passes there too
+            does the optimisation succeed, else that outcome (and cost) replaces the rollout's and
+            the optimisation goes on. Without it, a rollout is the execution model's own: nothing
+            to verify.
+        max_verifications: verifications per optimisation at most (on the execution model, or in
+            the ``displaced_checks`` worlds; they do not count in ``max_rollouts``). Once they are
             spent the optimisation ends, whatever rollouts are left (8: with 4, searches whose
             fifth candidate held ended at half their rollouts, see docs/perception.md).
         alternatives: when the initial sequence's rollout fails, roll out the planner's next this
@@ -184,16 +158,13 @@ class StoConfig:
     mppi_temperature: PositiveFloat = 10.0
     workers: Annotated[int, Count(1, MAX_WORKERS)] = 2
     seed: Annotated[int, Count(0, MAX_SEED)] = 0
-    rollout_time_step: Annotated[float, Positive(MIN_TIME_STEP, MAX_TIME_STEP)] = 0.02
-    rollout_trims: RolloutTrims = field(default_factory=RolloutTrims)
-    reduced_model: bool = True
+    reduced_model: bool = False
     weld_clearance: PositiveFloat = 0.15
     weld_lookahead: Annotated[float, Positive(upper=MAX_DURATION, zero_ok=True)] = 0.5
     weld_margin: NonNegativeFloat = 0.01
     sleep_speed: NonNegativeFloat = 0.005
-    settle_s: Annotated[float, Positive(upper=MAX_DURATION, zero_ok=True)] = 0.5
-    sample_period: Annotated[float, PERIOD] = 0.1
-    rollout_sample_period: Annotated[float, PERIOD] = 0.2
+    settle_s: Annotated[float, Positive(upper=MAX_DURATION, zero_ok=True)] = 1.0
+    sample_period: Annotated[float, PERIOD] = 0.2
     max_object_speed: PositiveFloat = 5.0
     max_sink: PositiveFloat = 0.03
     cost: StoCost = field(default_factory=StoCost)

@@ -94,7 +94,7 @@ class RolloutOutcome:
         prediction: the samples' object centres and tcp positions.
         verification: the same sequence's outcome on the execution model, when it was verified there
             and passed (its prediction is then the execution's own).
-        final: the end state, for a rollout on the execution model only (None on the rollout model).
+        final: the end state, for a rollout from the scene's start with every object awake (None otherwise).
     """
 
     cost: float

@@ -6,9 +6,10 @@ sequence in the contact simulation (``RolloutWorld``), the noise being Gaussian 
 of the holonomic base; the update keeps the cheapest copy ("greedy") or the cost-weighted mean of
 the noise, w_k = exp(-h (c_k - c_min) / (c_max - c_min)) ("mppi", rolled out once more); a candidate
 replaces the current sequence only if its cost is lower (monotone acceptance). A rollout that passes
-the success test (target in the pre-grasp region, nothing fell) is simulated again on the execution
-model (``verify``); the optimisation succeeds when it passes there too, else that outcome replaces
-the rollout's and it goes on; with ``displaced_checks`` it must also pass in copies of the scene
+the success test (target in the pre-grasp region, nothing fell) succeeds: the rollouts run on the
+execution model itself (with the reduced model, an approximation, it is simulated again there,
+``verify``, and if it fails there that outcome replaces the rollout's and the optimisation goes on);
+with ``displaced_checks`` it must also pass in copies of the scene
 with every object displaced by about ``displaced_sigma`` (a push that only works to a fraction of
 a millimetre is rejected). The budget counts rollouts and iterations (``max_rollouts``,
 ``max_iterations``), so a result does not depend on the machine's speed or load; seconds
@@ -56,8 +57,9 @@ class StoResult:
             any) and after every iteration.
         initial_cost: the initial sequence's cost.
         start: which sequence the result grew from: 0 the initial one, i >= 1 the i-th alternative.
-        verifications: passing rollouts simulated again on the execution model (not in ``rollouts``).
-        rejected: of those, how many failed there (their rollout passed, the execution model's did not).
+        verifications: passing rollouts checked again (on the execution model after a reduced
+            model's rollout, or in the displaced worlds; not in ``rollouts``).
+        rejected: of those, how many failed there.
         verify_s: wall-clock time of the verifications, s (part of ``optimise_s``; the displaced
             worlds' included).
         displaced_checks: simulations on the execution model in worlds with the objects displaced
@@ -206,20 +208,26 @@ class _Run:
         return self._displaced
 
     def roll(self, sequences: list[ControlSequence]) -> list[RolloutOutcome]:
-        """The rollouts of ``sequences`` (on the rollout model, from the run's start)."""
+        """The rollouts of ``sequences`` (from the run's start)."""
         outcomes = self.pool.rollouts(self.scenario, sequences, start=self.start)
         self.rollouts += len(sequences)
         return outcomes
 
     def settle(self, sequences: list[ControlSequence], outcomes: list[RolloutOutcome], order) -> None:
-        """Verify the passing outcomes in ``order`` (indices) on the execution model until one
-        passes there too (or the verifications run out); each one that fails is replaced by its
-        verification's outcome, and once they run out no passing rollout is trusted."""
+        """Check the passing outcomes in ``order`` (indices) until one holds (or the verifications
+        run out): with the reduced model on the execution model, and in the displaced worlds. Each
+        one that fails is replaced by the failing check's outcome, and once the verifications run
+        out no passing rollout is trusted. A rollout on the execution model is its own verification."""
         if not self.budget.verify:
             return
+        on_model = not self.scenario.optimiser.reduced_model
+        displaced = self.displaced_scenarios()
         for i in order:
             if not outcomes[i].success:
                 continue
+            if on_model and not displaced:
+                outcomes[i] = replace(outcomes[i], verification=outcomes[i])
+                return
             if self.verifications >= self.budget.max_verifications:
                 outcomes[i] = replace(
                     outcomes[i],
@@ -228,10 +236,10 @@ class _Run:
                 )
                 continue
             started = time.perf_counter()
-            displaced = self.displaced_scenarios()
-            verified, *moved = self.pool.verifications(
-                [self.scenario, *displaced], sequences[i], start=self.start
+            checked = self.pool.verifications(
+                displaced if on_model else [self.scenario, *displaced], sequences[i], start=self.start
             )
+            verified, moved = (outcomes[i], checked) if on_model else (checked[0], checked[1:])
             self.verify_s += time.perf_counter() - started
             self.verifications += 1
             failed = next((k for k, o in enumerate(moved) if not o.success), None)

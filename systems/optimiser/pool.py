@@ -1,10 +1,11 @@
 """``RolloutPool``: STO rollouts on one or several worker processes, owned and closed by the caller.
 
 The pool keeps pre-built ``SceneRollouts`` (one per scenario, keyed by ``Scenario.key``, the latest
-few, each with its rollout world and, once verifying, its execution world): with one worker in the pool itself, with
-several in each worker process, which receives the scenario as YAML text once per task and builds
-its worlds on first use. A rollout then only swaps a trajectory and resets a context. The results
-are the same either way: a rollout is a pure function of the scenario and the sequence.
+few, each with its world): with one worker in the pool itself, with several in each worker process, which receives the scenario as YAML text once per task and builds
+its worlds on first use. A rollout then only swaps a trajectory and resets a context. The workers
+start in the background: the caller plans meanwhile, and a single rollout (the HLP's first, most
+often its only one) runs in the calling process, so nothing waits for them until a batch does. The
+results are the same either way: a rollout is a pure function of the scenario and the sequence.
 """
 
 from __future__ import annotations
@@ -76,7 +77,8 @@ def _warm_up(delay: float) -> int:
 class RolloutPool:
     """Rolls out control sequences on ``workers`` processes (1: in this process).
 
-    Use as a context manager, or call ``close()``; one pool can serve many scenarios in turn.
+    Use as a context manager, or call ``close()``; one pool can serve many scenarios in turn. The
+    worker processes start in the background; single rollouts run in this process.
 
     Args:
         workers: rollout processes (1: roll out here).
@@ -84,7 +86,8 @@ class RolloutPool:
             with the verifications').
 
     Attributes:
-        startup_s: how long starting the worker processes took, s.
+        startup_s: how long the caller waited for the worker processes to start, s (0 until a batch
+            of rollouts first needs them).
     """
 
     def __init__(
@@ -97,18 +100,24 @@ class RolloutPool:
         self._on_rollout = on_rollout
         self._worlds = _Worlds()
         self._executor: ProcessPoolExecutor | None = None
+        self._warming: list = []
         if self.workers > 1:
-            started = time.perf_counter()
             self._executor = worker_pool(self.workers)  # workers leave Ctrl-C to this process
             try:
-                # Start every worker (and import Drake there) now, not inside the first optimisation.
+                # Start every worker (and import Drake there) now, while the caller plans.
                 with interrupts_held():
-                    warming = [self._executor.submit(_warm_up, 0.2) for _ in range(self.workers)]
-                for future in warming:
-                    future.result()
+                    self._warming = [self._executor.submit(_warm_up, 0.2) for _ in range(self.workers)]
             except BaseException:
                 self.close(terminate=True)
                 raise
+
+    def _ready(self) -> None:
+        """Wait for the workers' start (once), counted in ``startup_s``."""
+        if self._warming:
+            started = time.perf_counter()
+            for future in self._warming:
+                future.result()
+            self._warming = []
             self.startup_s = time.perf_counter() - started
 
     def world(self, scenario: Scenario) -> SceneRollouts:
@@ -137,11 +146,12 @@ class RolloutPool:
     def _simulate(
         self, jobs: list[tuple[Scenario, ControlSequence]], start: RolloutStart | None, verify: bool
     ) -> list[RolloutOutcome]:
-        if self._executor is None:
+        if self._executor is None or len(jobs) == 1:
             return [
                 self._arrived((self.world(c).verify if verify else self.world(c).rollout)(s, start), verify)
                 for c, s in jobs
             ]
+        self._ready()
         futures = [
             self._executor.submit(_rollout_task, c.key, c.yaml, s.times, s.knots, start, verify)
             for c, s in jobs
@@ -154,11 +164,11 @@ class RolloutPool:
         return outcome
 
     def close(self, *, terminate: bool = False) -> None:
-        """Stop the worker processes (at once with ``terminate``, else after their rollouts) and
-        drop the worlds."""
+        """Stop the worker processes (at once with ``terminate`` or when they never rolled out, else
+        after their rollouts) and drop the worlds."""
         self._worlds.clear()
         if self._executor is not None:
-            if terminate:
+            if terminate or self._warming:
                 terminate_workers(self._executor)
             self._executor.shutdown(cancel_futures=True)
             self._executor = None
@@ -170,29 +180,26 @@ class RolloutPool:
         self.close(terminate=kind is not None and issubclass(kind, KeyboardInterrupt))
 
 
-# ``SceneRollouts``: the rollouts of one scenario on its rollout model, and their verification.
+# ``SceneRollouts``: the rollouts of one scenario on its execution model.
 #
-# The reduced model (``optimiser.reduced_model``): most of a rollout's time goes to the contact problem,
-# which every resting object joins with its contact points on the table. An object nothing has come
-# near stays at rest, so until then it can as well sleep (its joint locked; ``sleep_schedule``,
-# ``rollout_sampler``); one that has come to rest again goes back to sleep. Every cost term still
-# covers every object. ``verify`` rolls a sequence out on the execution model instead
-# (``RolloutWorld(..., execution=True)``).
+# The reduced model (``optimiser.reduced_model``, off by default): most of a rollout's time goes to the
+# contact problem, which every resting object joins with its contact points on the table. An object
+# nothing has come near stays at rest, so until then it can as well sleep (its joint locked;
+# ``sleep_schedule``, ``rollout_sampler``); one that has come to rest again goes back to sleep. Every
+# cost term still covers every object. ``verify`` rolls a sequence out with every object awake.
 class SceneRollouts:
-    """Rollouts on one scene: on the rollout model's world, with ``sto.reduced_model`` its objects
-    asleep while nothing comes near them (see the module's docstring); verification on the
-    execution model's (each world built on first use).
+    """Rollouts on one scene, on its execution model (with ``sto.reduced_model`` its objects asleep
+    while nothing comes near them, see the module's docstring); verification with every object awake.
 
     A rollout's outcome is a pure function of the scene, the configuration, the start and the sequence.
     """
 
     def __init__(self, scenario: Scenario) -> None:
         self.scenario = scenario
-        self._execution: RolloutWorld | None = None
 
     @cached_property
     def full(self) -> RolloutWorld:
-        """The rollout model's world (built on first use: a world only verified on needs none)."""
+        """The scene's world (built on first use)."""
         return RolloutWorld(self.scenario)
 
     @cached_property
@@ -225,8 +232,5 @@ class SceneRollouts:
         return timed_rollout(sequence, self.simulate, self.full, start)
 
     def verify(self, sequence: ControlSequence, start: RolloutStart | None = None) -> RolloutOutcome:
-        """Simulate ``sequence`` (from ``start``) on the execution model (built on first use), every
-        object awake, and cost it."""
-        if self._execution is None:
-            self._execution = RolloutWorld(self.scenario, execution=True)
-        return self._execution.rollout(sequence, start)
+        """Simulate ``sequence`` (from ``start``) with every object awake, and cost it."""
+        return self.full.rollout(sequence, start)

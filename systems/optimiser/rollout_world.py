@@ -1,20 +1,18 @@
 """``RolloutWorld``: a world built once per scene, in which a control sequence is rolled out with contact.
 
-The world is ``make_world_diagram`` of the rollout model (``rollout_scenario``: the optimiser's
-``rollout_time_step`` and ``rollout_trims``) or of the execution model itself (``execution=True``,
-for verifying), with a C++ ``TrajectorySource`` driving the robot; the initial context is kept. A
-rollout swaps the source's trajectory, resets the context (or sets a given start state) and
-simulates, Python only reading the state (``Reading``) every ``optimiser.rollout_sample_period``
-(``optimiser.sample_period`` on the execution model). Objects
+The world is ``make_world_diagram`` of the scenario: the execution model itself (its plant, contact
+geometry and settling), with a C++ ``TrajectorySource`` driving the robot; the initial context is
+kept. A rollout swaps the source's trajectory, resets the context (or sets a given start state) and
+simulates, Python only reading the state (``Reading``) every ``optimiser.sample_period``. Objects
 may be put to sleep (their floating joints locked in the context: they neither move nor cost the
-contact solver a degree of freedom) and woken again, at any pose (see ``rollout_sampler``). On the
-execution model a rollout from the scene's start keeps its end state (``RolloutOutcome.final``): the
-execution of a verified sequence starts from there rather than simulating the reach again.
+contact solver a degree of freedom) and woken again, at any pose (the reduced model,
+``rollout_sampler``). A rollout from the scene's start with every object awake keeps its end state
+(``RolloutOutcome.final``): the execution of that sequence starts from there rather than simulating
+the reach again.
 """
 
 from __future__ import annotations
 
-import copy
 import time
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
@@ -27,7 +25,6 @@ from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
-from hlp_drake.systems.execution.command import EXECUTION_SETTLE_S
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.cost import (
     FinalState,
@@ -65,31 +62,6 @@ def simulation_failure(error: BaseException) -> str:
     return str(error).splitlines()[0]
 
 
-def rollout_scenario(scenario: Scenario) -> Scenario:
-    """``scenario`` as the optimiser's rollout model: the plant stepping at ``optimiser.rollout_time_step``,
-    the contact geometry and plant outputs trimmed as ``optimiser.rollout_trims`` says and the state
-    read every ``optimiser.rollout_sample_period``."""
-    sto = scenario.optimiser
-    trims = sto.rollout_trims
-    plant = copy.copy(scenario.plant)
-    plant.time_step = sto.rollout_time_step
-    plant.use_sampled_output_ports = trims.sampled_output_ports
-    contact = replace(
-        scenario.contact,
-        top_spheres=trims.top_spheres,
-        rim_spheres=trims.rim_spheres,
-        robot_self_contact=trims.robot_self_contact,
-    )
-    optimiser = replace(sto, sample_period=sto.rollout_sample_period)
-    return replace(scenario, plant=plant, contact=contact, optimiser=optimiser)
-
-
-def verification_scenario(scenario: Scenario) -> Scenario:
-    """``scenario`` as the execution simulates it (its own plant and contact), settling as long as the
-    execution does before the reach is checked."""
-    return replace(scenario, optimiser=replace(scenario.optimiser, settle_s=EXECUTION_SETTLE_S))
-
-
 @dataclass(frozen=True)
 class RolloutStart:
     """A rollout's start other than the scene's: the given model instances' positions and velocities
@@ -100,20 +72,18 @@ class RolloutStart:
 
 
 class RolloutWorld:
-    """A pre-built world for rolling out control sequences on ``scenario``'s scene (one per worker process).
+    """A pre-built world for rolling out control sequences on ``scenario``'s scene, on its execution
+    model (one per worker process).
 
     Every object is a free body; ``begin(..., asleep=...)`` and ``set_asleep`` lock and unlock their
-    joints (``rollout_sampler``). With ``execution`` it is the execution model
-    (``verification_scenario``) rather than the rollout model.
+    joints (``rollout_sampler``).
     """
 
-    def __init__(self, scenario: Scenario, *, execution: bool = False) -> None:
-        self.execution, self.key = execution, scenario.key
-        scenario = verification_scenario(scenario) if execution else rollout_scenario(scenario)
+    def __init__(self, scenario: Scenario) -> None:
+        self.key = scenario.key
         scene = scenario.scene
         self.scene = scene
         self.scenario = scenario
-        """The model's own scenario (``rollout_scenario`` or ``verification_scenario``)."""
         builder = DiagramBuilder()
         world = builder.AddSystem(make_world_diagram(scenario, cameras=False))
         plant, robot = world_plant(world)
@@ -344,12 +314,12 @@ def timed_rollout(
     sequence: ControlSequence, simulate, costing: RolloutWorld, start: RolloutStart | None = None
 ) -> RolloutOutcome:
     """``simulate(sequence, start)`` costed by ``costing``, with the sleeping record and the wall time
-    (and, on the execution model from the scene's start, the end state)."""
+    (and, from the scene's start with every object awake at the end, the end state)."""
     started = time.perf_counter()
     samples = simulate(sequence, start)
     prediction = Prediction(samples.times, samples.positions, samples.tcp)
     final = None
-    if costing.execution and start is None:
+    if start is None and not samples.asleep and samples.switches == 0:
         final = FinalState(costing.key, costing.time(), costing.states())
     outcome = replace(
         costing.cost(samples, sequence),

@@ -65,9 +65,9 @@ class ContactConfig:
     hunt_crossley_dissipation: NonNegativeFloat = 10.0
     relaxation_time: NonNegativeFloat = 0.01
     corner_sphere_radius: NonNegativeFloat = 0.001
-    rim_spheres: Annotated[int, RIM_SPHERES] = 8
-    top_spheres: bool = True
-    robot_self_contact: bool = True
+    rim_spheres: Annotated[int, RIM_SPHERES] = 4
+    top_spheres: bool = False
+    robot_self_contact: bool = False
     table_friction: PositiveFloat = 0.3
     object_friction: PositiveFloat = 0.4
     gripper_friction: PositiveFloat = 0.8

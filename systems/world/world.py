@@ -82,17 +82,20 @@ PLANT_RANGES = Fields(
 
 
 def default_plant_config() -> MultibodyPlantConfig:
-    """The plant settings of the world: 2 ms steps, point contact, the SAP solver and approximation.
+    """The plant settings of the world, the execution model the optimiser also rolls out on: 20 ms
+    steps, point contact, the SAP solver and approximation, outputs from the current state.
 
-    SAP simulates the gripper's mimic finger (a coupler constraint); see the project's Drake notes
-    (section F) for the measurements behind the defaults here and in ``ContactConfig``.
+    SAP simulates the gripper's mimic finger (a coupler constraint). The step and the contact geometry
+    (``ContactConfig``) are the fastest setting whose verdicts and final object poses agree with
+    the same model at 1 ms (``benchmarks/physics_models.py``; docs/results.md, "One execution model").
     """
     return MultibodyPlantConfig(
-        time_step=0.002,
+        time_step=0.02,
         penetration_allowance=0.001,
         stiction_tolerance=1e-4,
         contact_model="point",
         discrete_contact_approximation="sap",
+        use_sampled_output_ports=False,
     )
 
 
@@ -157,7 +160,7 @@ def _set_robot_contact(
 def _filter_robot_self_contact(
     plant: MultibodyPlant, scene_graph: SceneGraph, instance: ModelInstanceIndex
 ) -> None:
-    """Exclude every contact pair between two of the robot's links (the rollout model's trim)."""
+    """Exclude every contact pair between two of the robot's links (``ContactConfig.robot_self_contact`` off)."""
     geometries = [
         g
         for i in plant.GetBodyIndices(instance)

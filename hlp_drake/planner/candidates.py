@@ -8,14 +8,17 @@ line are described and classified, and all rows share one classifier call per le
 from __future__ import annotations
 
 from itertools import pairwise
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from hlp_drake.features import gap_features, object_features
 from hlp_drake.features.segment import node_pairs, pair_features
-from hlp_drake.learners.models import DecisionModels
 from hlp_drake.planner.config import PlannerConfig
 from hlp_drake.taskspace import Node, TaskSpace
+
+if TYPE_CHECKING:
+    from hlp_drake.learners.models import DecisionModels
 
 
 def line_offsets(centres: np.ndarray, start: np.ndarray, target: np.ndarray) -> np.ndarray:

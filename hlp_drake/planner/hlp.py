@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from hlp_drake.errors import SceneError, short
 from hlp_drake.features import table_diagonal
 from hlp_drake.features.row_choice import HUMAN_HAND_WIDTH
-from hlp_drake.learners.models import DecisionModels
 from hlp_drake.planner.blas import single_blas_thread
 from hlp_drake.planner.candidates import classify, enumerate_paths, informed, row_candidates, segment_scores
 from hlp_drake.planner.config import PlannerConfig
@@ -22,6 +22,9 @@ from hlp_drake.scene.model import Scene
 from hlp_drake.scene.validation import scene_problems
 from hlp_drake.segmentation.modes import is_faithful
 from hlp_drake.taskspace import TaskSpace
+
+if TYPE_CHECKING:
+    from hlp_drake.learners.models import DecisionModels
 
 
 def _no_plan(scene: Scene, reason: str, started: float) -> HighLevelPlan:

@@ -9,18 +9,21 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cache, cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from hlp_drake.features import DIRECTION_FEATURES, direction_index
 from hlp_drake.features.direction import DirectionTable
 from hlp_drake.features.segment import path_occluders
-from hlp_drake.learners.models import DecisionModels
 from hlp_drake.planner.human_arm import arm_joints, sweep_collision
 from hlp_drake.planner.plan import PlanKeypoint
 from hlp_drake.segmentation.modes import Mode
 from hlp_drake.taskspace import DIRECTIONS, Node, TaskSpace, direction_of
 from hlp_drake.taskspace.relocation import relocated_array
+
+if TYPE_CHECKING:
+    from hlp_drake.learners.models import DecisionModels
 
 
 def path_keypoints(

@@ -20,19 +20,22 @@ import math
 import time
 from dataclasses import dataclass
 from itertools import pairwise
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from hlp_drake.features import DIRECTION_FEATURES, direction_index
 from hlp_drake.features.direction import DirectionTable
 from hlp_drake.features.row_choice import RowCandidates, RowChoiceScene
-from hlp_drake.learners.models import DecisionModels
 from hlp_drake.planner.config import PlannerConfig
 from hlp_drake.planner.plan import HighLevelPlan, PlanCandidate, PlanKeypoint
 from hlp_drake.planner.rollout import PrefixTree, arm_configurations, expected_collisions
 from hlp_drake.scene.rows import Row
 from hlp_drake.taskspace import DIRECTIONS, TaskSpace
 from hlp_drake.taskspace.routes import segment_inside
+
+if TYPE_CHECKING:
+    from hlp_drake.learners.models import DecisionModels
 
 REACH_FRACTION = 0.25  # the hand stops this many hand widths short of the target's near face
 

@@ -20,7 +20,6 @@ import numpy as np
 from pydrake.geometry import Meshcat
 from pydrake.systems.framework import Diagram, DiagramBuilder
 
-from hlp_drake.learners.models import DecisionModels
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
@@ -41,6 +40,7 @@ if TYPE_CHECKING:
     from pydrake.multibody.tree import ModelInstanceIndex
     from pydrake.systems.primitives import TrajectorySource
 
+    from hlp_drake.learners.models import DecisionModels
     from hlp_drake.systems.scenario import Scenario
     from hlp_drake.systems.world.uncertainty import WorldPerturbation
 

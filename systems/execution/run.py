@@ -20,7 +20,6 @@ from pydrake.geometry import Meshcat
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import EventStatus
 
-from hlp_drake.learners.models import DecisionModels
 from hlp_drake.planner import HighLevelPlan
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.execution.command import (
@@ -51,6 +50,7 @@ from hlp_drake.systems.world.world import world_plant
 if TYPE_CHECKING:
     from pydrake.trajectories import PiecewisePolynomial
 
+    from hlp_drake.learners.models import DecisionModels
     from hlp_drake.systems.optimiser.optimiser import StoResult
     from hlp_drake.systems.perception.perception import Perception
     from hlp_drake.systems.scenario import Scenario

@@ -26,7 +26,6 @@ from hlp_drake.systems.optimiser.sampler import sample_rollout
 from hlp_drake.systems.optimiser.sleep import AWAKE, SleepSchedule, Sweep
 
 if TYPE_CHECKING:
-    from hlp_drake.systems.optimiser.rollout_world import RolloutStart
     from hlp_drake.systems.scenario import Scenario
 
 

@@ -7,74 +7,7 @@ the scene from their ``scene`` input port (``SceneFromPlant`` reads it from a pl
 ``optimiser``, ``perception`` and ``execution``; the names below are the public API.
 """
 
-from hlp_drake.systems.execution.command import GraspConfig
-from hlp_drake.systems.execution.diagram import ExecutionDiagram, make_execution_diagram
-from hlp_drake.systems.execution.job import run_job, scenario_yamls
-from hlp_drake.systems.execution.meshcat_view import draw_perception, draw_plan, frame_table
-from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
-from hlp_drake.systems.execution.run import ExecutionResult, RunListener, plan_and_execute, run_execution
-from hlp_drake.systems.optimiser.config import StoConfig
-from hlp_drake.systems.optimiser.control_sequence import ControlSequence
-from hlp_drake.systems.optimiser.cost import RolloutOutcome
-from hlp_drake.systems.optimiser.optimiser import StoResult, optimise
-from hlp_drake.systems.optimiser.pool import RolloutPool, SceneRollouts
-from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
-from hlp_drake.systems.optimiser.system import StochasticTrajectoryOptimiser
-from hlp_drake.systems.perception.accuracy import perception_record
-from hlp_drake.systems.perception.cameras import CameraConfig, PerceptionConfig
-from hlp_drake.systems.perception.perception import PerceivedObject, Perception, perceive
-from hlp_drake.systems.perception.system import ScenePerception, add_scene_perception, perceive_world
-from hlp_drake.systems.planning.diagram import (
-    HlpPlannerSystem,
-    StraightLinePlanSystem,
-    first_rollout,
-    initial_sequence,
-    make_planning_diagram,
-    straight_line_plan,
-)
-from hlp_drake.systems.planning.ik import KeypointIk
-from hlp_drake.systems.planning.keyframes import Keyframes, PlanningModel
-from hlp_drake.systems.planning.transfer import RobotPlanTransfer, gripper_geometry
-from hlp_drake.systems.scenario import PlannerChoiceConfig, Scenario, load_scenario
-from hlp_drake.systems.world.robot import (
-    ACTUATED_JOINTS,
-    ARM_JOINTS,
-    BASE_JOINTS,
-    GRIPPER_JOINTS,
-    HOME_ARM_POSITIONS,
-    MODELS_PACKAGE,
-    ROBOT_URL,
-    TCP_FRAME,
-    add_robot,
-    configure_parser,
-    models_directory,
-    robot_joint_limits,
-    set_robot_positions,
-)
-from hlp_drake.systems.world.scene_models import (
-    SceneModels,
-    add_scene,
-    fallen_objects,
-    object_planar_poses,
-    scene_from_plant,
-    set_object_poses,
-)
-from hlp_drake.systems.world.scene_source import SceneFromPlant
-from hlp_drake.systems.world.start_pose import robot_base_pose, robot_position_names, start_configuration
-from hlp_drake.systems.world.world import (
-    DESIRED_STATE_PORT,
-    add_position_trajectory,
-    desired_state_from_robot_state,
-    make_world_diagram,
-    world_plant,
-)
-from hlp_drake.transfer.push import ROBOT_ACTIONS, robot_alternatives, robot_plan
-from hlp_drake.transfer.rules import (
-    GripperGeometry,
-    PushRules,
-    TransferConfig,
-    push_rules,
-)
+from hlp_drake.exports import lazy_exports
 
 __all__ = [
     "ACTUATED_JOINTS",
@@ -158,3 +91,83 @@ __all__ = [
     "straight_line_plan",
     "world_plant",
 ]
+
+# Each name's module is imported when the name is first used: importing one subpackage (a rollout
+# worker's pool) does not import the others.
+__getattr__, __dir__ = lazy_exports(
+    __name__,
+    {
+        "hlp_drake.systems.execution.command": ("GraspConfig",),
+        "hlp_drake.systems.execution.diagram": ("ExecutionDiagram", "make_execution_diagram"),
+        "hlp_drake.systems.execution.job": ("run_job", "scenario_yamls"),
+        "hlp_drake.systems.execution.meshcat_view": ("draw_perception", "draw_plan", "frame_table"),
+        "hlp_drake.systems.execution.receding_horizon": ("RecedingHorizonController",),
+        "hlp_drake.systems.execution.run": (
+            "ExecutionResult",
+            "RunListener",
+            "plan_and_execute",
+            "run_execution",
+        ),
+        "hlp_drake.systems.optimiser.config": ("StoConfig",),
+        "hlp_drake.systems.optimiser.control_sequence": ("ControlSequence",),
+        "hlp_drake.systems.optimiser.cost": ("RolloutOutcome",),
+        "hlp_drake.systems.optimiser.optimiser": ("StoResult", "optimise"),
+        "hlp_drake.systems.optimiser.pool": ("RolloutPool", "SceneRollouts"),
+        "hlp_drake.systems.optimiser.rollout_world": ("RolloutWorld",),
+        "hlp_drake.systems.optimiser.system": ("StochasticTrajectoryOptimiser",),
+        "hlp_drake.systems.perception.accuracy": ("perception_record",),
+        "hlp_drake.systems.perception.cameras": ("CameraConfig", "PerceptionConfig"),
+        "hlp_drake.systems.perception.perception": ("PerceivedObject", "Perception", "perceive"),
+        "hlp_drake.systems.perception.system": ("ScenePerception", "add_scene_perception", "perceive_world"),
+        "hlp_drake.systems.planning.diagram": (
+            "HlpPlannerSystem",
+            "StraightLinePlanSystem",
+            "first_rollout",
+            "initial_sequence",
+            "make_planning_diagram",
+            "straight_line_plan",
+        ),
+        "hlp_drake.systems.planning.ik": ("KeypointIk",),
+        "hlp_drake.systems.planning.keyframes": ("Keyframes", "PlanningModel"),
+        "hlp_drake.systems.planning.transfer": ("RobotPlanTransfer", "gripper_geometry"),
+        "hlp_drake.systems.scenario": ("PlannerChoiceConfig", "Scenario", "load_scenario"),
+        "hlp_drake.systems.world.robot": (
+            "ACTUATED_JOINTS",
+            "ARM_JOINTS",
+            "BASE_JOINTS",
+            "GRIPPER_JOINTS",
+            "HOME_ARM_POSITIONS",
+            "MODELS_PACKAGE",
+            "ROBOT_URL",
+            "TCP_FRAME",
+            "add_robot",
+            "configure_parser",
+            "models_directory",
+            "robot_joint_limits",
+            "set_robot_positions",
+        ),
+        "hlp_drake.systems.world.scene_models": (
+            "SceneModels",
+            "add_scene",
+            "fallen_objects",
+            "object_planar_poses",
+            "scene_from_plant",
+            "set_object_poses",
+        ),
+        "hlp_drake.systems.world.scene_source": ("SceneFromPlant",),
+        "hlp_drake.systems.world.start_pose": (
+            "robot_base_pose",
+            "robot_position_names",
+            "start_configuration",
+        ),
+        "hlp_drake.systems.world.world": (
+            "DESIRED_STATE_PORT",
+            "add_position_trajectory",
+            "desired_state_from_robot_state",
+            "make_world_diagram",
+            "world_plant",
+        ),
+        "hlp_drake.transfer.push": ("ROBOT_ACTIONS", "robot_alternatives", "robot_plan"),
+        "hlp_drake.transfer.rules": ("GripperGeometry", "PushRules", "TransferConfig", "push_rules"),
+    },
+)

@@ -1,17 +1,6 @@
 """Demonstration segmentation (reference notes section 3): per-row decisions, keypoints, arm angles."""
 
-from hlp_drake.segmentation.arm import LinkLengths, arm_angles, link_lengths, medial_direction
-from hlp_drake.segmentation.batch import SegmentationResult, demonstration_records, segment_dataset
-from hlp_drake.segmentation.demonstration import (
-    GAP,
-    OBJECT,
-    Demonstration,
-    Keypoint,
-    Rejection,
-    RowDecision,
-)
-from hlp_drake.segmentation.modes import DEFAULT_MODE, MODES, Mode, check_mode, is_faithful
-from hlp_drake.segmentation.segment import Rejected, segment_trial
+from hlp_drake.exports import lazy_exports
 
 __all__ = [
     "DEFAULT_MODE",
@@ -35,3 +24,23 @@ __all__ = [
     "segment_dataset",
     "segment_trial",
 ]
+
+# Imported on first use: the planner settings (which a rollout worker reads) need ``modes`` alone, not
+# the dataset and progress bars of batch segmentation.
+__getattr__, __dir__ = lazy_exports(
+    __name__,
+    {
+        "hlp_drake.segmentation.arm": ("LinkLengths", "arm_angles", "link_lengths", "medial_direction"),
+        "hlp_drake.segmentation.batch": ("SegmentationResult", "demonstration_records", "segment_dataset"),
+        "hlp_drake.segmentation.demonstration": (
+            "GAP",
+            "OBJECT",
+            "Demonstration",
+            "Keypoint",
+            "Rejection",
+            "RowDecision",
+        ),
+        "hlp_drake.segmentation.modes": ("DEFAULT_MODE", "MODES", "Mode", "check_mode", "is_faithful"),
+        "hlp_drake.segmentation.segment": ("Rejected", "segment_trial"),
+    },
+)

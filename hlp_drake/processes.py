@@ -13,11 +13,13 @@ the workers keep SIGTERM's default, which is how they are stopped.
 from __future__ import annotations
 
 import contextlib
-import multiprocessing
 import signal
 import threading
 from collections.abc import Iterator
-from concurrent.futures import ProcessPoolExecutor
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from concurrent.futures import ProcessPoolExecutor
 
 
 class Terminated(KeyboardInterrupt):
@@ -69,6 +71,9 @@ def worker_pool(workers: int, *, method: str | None = "spawn") -> ProcessPoolExe
         method: the multiprocessing start method ("spawn": fresh interpreters, needed once Drake is
             imported; None: the platform's default).
     """
+    import multiprocessing  # here, not at the top: every command imports this module, few start workers
+    from concurrent.futures import ProcessPoolExecutor
+
     context = multiprocessing.get_context(method)
     return ProcessPoolExecutor(workers, mp_context=context, initializer=ignore_interrupts)
 

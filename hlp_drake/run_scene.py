@@ -34,8 +34,7 @@ from hlp_drake.cli import (
     run_cli,
 )
 from hlp_drake.errors import InstallError
-from hlp_drake.scene.generators import KINDS, MAX_GENERATED, generate_scene
-from hlp_drake.scene.io import DEFAULT_SCENE_FILE, load_scene
+from hlp_drake.scene.constants import DEFAULT_SCENE_FILE, KINDS, MAX_GENERATED
 
 DEFAULT_SCENE = DEFAULT_SCENE_FILE
 PROG = "python -m hlp_drake.run_scene"
@@ -130,6 +129,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.kind is None and (args.seed is not None or args.objects is not None):
         parser.error("--seed and --objects describe a generated scene: give its --kind too")
     check_writable(args.json, args.html)
+    from hlp_drake.scene.generators import generate_scene  # numpy and shapely: once the arguments are good
+    from hlp_drake.scene.io import load_scene
+
     scene = None
     if args.kind is not None:
         scene = generate_scene(args.kind, args.seed or 0, args.objects)

@@ -1,17 +1,6 @@
 """The scene model: table, start, target and obstacles in the world frame (see ``hlp_drake.frames``)."""
 
-from hlp_drake.scene.generators import KINDS, generate_scene
-from hlp_drake.scene.io import (
-    DEFAULT_SCENE_FILE,
-    default_scene,
-    load_scene,
-    save_scene,
-    scene_from_dict,
-    scene_to_dict,
-)
-from hlp_drake.scene.model import SHAPES, Scene, SceneObject, Table
-from hlp_drake.scene.rows import Row, find_rows
-from hlp_drake.scene.validation import scene_problems, validate_scene
+from hlp_drake.exports import lazy_exports
 
 __all__ = [
     "DEFAULT_SCENE_FILE",
@@ -31,3 +20,22 @@ __all__ = [
     "scene_to_dict",
     "validate_scene",
 ]
+
+# Imported on first use: a command's parser needs ``constants`` alone (no numpy, shapely or YAML).
+__getattr__, __dir__ = lazy_exports(
+    __name__,
+    {
+        "hlp_drake.scene.constants": ("DEFAULT_SCENE_FILE", "KINDS"),
+        "hlp_drake.scene.generators": ("generate_scene",),
+        "hlp_drake.scene.io": (
+            "default_scene",
+            "load_scene",
+            "save_scene",
+            "scene_from_dict",
+            "scene_to_dict",
+        ),
+        "hlp_drake.scene.model": ("SHAPES", "Scene", "SceneObject", "Table"),
+        "hlp_drake.scene.rows": ("Row", "find_rows"),
+        "hlp_drake.scene.validation": ("scene_problems", "validate_scene"),
+    },
+)

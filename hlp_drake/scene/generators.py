@@ -26,6 +26,7 @@ from shapely.geometry import Polygon
 
 from hlp_drake.documents import brief
 from hlp_drake.errors import SceneError
+from hlp_drake.scene.constants import KINDS, MAX_GENERATED
 from hlp_drake.scene.geometry import footprint
 from hlp_drake.scene.model import Scene, SceneObject, Table
 from hlp_drake.scene.validation import validate_scene
@@ -70,8 +71,6 @@ DECIMALS = 4  # generated values are rounded to 0.1 mm / 0.1 mrad so files read 
 MAX_PLACEMENT_ATTEMPTS = 2000
 MAX_SEED = 2**32 - 1
 """Seeds lie in [0, MAX_SEED] (numpy's seeds are non-negative)."""
-MAX_GENERATED = 100
-"""Most obstacles a generator places (tables fill up well before)."""
 
 
 def _rounded(value: float) -> float:
@@ -365,7 +364,6 @@ def generate_unstructured(seed: int, objects: int = 6) -> Scene:
     )
 
 
-KINDS = ("vr", "gen1", "gen2", "unstructured")
 FIXED_OBJECT_COUNT = {"vr": 6, "gen1": 6}
 
 

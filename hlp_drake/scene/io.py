@@ -17,12 +17,11 @@ import yaml
 from hlp_drake.atomic import write_text_atomic
 from hlp_drake.documents import parse_json, parse_yaml, read_document
 from hlp_drake.errors import SceneError
+from hlp_drake.scene.constants import DEFAULT_SCENE_FILE
 from hlp_drake.scene.model import Scene, SceneObject
 from hlp_drake.scene.validation import MAX_OBSTACLES, scene_problems, validate_scene
 from hlp_drake.typed_yaml import load_typed
 
-DEFAULT_SCENE_FILE = Path(__file__).resolve().parents[1] / "scenes" / "default.yaml"
-"""The bundled default scene (Generalization I, seed 3), which ``run_scene`` runs without arguments."""
 YAML_SUFFIXES = (".yaml", ".yml")
 JSON_SUFFIXES = (".json",)
 

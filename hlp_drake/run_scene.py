@@ -212,7 +212,7 @@ def _run(scenario, args, started: float):
     listener = ProgressListener(quiet=args.quiet, stream=sys.stderr)
     workers = scenario.optimiser.workers
     if workers > 1:
-        _print(f"starting {workers} rollout workers in the background")
+        _print(f"rollout workers: {workers}, started when a batch of rollouts needs them")
     with contextlib.closing(listener), RolloutPool(workers, on_rollout=listener.rollout) as pool:
         result = plan_and_execute(
             scenario,

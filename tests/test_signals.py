@@ -16,7 +16,7 @@ import time
 
 import pytest
 
-_STARTING = "starting 2 rollout workers"
+_STARTING = "rollout workers: 2"
 
 
 def _interrupt(

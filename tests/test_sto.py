@@ -242,9 +242,9 @@ def test_two_workers_give_the_same_outcomes_as_one(scene, trajectories):
     sequences = [base.with_base_velocity(v) for v in noise]
     local = [SceneRollouts(config).rollout(s) for s in sequences]  # a fresh set of worlds for each
     with RolloutPool(2) as pool:
-        (single,) = pool.rollouts(config, sequences[:1])  # here, while the workers start
+        (single,) = pool.rollouts(config, sequences[:1])  # here: no worker started for it
         assert pool.startup_s == 0.0
-        remote = pool.rollouts(config, sequences)  # a batch: on the workers, once they are up
+        remote = pool.rollouts(config, sequences)  # a batch: on the workers, started for it
         assert pool.startup_s > 0
     assert single.cost == local[0].cost
     assert [o.cost for o in remote] == [o.cost for o in local]

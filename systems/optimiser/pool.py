@@ -2,10 +2,11 @@
 
 The pool keeps pre-built ``SceneRollouts`` (one per scenario, keyed by ``Scenario.key``, the latest
 few, each with its world): with one worker in the pool itself, with several in each worker process, which receives the scenario as YAML text once per task and builds
-its worlds on first use. A rollout then only swaps a trajectory and resets a context. The workers
-start in the background: the caller plans meanwhile, and a single rollout (the HLP's first, most
-often its only one) runs in the calling process, so nothing waits for them until a batch does. The
-results are the same either way: a rollout is a pure function of the scenario and the sequence.
+its worlds on first use. A rollout then only swaps a trajectory and resets a context. A single
+rollout (the HLP's first, most often its only one) runs in the calling process; the workers start
+when a batch first needs them, so a run that needs none neither waits for them nor shares its cores
+with their start. The results are the same either way: a rollout is a pure function of the scenario
+and the sequence.
 """
 
 from __future__ import annotations
@@ -77,7 +78,7 @@ class RolloutPool:
     """Rolls out control sequences on ``workers`` processes (1: in this process).
 
     Use as a context manager, or call ``close()``; one pool can serve many scenarios in turn. The
-    worker processes start in the background; single rollouts run in this process.
+    worker processes start when a batch of rollouts first needs them; single rollouts run here.
 
     Args:
         workers: rollout processes (1: roll out here).
@@ -85,8 +86,7 @@ class RolloutPool:
             with the verifications').
 
     Attributes:
-        startup_s: how long the caller waited for the worker processes to start, s (0 until a batch
-            of rollouts first needs them).
+        startup_s: how long starting the worker processes took, s (0 while none was needed).
     """
 
     def __init__(
@@ -99,25 +99,22 @@ class RolloutPool:
         self._on_rollout = on_rollout
         self._worlds = _Worlds()
         self._executor: ProcessPoolExecutor | None = None
-        self._warming: list = []
-        if self.workers > 1:
+
+    def _started(self) -> ProcessPoolExecutor:
+        """The worker processes, started (and Drake imported in each) on first use."""
+        if self._executor is None:
+            started = time.perf_counter()
             self._executor = worker_pool(self.workers)  # workers leave Ctrl-C to this process
             try:
-                # Start every worker (and import Drake there) now, while the caller plans.
                 with interrupts_held():
-                    self._warming = [self._executor.submit(_warm_up, 0.2) for _ in range(self.workers)]
+                    warming = [self._executor.submit(_warm_up, 0.2) for _ in range(self.workers)]
+                for future in warming:
+                    future.result()
             except BaseException:
                 self.close(terminate=True)
                 raise
-
-    def _ready(self) -> None:
-        """Wait for the workers' start (once), counted in ``startup_s``."""
-        if self._warming:
-            started = time.perf_counter()
-            for future in self._warming:
-                future.result()
-            self._warming = []
             self.startup_s = time.perf_counter() - started
+        return self._executor
 
     def world(self, scenario: Scenario) -> SceneRollouts:
         """This pool's pre-built ``SceneRollouts`` for ``scenario`` (for start checks and in-process rollouts)."""
@@ -145,15 +142,14 @@ class RolloutPool:
     def _simulate(
         self, jobs: list[tuple[Scenario, ControlSequence]], start: RolloutStart | None, verify: bool
     ) -> list[RolloutOutcome]:
-        if self._executor is None or len(jobs) == 1:
+        if self.workers == 1 or len(jobs) == 1:
             return [
                 self._arrived((self.world(c).verify if verify else self.world(c).rollout)(s, start), verify)
                 for c, s in jobs
             ]
-        self._ready()
+        executor = self._started()
         futures = [
-            self._executor.submit(_rollout_task, c.key, c.yaml, s.times, s.knots, start, verify)
-            for c, s in jobs
+            executor.submit(_rollout_task, c.key, c.yaml, s.times, s.knots, start, verify) for c, s in jobs
         ]
         return [self._arrived(future.result(), verify) for future in futures]
 
@@ -163,11 +159,11 @@ class RolloutPool:
         return outcome
 
     def close(self, *, terminate: bool = False) -> None:
-        """Stop the worker processes (at once with ``terminate`` or when they never rolled out, else
-        after their rollouts) and drop the worlds."""
+        """Stop the worker processes (at once with ``terminate``, else after their rollouts) and
+        drop the worlds."""
         self._worlds.clear()
         if self._executor is not None:
-            if terminate or self._warming:
+            if terminate:
                 terminate_workers(self._executor)
             self._executor.shutdown(cancel_futures=True)
             self._executor = None

@@ -2,23 +2,38 @@
 
 ``ProgressListener`` has the methods of ``hlp_drake.systems.RunListener``: the stage lines go to
 stdout as each stage ends; the optimiser's rollouts and the execution's simulated time are tqdm
-bars on ``stream`` (off with ``quiet``).
+bars on ``stream`` (off with ``quiet``). A plan on a perceived scene names each object by the
+true object it was matched to, the perceived name beside.
 """
 
 from __future__ import annotations
 
 import sys
+from collections.abc import Mapping
 from typing import TextIO
 
 from tqdm import tqdm
 
 
-def plan_steps(plan) -> str:
-    """A plan's keypoints as one line: ``start -> move Long RR -> release -> target``."""
+def object_name(name: str, true_names: Mapping[str, str | None] | None = None) -> str:
+    """``name``, or with ``true_names`` (perceived -> true) the true name and the perceived one beside:
+    ``obstacle_9 (seen as object_2)``."""
+    if true_names is None:
+        return name
+    true = true_names.get(name)
+    if true is None:
+        return f"{name} (seen; matches no true object)"
+    return true if true == name else f"{true} (seen as {name})"
+
+
+def plan_steps(plan, true_names: Mapping[str, str | None] | None = None) -> str:
+    """A plan's keypoints as one line: ``start -> move Long RR -> release -> target`` (``true_names``:
+    planned on a perceived scene, see ``object_name``)."""
     return (
         " -> ".join(
             k.action
-            + (f" {k.element}" if k.action in ("gap", "move") else "")
+            + (f" {k.element}" if k.action == "gap" else "")
+            + (f" {object_name(k.element, true_names)}" if k.action == "move" else "")
             + (f" {k.direction}" if k.action == "move" else "")
             for k in plan.keypoints
         )
@@ -30,7 +45,9 @@ class ProgressListener:
     """Prints each stage of a run as it happens (see the module's docstring)."""
 
     def __init__(self, *, quiet: bool = False, stream: TextIO = sys.stderr) -> None:
-        self._quiet, self._stream = quiet, stream
+        self._bars = not quiet
+        self._stream = stream
+        self._true_names: Mapping[str, str | None] | None = None
         self._bar: tqdm | None = None
         self._shown = 0.0
         self._optimising = False  # the bar counts rollouts (not the closed loop's, during the execution)
@@ -39,7 +56,7 @@ class ProgressListener:
         print(text, flush=True)
 
     def _open(self, **kwargs) -> None:
-        if not self._quiet:
+        if self._bars:
             self._bar = tqdm(file=self._stream, dynamic_ncols=True, leave=False, **kwargs)
 
     def close(self) -> None:
@@ -57,8 +74,11 @@ class ProgressListener:
             f"perceive: {what} ({seconds:.2f} s: perception {perception.perception_s:.3f} s, the rest rendering)"
         )
 
+    def named(self, names: Mapping[str, str | None]) -> None:
+        self._true_names = names
+
     def planned(self, plan, seconds: float) -> None:
-        what = f"plan: {plan_steps(plan)}" if plan.ok else f"plan: none ({plan.reason})"
+        what = f"plan: {plan_steps(plan, self._true_names)}" if plan.ok else f"plan: none ({plan.reason})"
         self._line(f"{what} ({seconds:.2f} s)")
 
     def solved(self, keyframes, trajectory, seconds: float) -> None:

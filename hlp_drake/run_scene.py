@@ -7,9 +7,16 @@
 
 With no arguments it runs the bundled default scene with the bundled models. With --perception camera
 the planner, IK and optimiser work on the scene the world's cameras see (ScenePerception) while the
-simulation runs the true one; the JSON's perception record compares the two. Each stage is printed
-as it happens (plan, IK, the optimiser's rollouts, the execution's simulated time), then a summary.
-Exit status: 0 on success, 1 when the run failed (the reason is printed), 2 on bad input.
+simulation runs the true one; the plan names each perceived object by the true one it was matched
+to, the perceived name beside, and the JSON's perception record compares the two scenes. A header
+says what runs (the scene; the robot, planner, execution mode, model error, perception source and
+scenario file), each stage is printed as it happens (plan, IK, the optimiser's rollouts, the
+execution's simulated time), then a summary ending in one verdict line: the paper's reach success
+(the target in the gripper's pre-grasp region, no object off the table), the grasp beside it.
+
+Exit status: 0 when the reach succeeded, whether or not the grasp then held (the grasp is reported,
+not part of success); 1 when it failed (the verdict line says why); 2 on bad input; 130 when
+interrupted.
 """
 
 from __future__ import annotations
@@ -35,12 +42,31 @@ from hlp_drake.cli import (
 )
 from hlp_drake.errors import InstallError
 from hlp_drake.scene.constants import DEFAULT_SCENE_FILE, KINDS, MAX_GENERATED
+from hlp_drake.what_ran import WhatRan
 
 DEFAULT_SCENE = DEFAULT_SCENE_FILE
 PROG = "python -m hlp_drake.run_scene"
 
 
-def summary(result) -> str:
+def verdict(result) -> str:
+    """The verdict line: whether the reach succeeded (the paper's success, which sets the exit status),
+    and beside it whether the grasp held."""
+    grasp = {None: "not attempted", True: "held", False: "did not hold"}[result.grasp_held]
+    reach = (
+        "reach success (the paper's criterion, exit status 0)"
+        if result.success
+        else f"reach failure: {result.failure_reason} (exit status 1)"
+    )
+    return f"verdict: {reach}; grasp {grasp} (reported, not part of success)"
+
+
+def exit_status(result) -> int:
+    """0 when the reach succeeded (the paper's success), whatever the grasp; 1 when it failed."""
+    return 0 if result.success else 1
+
+
+def summary(result, ran: WhatRan | None = None) -> str:
+    """The run's summary: what ran (``ran``), timings, the objects moved and dropped, the verdict."""
     t = result.timings
     start = (result.optimisation or {}).get("start", 0)
     alternative = f", from the planner's alternative {start}" if start else ""
@@ -50,7 +76,6 @@ def summary(result) -> str:
         if result.rollouts
         else "not optimised"
     )
-    grasp = {None: "not attempted", True: "held", False: "did not hold"}[result.grasp_held]
     verified = (result.optimisation or {}).get("verifications", 0)
     if verified:
         displaced = result.optimisation.get("displaced_checks", 0)
@@ -65,14 +90,14 @@ def summary(result) -> str:
             f"; closed loop: {loop['replans']} re-optimisations, {loop['rollouts']} rollouts, "
             f"{loop['on_track']} periods on track"
         )
-    lines = [
+    lines = [f"ran: {ran.line()}"] if ran is not None else []
+    lines += [
         (
             f"timings: plan {t['plan_s']:.3f} s, IK {t['ik_s']:.2f} s, {optimiser}, execute {t['execute_s']:.1f} s "
             f"({result.simulated_s:.1f} s simulated), total {t['total_s']:.1f} s"
         ),
         f"objects moved: {', '.join(result.objects_moved) or 'none'}; dropped: {', '.join(result.objects_dropped) or 'none'}",
-        "success" if result.success else f"failure: {result.failure_reason}",
-        f"grasp: {grasp}",
+        verdict(result),
     ]
     return "\n".join(lines)
 
@@ -138,7 +163,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     elif args.scene is not None or args.config is None:
         scene = load_scene(args.scene or DEFAULT_SCENE)
     if scene is not None:
-        _print(f"scene {scene.name}: {len(scene.obstacles)} obstacles, planner {args.planner or 'hlp'}")
+        _print(f"scene {scene.name}: {len(scene.obstacles)} obstacles")
 
     from hlp_drake.systems.scenario import load_scenario, with_conditions  # Drake is imported from here on
 
@@ -153,17 +178,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         scenario, execution=args.execution, uncertainty=args.uncertainty, perception=args.perception
     )
     if scene is None:
-        _print(
-            f"scene {scenario.scene.name}: {len(scenario.scene.obstacles)} obstacles, "
-            f"planner {scenario.planner.kind}"
-        )
+        _print(f"scene {scenario.scene.name}: {len(scenario.scene.obstacles)} obstacles")
+    from hlp_drake.systems.execution.run import what_ran
+
+    ran = what_ran(scenario, args.config)
+    _print(f"run: {ran.line()}")
     result, meshcat = _run(scenario, args, started)
-    print(summary(result))
+    print(summary(result, ran))
     if args.html:
         write_text_atomic(args.html, meshcat.StaticHtml())
         print(f"wrote {args.html}")
     if args.json:
-        write_text_atomic(args.json, json.dumps(result.to_dict(), indent=2) + "\n")
+        write_text_atomic(args.json, json.dumps({**ran.to_dict(), **result.to_dict()}, indent=2) + "\n")
         print(f"wrote {args.json}")
     if args.meshcat:
         print(f"done in {time.perf_counter() - started:.1f} s; MeshCat keeps serving until you press Ctrl-C")
@@ -172,7 +198,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 time.sleep(1.0)
         except KeyboardInterrupt:
             pass
-    return 0 if result.success else 1
+    return exit_status(result)
 
 
 def _print(line: str) -> None:

@@ -35,6 +35,7 @@ from hlp_drake.experiments.results import (
 from hlp_drake.experiments.runner import JobFunction
 from hlp_drake.experiments.summary import summarise
 from hlp_drake.systems import scenario_yamls
+from hlp_drake.systems.world.robot import ROBOT_MODEL_NAME
 
 # fmt: off
 REQUIRED_COLUMNS = ["scene", "objects", "planner", "success", "failure_reason", "init_s", "optimise_s",
@@ -567,6 +568,39 @@ def test_perception_camera_is_part_of_the_runs_scenario_and_summary(tmp_path, ca
     # The same directory with the true scenes is another run: refused.
     assert run_cli(lambda a: main(a, job=never_called), [*argv, "--perception", "truth"]) == 2
     assert "different scenario" in capsys.readouterr().err
+
+
+def test_run_json_and_the_summary_say_what_ran(tmp_path, capsys):
+    config = tmp_path / "scenario.yaml"
+    config.write_text("optimiser: {samples: 2}\n")
+    out = tmp_path / "out"
+    argv = ["gen1", "--scenes", "1", "--workers", "1", "--quiet", "--config", str(config), "--out", str(out)]
+    argv += ["--execution", "closed", "--uncertainty", "4"]
+    assert run_cli(lambda a: main(a, job=cheap_job), argv) == 0
+    printed = capsys.readouterr().out
+    ran = {
+        "robot": ROBOT_MODEL_NAME,
+        "planners": ["hlp", "sto"],
+        "execution": "closed",
+        "model_error_seed": 4,
+        "perception_source": "truth",
+        "scenario_file": str(config),
+    }
+    run = json.loads((out / "run.json").read_text())
+    summary = json.loads((out / "summary.json").read_text())
+    assert {key: run[key] for key in ran} == ran == {key: summary[key] for key in ran}
+    line = (
+        f"Ran: robot {ROBOT_MODEL_NAME}, planners hlp and sto, execution closed, model error seed 4, "
+        f"perception truth, scenario {config}."
+    )
+    assert line in (out / "summary.md").read_text() and line in printed
+    # Without a scenario file: the built-in default (null in the JSON).
+    run_cli(
+        lambda a: main(a, job=cheap_job),
+        ["gen1", "--scenes", "1", "--workers", "1", "--quiet", "--out", str(tmp_path / "b")],
+    )
+    assert json.loads((tmp_path / "b" / "summary.json").read_text())["scenario_file"] is None
+    assert "model error none, perception truth, scenario built-in default." in capsys.readouterr().out
 
 
 @pytest.mark.slow

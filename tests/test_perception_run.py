@@ -27,10 +27,19 @@ def test_run_scene_plans_on_the_perceived_scene_and_reports_its_errors(tmp_path)
     for error in record["objects"]:
         assert error["position_error_m"] < 0.005 and error["size_error_m"] < 0.005, error
         assert error["yaw_error_rad"] is None or error["yaw_error_rad"] < 0.05, error
-    # The plan names the perceived obstacles; the simulation moves the true ones.
-    moved = {k["element"] for k in report["plan"]["keypoints"] if k["action"] == "move"}
-    assert moved <= {o["name"] for o in record["perceived"]}
+    # The plan names the true objects the perceived ones were matched to, the perceived names beside;
+    # the simulation moves the true ones.
+    matched_to = {o["name"]: o["matched_to"] for o in record["perceived"]}
+    assert set(matched_to.values()) == {o.name for o in true.objects}
+    assert {e["perceived_as"]: e["name"] for e in record["objects"]} == matched_to
+    named = [k for k in report["plan"]["keypoints"] if k["action"] not in ("start", "gap")]
+    assert named and all(k["element"] == matched_to[k["perceived_as"]] for k in named)
+    for k in named:
+        if k["action"] == "move":
+            seen = "" if k["element"] == k["perceived_as"] else f" (seen as {k['perceived_as']})"
+            assert f"move {k['element']}{seen} {k['direction']}" in result.stdout
     assert set(report["objects_moved"]) <= {o.name for o in true.objects}
+    assert report["perception_source"] == "camera" and "perception camera" in result.stdout
     assert report["timings"]["perceive_s"] > record["perception_s"] > 0
     commands = recorded(html.read_text())
     for path in (b"/drake/perception/points", b"/drake/perception/objects/Target", b"/drake/robot_plan/path"):
@@ -46,7 +55,7 @@ def test_run_scene_with_a_camera_that_sees_no_table_fails_with_the_reason(tmp_pa
     result = run_module("hlp_drake.run_scene", *args)
     assert result.returncode == 1 and "Traceback" not in result.stderr
     reason = "perception failed: no table plane found (too few pixels with a depth)"
-    assert f"failure: {reason}" in result.stdout
+    assert f"verdict: reach failure: {reason} (exit status 1); grasp not attempted" in result.stdout
     report = json.loads(out.read_text())
     assert report["failure_reason"] == reason and not report["success"]
     assert report["perception"]["ok"] is False and "Target" in report["perception"]["missed"]

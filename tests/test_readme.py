@@ -64,7 +64,7 @@ def test_every_bash_block_runs(tmp_path):
         if "scene show" in command:
             assert "robot plan: start ->" in result.stdout and "human plan: start ->" in result.stdout
         if "hlp_drake.run_scene" in command:  # the quick start: the default scene, planned and grasped
-            for line in ("plan: start ->", "optimise: success", "success\n", "grasp: held"):
+            for line in ("plan: start ->", "optimise: success", "verdict: reach success", "grasp held"):
                 assert line in result.stdout, (line, result.stdout)
     assert (tmp_path / "scene.png").stat().st_size > 10_000
 

@@ -20,7 +20,8 @@ from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import scene_to_dict
 from hlp_drake.systems.planning.diagram import make_planning_diagram
 from hlp_drake.systems.planning.transfer import gripper_geometry
-from hlp_drake.systems.scenario import Scenario
+from hlp_drake.systems.scenario import Scenario, with_conditions
+from hlp_drake.systems.world.robot import ROBOT_MODEL_NAME
 from hlp_drake.taskspace import DIRECTION_VECTORS, TaskSpace
 from hlp_drake.transfer.push import ROBOT_ACTIONS, robot_alternatives, robot_plan
 from hlp_drake.transfer.rules import TransferConfig, push_rules
@@ -141,6 +142,25 @@ def test_run_scene_end_to_end_json_and_html(tmp_path):
     assert b"contact_forces" not in commands and b"animation" in commands
     report = json.loads(out.read_text())
     assert report["planner"] == "hlp" and report["robot_actuated_dofs"] == 10
+    # What ran: in the header, the summary and the JSON.
+    ran = {
+        "robot": ROBOT_MODEL_NAME,
+        "planner": "hlp",
+        "execution": "open",
+        "model_error_seed": None,
+        "perception_source": "truth",
+        "scenario_file": None,
+    }
+    assert {key: report[key] for key in ran} == ran
+    line = f"robot {ROBOT_MODEL_NAME}, planner hlp, execution open, model error none, perception truth, "
+    line += "scenario built-in default"
+    assert f"run: {line}\n" in result.stdout and f"ran: {line}\n" in result.stdout
+    verdicts = [v for v in result.stdout.splitlines() if v.startswith("verdict: ")]
+    assert len(verdicts) == 1 and verdicts[0].startswith(
+        "verdict: reach success (the paper's criterion, exit status 0); grasp "
+        if report["success"]
+        else "verdict: reach failure: "
+    )
     assert set(report["timings"]) >= {"plan_s", "ik_s", "optimise_s", "total_s"}
     assert [k["action"] for k in report["plan"]["keypoints"]][:: len(report["plan"]["keypoints"]) - 1] == [
         "start",
@@ -167,12 +187,101 @@ def test_run_scene_closed_loop_with_uncertainty_end_to_end(tmp_path):
     assert result.returncode in (0, 1) and "Traceback" not in result.stderr, result.stderr
     report = json.loads(out.read_text())
     assert report["execution"] == "closed" and report["success"] == (result.returncode == 0)
+    assert report["model_error_seed"] == 5 and report["scenario_file"] == str(config)
+    assert f"execution closed, model error seed 5, perception truth, scenario {config}" in result.stdout
     loop = report["closed_loop"]
     assert loop["replans"] >= 1 and loop["replans"] <= loop["rollouts"] <= 3 * loop["replans"]
     assert "closed loop:" in result.stdout
     assert report["rollout_passed_execution_failed"] == (
         report["optimisation"]["success"] and not report["success"]
     )
+
+
+def test_what_ran_names_the_robot_planner_execution_model_error_perception_and_scenario_file():
+    from hlp_drake.systems.execution.run import what_ran
+    from hlp_drake.what_ran import WhatRan
+
+    plain = what_ran(Scenario())
+    assert plain == WhatRan(ROBOT_MODEL_NAME, ("hlp",), "open", None, "truth", None)
+    assert plain.line() == (
+        f"robot {ROBOT_MODEL_NAME}, planner hlp, execution open, model error none, perception truth, "
+        "scenario built-in default"
+    )
+    changed = with_conditions(
+        Scenario().updated("planner: {kind: sto}"), execution="closed", uncertainty=3, perception="camera"
+    )
+    ran = what_ran(changed, "my.yaml")
+    assert ran.line() == (
+        f"robot {ROBOT_MODEL_NAME}, planner sto, execution closed, model error seed 3, perception camera, "
+        "scenario my.yaml"
+    )
+    assert ran.to_dict() == {
+        "robot": ROBOT_MODEL_NAME,
+        "planner": "sto",
+        "execution": "closed",
+        "model_error_seed": 3,
+        "perception_source": "camera",
+        "scenario_file": "my.yaml",
+    }
+    assert WhatRan.from_dict(ran.to_dict()) == ran and WhatRan.from_dict({"planner": "hlp"}) is None
+    both = what_ran(Scenario(), planners=("hlp", "sto"))
+    assert "planners hlp and sto" in both.line() and both.to_dict()["planners"] == ["hlp", "sto"]
+    assert WhatRan.from_dict(both.to_dict()) == both
+
+
+@pytest.mark.parametrize(
+    ("success", "grasp_held", "status", "line"),
+    [
+        (True, True, 0, "verdict: reach success (the paper's criterion, exit status 0); grasp held"),
+        (True, False, 0, "verdict: reach success (the paper's criterion, exit status 0); grasp did not hold"),
+        (False, None, 1, "verdict: reach failure: in execution: x (exit status 1); grasp not attempted"),
+    ],
+)
+def test_the_exit_status_follows_the_reach_whatever_the_grasp(success, grasp_held, status, line):
+    from types import SimpleNamespace
+
+    from hlp_drake.run_scene import exit_status, verdict
+
+    result = SimpleNamespace(
+        success=success, grasp_held=grasp_held, failure_reason=None if success else "in execution: x"
+    )
+    assert exit_status(result) == status
+    assert verdict(result) == f"{line} (reported, not part of success)"
+
+
+def test_a_plan_on_a_perceived_scene_names_the_true_objects_with_the_perceived_names_beside():
+    from hlp_drake.planner import HighLevelPlan
+    from hlp_drake.planner.plan import PlanKeypoint
+    from hlp_drake.run_progress import plan_steps
+    from hlp_drake.systems.execution.run import named_plan
+
+    seen = HighLevelPlan(
+        scene="seen",
+        keypoints=(
+            PlanKeypoint("start", (0.1, 0.0)),
+            PlanKeypoint("move", (0.3, 0.0), row=1, element="object_2", direction="LL"),
+            PlanKeypoint("release", (0.3, 0.1), row=1, element="object_2", direction="LL"),
+            PlanKeypoint("gap", (0.4, 0.0), row=2, element="1"),
+            PlanKeypoint("move", (0.5, 0.0), row=3, element="object_5", direction="RR"),
+            PlanKeypoint("target", (0.6, 0.0), element="Target"),
+        ),
+    )
+    names = {"object_2": "obstacle_9", "object_5": None, "Target": "Target"}
+    assert plan_steps(seen, names) == (
+        "start -> move obstacle_9 (seen as object_2) LL -> release -> gap 1 -> "
+        "move object_5 (seen; matches no true object) RR -> target"
+    )
+    assert plan_steps(seen) == "start -> move object_2 LL -> release -> gap 1 -> move object_5 RR -> target"
+    keypoints = named_plan(seen.to_dict(), names)["keypoints"]
+    assert [(k["element"], k.get("perceived_as")) for k in keypoints] == [
+        (None, None),
+        ("obstacle_9", "object_2"),
+        ("obstacle_9", "object_2"),
+        ("1", None),
+        (None, "object_5"),
+        ("Target", "Target"),
+    ]
+    assert named_plan(seen.to_dict(), None) == seen.to_dict()
 
 
 def test_run_scene_bad_scene_file_is_one_line(tmp_path):

@@ -122,6 +122,7 @@ def main(
         scheduler=args.scheduler,
         config_yaml=config_yaml,
         perception=args.perception,
+        scenario_file=args.config,
         fresh=args.fresh,
         progress=not args.quiet,
     )

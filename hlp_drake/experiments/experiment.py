@@ -2,7 +2,7 @@
 
 The directory holds ``config.json`` (what the rows depend on: kind, first seed, scenario settings),
 ``results.csv`` (rewritten atomically after every finished job), ``run.json`` (the run's settings,
-machine and software), ``summary.md``/``summary.json`` and ``success.png``/``times.png``.
+what it ran, machine and software), ``summary.md``/``summary.json`` and ``success.png``/``times.png``.
 Scene i of a run has seed ``seed + i``. Rows already in ``results.csv`` are kept and not run again;
 a job interrupted mid-way is simply run again next time.
 """
@@ -13,7 +13,7 @@ import json
 import os
 import time
 from contextlib import closing
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -27,6 +27,7 @@ from hlp_drake.experiments.plots import write_plots
 from hlp_drake.experiments.results import START_OVER, ResultsFile, read_results, read_run_file, row_key
 from hlp_drake.experiments.runner import KINDS, Job, JobFunction, ScenarioResolver, make_jobs
 from hlp_drake.experiments.summary import summarise, write_summary
+from hlp_drake.what_ran import WhatRan
 
 RESULTS, CONFIG, RUN = "results.csv", "config.json", "run.json"
 DERIVED = ("summary.md", "summary.json", "success.png", "times.png")
@@ -51,6 +52,8 @@ class ExperimentSettings:
             replaced by each job's).
         perception: overrides the scenario's ``perception.source`` ("truth" or "camera"; None: the
             scenario's).
+        scenario_file: the file ``config_yaml`` was read from (None: none, the built-in default), named
+            in ``run.json`` and the summary.
         fresh: start over, discarding the directory's earlier results.
     """
 
@@ -63,6 +66,7 @@ class ExperimentSettings:
     scheduler: str | None = None
     config_yaml: str | None = None
     perception: str | None = None
+    scenario_file: str | None = None
     fresh: bool = False
     progress: bool = True
 
@@ -161,11 +165,13 @@ def _run_record(
     jobs: list[Job],
     pending: list[Job],
     earlier: list[dict[str, Any]],
+    ran: WhatRan,
 ) -> dict[str, Any]:
     return {
         "command": command,
         "status": "running",
         "kind": settings.kind,
+        **ran.to_dict(),
         "seeds": {
             "first": settings.seed,
             "last": settings.seed + settings.scenes - 1,
@@ -266,7 +272,8 @@ def run_experiment(
     _prepare(out, identity, settings.fresh)
     results.save()
     pending = [j for j in jobs if j.key not in results]
-    record = _run_record(settings, command, config_yaml, jobs, pending, earlier)
+    ran = replace(yamls.ran, scenario_file=settings.scenario_file)
+    record = _run_record(settings, command, config_yaml, jobs, pending, earlier, ran)
     write_text_atomic(out / RUN, json.dumps(record, indent=2) + "\n")
     try:
         _run_pending(job, pending, results, settings, len(jobs))
@@ -285,7 +292,7 @@ def run_experiment(
     measured_on = _measured_on(record["machine"], settings)
     if yamls.perception_source == "camera":
         measured_on += "; the planners saw the scenes through the cameras (perception: camera)"
-    summary = summarise(settings.kind, results.rows.values(), measured_on)
+    summary = summarise(settings.kind, results.rows.values(), measured_on, ran)
     write_summary(out, summary)
     write_plots(out, summary)
     return summary

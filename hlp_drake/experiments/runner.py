@@ -15,6 +15,7 @@ from typing import Any, Protocol
 from hlp_drake.errors import SceneError
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene
+from hlp_drake.what_ran import WhatRan
 
 PLANNERS = ("hlp", "sto")  # the planners of Tables II and III: human-like plan; STO's straight line
 KINDS = ("gen1", "gen2")  # Generalization I (Table II) and II (Table III)
@@ -57,12 +58,18 @@ class ScenarioYamls:
     Attributes:
         identity: the scenario as YAML (the run's identity, in ``config.json`` and ``run.json``).
         job: the scenario as the jobs run it, as YAML (``Job.config_yaml``).
-        perception_source: its ``perception.source`` ("truth" or "camera").
+        ran: what its jobs run: the robot, both planners, the execution mode, the model error's seed
+            and the perception source (no scenario file: the run's settings name it).
     """
 
     identity: str
     job: str
-    perception_source: str
+    ran: WhatRan
+
+    @property
+    def perception_source(self) -> str:
+        """The scenario's ``perception.source`` ("truth" or "camera")."""
+        return self.ran.perception_source
 
 
 class ScenarioResolver(Protocol):

@@ -18,6 +18,7 @@ from typing import Any
 
 from hlp_drake.atomic import write_text_atomic
 from hlp_drake.experiments.runner import PLANNERS, Row
+from hlp_drake.what_ran import WhatRan
 
 PLANNER_LABELS = {"hlp": "HLP", "sto": "STO (straight line)"}
 TIMES = ("init_s", "optimise_s", "total_s")
@@ -132,8 +133,11 @@ def planner_stats(rows: list[Row], paper: PaperFigures) -> dict[str, Any]:
     return stats
 
 
-def summarise(kind: str, rows: Iterable[Row], measured_on: str | None = None) -> dict[str, Any]:
-    """Per condition (object count) and planner: the figures of Table II (gen1) or III (gen2)."""
+def summarise(
+    kind: str, rows: Iterable[Row], measured_on: str | None = None, ran: WhatRan | None = None
+) -> dict[str, Any]:
+    """Per condition (object count) and planner: the figures of Table II (gen1) or III (gen2); what
+    the run ran (``ran``: robot, planners, execution, model error, perception, scenario file)."""
     groups: dict[int, dict[str, list[Row]]] = defaultdict(lambda: defaultdict(list))
     for row in rows:
         groups[row["objects"]][row["planner"]].append(row)
@@ -164,6 +168,7 @@ def summarise(kind: str, rows: Iterable[Row], measured_on: str | None = None) ->
     return {
         "kind": kind,
         "table": TABLES[kind],
+        **({} if ran is None else ran.to_dict()),
         "measured_on": measured_on,
         "conditions": conditions,
         "notes": NOTES[kind],
@@ -197,6 +202,9 @@ def _table_rows(condition: dict[str, Any]) -> list[str]:
 def summary_markdown(summary: dict[str, Any]) -> str:
     """The summary as Markdown: the paper's table with the paper's values in parentheses, ratios, notes."""
     lines = [f"# {summary['table']}", ""]
+    ran = WhatRan.from_dict(summary)
+    if ran is not None:
+        lines += [f"Ran: {ran.line()}.", ""]
     if summary["measured_on"]:
         lines += [f"Measured on {summary['measured_on']}.", ""]
     lines += [

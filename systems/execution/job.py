@@ -11,7 +11,7 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from hlp_drake.learners.bundled import default_models
-from hlp_drake.systems.execution.run import plan_and_execute
+from hlp_drake.systems.execution.run import plan_and_execute, what_ran
 from hlp_drake.systems.optimiser.pool import RolloutPool
 from hlp_drake.systems.optimiser.rollout_world import simulation_failure
 from hlp_drake.systems.scenario import load_scenario, with_conditions
@@ -25,13 +25,13 @@ def scenario_yamls(
 ) -> ScenarioYamls:
     """The scenario of ``text`` (None: the defaults; ``perception.source`` set to ``perception``
     unless None), read once: its YAML (the run's identity), written out in full as the jobs run it
-    (``optimiser.workers = 1`` if ``single_process_rollouts``), and its ``perception.source``.
+    (``optimiser.workers = 1`` if ``single_process_rollouts``), and what its jobs run.
 
     Raises:
         HlpError: the scenario is invalid.
     """
     # hlp_drake.experiments is imported when needed: importing hlp_drake.systems does not load it
-    from hlp_drake.experiments.runner import ScenarioYamls
+    from hlp_drake.experiments.runner import PLANNERS, ScenarioYamls
 
     scenario = with_conditions(load_scenario(data=text, where="--config"), perception=perception)
     jobs = (
@@ -39,7 +39,7 @@ def scenario_yamls(
         if single_process_rollouts
         else scenario
     )
-    return ScenarioYamls(identity=scenario.yaml, job=jobs.yaml, perception_source=scenario.perception.source)
+    return ScenarioYamls(identity=scenario.yaml, job=jobs.yaml, ran=what_ran(scenario, planners=PLANNERS))
 
 
 def run_job(job: Job) -> Row:

@@ -38,14 +38,15 @@ from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.cost import FinalState, pregrasp_check, reach_problem
 from hlp_drake.systems.optimiser.pool import RolloutPool
 from hlp_drake.systems.optimiser.rollout_world import simulation_failure
-from hlp_drake.systems.perception.accuracy import perception_record
+from hlp_drake.systems.perception.accuracy import match_objects, perception_record
 from hlp_drake.systems.perception.system import perceive_world
 from hlp_drake.systems.planning.keyframes import Keyframes
-from hlp_drake.systems.world.robot import TCP_FRAME
+from hlp_drake.systems.world.robot import ROBOT_MODEL_NAME, TCP_FRAME
 from hlp_drake.systems.world.scene_models import fallen_objects, object_planar_poses
 from hlp_drake.systems.world.scene_source import SCENE_PORT
 from hlp_drake.systems.world.start_pose import tcp_keypoint_height
 from hlp_drake.systems.world.world import world_plant
+from hlp_drake.what_ran import WhatRan
 
 if TYPE_CHECKING:
     from pydrake.trajectories import PiecewisePolynomial
@@ -55,6 +56,23 @@ if TYPE_CHECKING:
     from hlp_drake.systems.perception.perception import Perception
     from hlp_drake.systems.scenario import Scenario
 
+
+def what_ran(
+    scenario: Scenario, scenario_file: str | None = None, *, planners: tuple[str, ...] | None = None
+) -> WhatRan:
+    """What a run of ``scenario`` (read from ``scenario_file``; None: the built-in default) runs: its
+    robot, planner (or ``planners``), execution mode, model error's seed, perception source."""
+    uncertainty = scenario.uncertainty
+    return WhatRan(
+        robot=ROBOT_MODEL_NAME,
+        planners=planners or (scenario.planner.kind,),
+        execution="closed" if scenario.closed_loop.enabled else "open",
+        model_error_seed=uncertainty.seed if uncertainty.enabled else None,
+        perception_source=scenario.perception.source,
+        scenario_file=scenario_file,
+    )
+
+
 MOVED_TOLERANCE = 0.01  # m: an object displaced further than this counts as moved
 RECORDING_FPS = 32.0  # frames per second of a MeshCat recording
 
@@ -63,7 +81,12 @@ RECORDING_FPS = 32.0  # frames per second of a MeshCat recording
 class ExecutionResult:
     """Outcome of planning and executing one scene (``reach_reused``: the execution started where
     the optimised sequence's verification on the execution model ended, rather than simulating the
-    reach again; see ``verified_reach``)."""
+    reach again; see ``verified_reach``; ``true_names``: planned on a perceived scene, per perceived
+    object's name the true object's it was matched to, None if none).
+
+    ``success`` is the paper's reach success (see ``plan_and_execute``); ``grasp_held`` is reported
+    beside it and is not part of it.
+    """
 
     planner: str
     scene: Scene
@@ -85,6 +108,7 @@ class ExecutionResult:
     execution: str = "open"
     closed_loop: dict[str, Any] = field(default_factory=dict)
     reach_reused: bool = False
+    true_names: dict[str, str | None] | None = None
 
     @property
     def rollout_passed_execution_failed(self) -> bool:
@@ -97,7 +121,7 @@ class ExecutionResult:
             "scene": self.scene.name,
             "success": self.success,
             "failure_reason": self.failure_reason,
-            "plan": self.plan.to_dict(),
+            "plan": named_plan(self.plan.to_dict(), self.true_names),
             "ik": {"ok": self.keyframes.ok, "failures": self.keyframes.failures},
             "robot_actuated_dofs": 10,
             "timings": self.timings,
@@ -115,6 +139,29 @@ class ExecutionResult:
             "reach_reused": self.reach_reused,
             "rollout_passed_execution_failed": self.rollout_passed_execution_failed,
         }
+
+
+def true_names(scene: Scene, perception: Perception) -> dict[str, str | None]:
+    """Per object of the ``perception``'s scene, the name of the object of the true ``scene`` it was
+    matched to (``match_objects``), None for an object matched to none."""
+    if not perception.ok:
+        return {}
+    matched = {seen: true for true, seen in match_objects(scene, perception.scene).items()}
+    return {o.name: matched.get(o.name) for o in perception.scene.objects}
+
+
+def named_plan(plan: dict[str, Any], names: dict[str, str | None] | None) -> dict[str, Any]:
+    """A plan's JSON (``HighLevelPlan.to_dict``) whose keypoints name the true objects (``names``:
+    perceived -> true, None: planned on the true scene), each perceived name beside as ``perceived_as``."""
+    if names is None:
+        return plan
+    keypoints = []
+    for keypoint in plan["keypoints"]:
+        element = keypoint["element"]
+        if keypoint["action"] != "gap" and element is not None:
+            keypoint = {**keypoint, "element": names.get(element), "perceived_as": element}
+        keypoints.append(keypoint)
+    return {**plan, "keypoints": keypoints}
 
 
 def plan_and_execute(
@@ -235,6 +282,9 @@ def _plan(handles, scenario, simulator, listener, started, perception, perceive_
     plan: HighLevelPlan = planning.GetOutputPort("plan").Eval(context)
     planned = time.perf_counter()
     plan_s = planned - started - (perceive_s if handles.watching else 0.0)  # open loop: perceived before
+    names = None if perception is None else true_names(scenario.scene, perception)
+    if names is not None:
+        listener.named(names)
     listener.planned(plan, plan_s)
     keyframes: Keyframes = planning.GetOutputPort("keyframes").Eval(context)
     trajectory = planning.GetOutputPort("trajectory").Eval(context)
@@ -245,6 +295,7 @@ def _plan(handles, scenario, simulator, listener, started, perception, perceive_
         scenario.planner.kind, scenario.scene, plan, keyframes, robot_plan, execution=handles.execution
     )
     result.timings = {"plan_s": plan_s, "ik_s": solved - planned, "optimise_s": 0.0}
+    result.true_names = names
     if scenario.perception.source == "camera":
         result.perception = perception_record(scenario.scene, perception)
         result.timings["perceive_s"] = perceive_s
@@ -374,6 +425,10 @@ class RunListener:
 
     def perceived(self, perception: Perception, seconds: float) -> None:
         """The cameras' frame is perceived (``seconds`` with the rendering; ``perception_s`` without)."""
+
+    def named(self, names: dict[str, str | None]) -> None:
+        """The perceived objects' true names (perceived -> true, None: matched to none), before
+        ``planned`` of a plan on a perceived scene."""
 
     def planned(self, plan: HighLevelPlan, seconds: float) -> None:
         """The planner's plan is ready."""

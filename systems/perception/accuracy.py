@@ -68,7 +68,8 @@ def match_objects(true: Scene, seen: Scene) -> dict[str, str]:
 
 def perception_record(true: Scene, perception: Perception) -> dict[str, Any]:
     """The ``perception`` record of a run: the frame's outcome (``Perception.to_dict``: the fitted
-    objects under ``perceived``), per true object its errors (``objects``), the objects ``missed``
+    objects under ``perceived``, each with the true object's name it was ``matched_to``, None if
+    none), per true object its errors (``objects``), the objects ``missed``
     (true ones without a match) and ``invented`` (perceived ones without one), and the table's
     errors."""
     record = {**perception.to_dict(), "objects": [], "missed": [], "invented": []}
@@ -84,6 +85,10 @@ def perception_record(true: Scene, perception: Perception) -> dict[str, Any]:
     record["missed"] = [o.name for o in true.objects if o.name not in matches]
     matched = set(matches.values())
     record["invented"] = [o.name for o in seen.objects if o.name not in matched]
+    true_of = {seen_name: true_name for true_name, seen_name in matches.items()}
+    record["perceived"] = [
+        {"name": o["name"], "matched_to": true_of.get(o["name"]), **o} for o in record["perceived"]
+    ]
     table = true.table
     record["table_errors_m"] = {
         "length": seen.table.length - table.length,

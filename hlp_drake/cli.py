@@ -3,8 +3,9 @@
 Every command (``python -m hlp_drake.X`` or ``hlp-drake X``) builds its parser with ``make_parser``:
 the help shows the module's docstring without reStructuredText markup, ``--version`` prints the
 package's version, and a usage error is one ``error: ...`` line with exit status 2. Commands with
-progress bars take ``--quiet`` (``add_quiet``) to turn them off; commands that plan take
-``--perception`` (``add_perception``).
+progress bars take ``--quiet`` (``add_quiet``) to turn them off; commands that run Drake take
+``--quiet`` or ``--verbose`` (``add_verbosity``: Drake's INFO lines only with ``--verbose``,
+``drake_logging``); commands that plan take ``--perception`` (``add_perception``).
 """
 
 from __future__ import annotations
@@ -72,8 +73,32 @@ def integer(low: int, high: int) -> Callable[[str], int]:
 
 
 def add_quiet(parser: argparse.ArgumentParser) -> None:
-    """``--quiet``: no progress bars (they are shown by default, on stderr)."""
+    """``--quiet``: no progress bars (shown by default on stderr when it is a terminal)."""
     parser.add_argument("--quiet", action="store_true", help="no progress bars")
+
+
+def add_verbosity(parser: argparse.ArgumentParser) -> None:
+    """``--quiet`` (no progress bars) or ``--verbose`` (Drake's INFO lines too): for commands that run
+    Drake (``drake_logging``)."""
+    group = parser.add_mutually_exclusive_group()
+    group.add_argument(
+        "--quiet",
+        action="store_true",
+        help="no progress bars (shown on stderr when it is a terminal) and no Drake INFO lines",
+    )
+    group.add_argument(
+        "--verbose", action="store_true", help="Drake's INFO lines too (e.g. where MeshCat listens)"
+    )
+
+
+def drake_logging(verbose: bool) -> None:
+    """Drake's INFO lines (e.g. ``Meshcat listening for connections at ...``) only when ``verbose``; its
+    warnings and errors always. Imports pydrake, which sets its logger's level on import."""
+    import logging
+
+    import pydrake.common  # noqa: F401 - sets the "drake" logger's level: set it afterwards
+
+    logging.getLogger("drake").setLevel(logging.INFO if verbose else logging.WARNING)
 
 
 PERCEPTION_SOURCES = ("truth", "camera")

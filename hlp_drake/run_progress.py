@@ -2,7 +2,8 @@
 
 ``ProgressListener`` has the methods of ``hlp_drake.systems.RunListener``: the stage lines go to
 stdout as each stage ends; the optimiser's rollouts and the execution's simulated time are tqdm
-bars on ``stream`` (off with ``quiet``). A plan on a perceived scene names each object by the
+bars on ``stream`` when it is a terminal (never in a file or a pipe, where their carriage returns
+would run into the lines; off with ``quiet``). A plan on a perceived scene names each object by the
 true object it was matched to, the perceived name beside.
 """
 
@@ -13,6 +14,8 @@ from collections.abc import Mapping
 from typing import TextIO
 
 from tqdm import tqdm
+
+from hlp_drake.terminal import is_terminal
 
 
 def object_name(name: str, true_names: Mapping[str, str | None] | None = None) -> str:
@@ -45,7 +48,7 @@ class ProgressListener:
     """Prints each stage of a run as it happens (see the module's docstring)."""
 
     def __init__(self, *, quiet: bool = False, stream: TextIO = sys.stderr) -> None:
-        self._bars = not quiet
+        self._bars = not quiet and is_terminal(stream)
         self._stream = stream
         self._true_names: Mapping[str, str | None] | None = None
         self._bar: tqdm | None = None

@@ -3,7 +3,7 @@
     python -m hlp_drake.run_scene [--scene FILE | --kind vr|gen1|gen2|unstructured --seed N [--objects K]]
         [--planner hlp|sto] [--perception truth|camera] [--config SCENARIO.yaml] [--workers N]
         [--meshcat] [--html FILE] [--contact-forces] [--execution open|closed] [--uncertainty [SEED]]
-        [--json FILE] [--quiet]
+        [--json FILE] [--quiet | --verbose]
 
 With no arguments it runs the bundled default scene with the bundled models. With --perception camera
 the planner, IK and optimiser work on the scene the world's cameras see (ScenePerception) while the
@@ -35,7 +35,8 @@ from hlp_drake.cli import (
     MAX_WORKERS,
     add_conditions,
     add_perception,
-    add_quiet,
+    add_verbosity,
+    drake_logging,
     integer,
     make_parser,
     run_cli,
@@ -143,7 +144,7 @@ def _parser():
     parser.add_argument("--contact-forces", action="store_true", help="draw the contact forces in MeshCat")
     add_conditions(parser)
     parser.add_argument("--json", metavar="FILE", help="write the result as JSON")
-    add_quiet(parser)
+    add_verbosity(parser)
     return parser
 
 
@@ -165,7 +166,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     if scene is not None:
         _print(f"scene {scene.name}: {len(scene.obstacles)} obstacles")
 
-    from hlp_drake.systems.scenario import load_scenario, with_conditions  # Drake is imported from here on
+    drake_logging(args.verbose)  # Drake is imported from here on
+    from hlp_drake.systems.scenario import load_scenario, with_conditions
 
     scenario = load_scenario(args.config)
     scenario = replace(

@@ -570,6 +570,23 @@ def test_perception_camera_is_part_of_the_runs_scenario_and_summary(tmp_path, ca
     assert "different scenario" in capsys.readouterr().err
 
 
+def test_without_a_terminal_progress_is_a_line_per_job_without_carriage_returns(tmp_path, capsys):
+    argv = ["gen1", "--scenes", "2", "--seed", "5", "--workers", "1", "--out", str(tmp_path)]
+    assert run_cli(lambda a: main(a, job=cheap_job), argv) == 0  # stderr is captured: no terminal
+    err = capsys.readouterr().err
+    assert "\r" not in err
+    rows = {(r["scene"], r["planner"]): r["success"] for r in read_rows(tmp_path / "results.csv")}
+    assert err.splitlines() == [
+        f"gen1: {n} of 4 jobs done ({scene} {planner}: "
+        f"{'success' if rows[scene, planner] == 'true' else 'failure'})"
+        for n, (scene, planner) in enumerate(
+            [("gen1-5", "hlp"), ("gen1-5", "sto"), ("gen1-6", "hlp"), ("gen1-6", "sto")], 1
+        )
+    ]
+    assert run_cli(lambda a: main(a, job=never_called), [*argv, "--quiet"]) == 0
+    assert capsys.readouterr().err == ""
+
+
 def test_run_json_and_the_summary_say_what_ran(tmp_path, capsys):
     config = tmp_path / "scenario.yaml"
     config.write_text("optimiser: {samples: 2}\n")

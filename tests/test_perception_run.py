@@ -15,8 +15,11 @@ def test_run_scene_plans_on_the_perceived_scene_and_reports_its_errors(tmp_path)
     out, html = tmp_path / "run.json", tmp_path / "run.html"
     args = ("--kind", "vr", "--seed", "1", "--workers", "1", "--perception", "camera")
     network = {"DRAKE_ALLOW_NETWORK": "meshcat"}  # a recording needs a local MeshCat server (CI sets none)
-    result = run_module("hlp_drake.run_scene", *args, "--json", str(out), "--html", str(html), env=network)
+    result = run_module(
+        "hlp_drake.run_scene", *args, "--json", str(out), "--html", str(html), "--verbose", env=network
+    )
     assert result.returncode in (0, 1) and "Traceback" not in result.stderr, result.stderr
+    assert "INFO:drake:Meshcat listening for connections" in result.stderr  # shown with --verbose only
     assert "perceive: 7 objects, the target Target" in result.stdout
     report = json.loads(out.read_text())
     record = report["perception"]

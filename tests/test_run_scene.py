@@ -284,6 +284,69 @@ def test_a_plan_on_a_perceived_scene_names_the_true_objects_with_the_perceived_n
     assert named_plan(seen.to_dict(), None) == seen.to_dict()
 
 
+def test_a_run_logged_to_a_file_has_one_line_per_stage_and_no_carriage_returns(tmp_path):
+    import subprocess
+    import sys
+
+    log = tmp_path / "run.log"
+    with log.open("w") as file:  # stdout and stderr into one file, as `> run.log 2>&1`
+        code = subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "hlp_drake.run_scene",
+                "--workers",
+                "1",
+                "--html",
+                str(tmp_path / "r.html"),
+            ],
+            stdout=file,
+            stderr=subprocess.STDOUT,
+            env={**os.environ, "DRAKE_ALLOW_NETWORK": "meshcat"},
+            timeout=600,
+            check=False,
+        ).returncode
+    text = log.read_text()
+    assert code == 0 and "\r" not in text and "INFO:drake" not in text, text
+    stages = ("scene ", "run: ", "plan: ", "IK: ", "optimise: ", "execute: ", "ran: ", "verdict: ")
+    lines = text.splitlines()
+    found = [next(i for i, line in enumerate(lines) if line.startswith(stage)) for stage in stages]
+    assert found == sorted(found), text
+    assert sum(line.startswith("optimise") for line in lines) == 1
+    assert lines[-1] == f"wrote {tmp_path / 'r.html'}"
+
+
+def test_progress_bars_only_on_a_terminal():
+    import io
+    from types import SimpleNamespace
+
+    from hlp_drake.run_progress import ProgressListener
+
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    for stream, bars in ((io.StringIO(), False), (Terminal(), True)):
+        listener = ProgressListener(stream=stream)
+        listener.optimising()
+        listener.rollout(SimpleNamespace(cost=1.0))
+        listener.executing(1.0)
+        listener.simulated(0.5)
+        listener.close()
+        assert ("\r" in stream.getvalue()) == bars
+    quiet = Terminal()
+    listener = ProgressListener(quiet=True, stream=quiet)
+    listener.optimising()
+    listener.close()
+    assert quiet.getvalue() == ""
+
+
+def test_quiet_and_verbose_are_exclusive():
+    result = run_module("hlp_drake.run_scene", "--quiet", "--verbose")
+    assert result.returncode == 2
+    assert result.stderr.startswith("error: argument --verbose: not allowed with argument --quiet")
+
+
 def test_run_scene_bad_scene_file_is_one_line(tmp_path):
     bad = tmp_path / "bad.yaml"
     bad.write_text("table: [1, 2\n")

@@ -36,6 +36,7 @@ from hlp_drake.dataset.parse import (
 from hlp_drake.dataset.records import TRACKERS, category_of, trial_key
 from hlp_drake.dataset.source import PARTICIPANTS_FILE, Source
 from hlp_drake.errors import HlpError, short
+from hlp_drake.terminal import bars_disabled
 
 CACHE_VERSION = 5  # 5: values beyond parse.MAX_VALUE, files beyond source.MAX_FILE_BYTES and trials
 # listed twice are left out (4: the track array holds the kept trials' tracks only, in index order)
@@ -295,7 +296,7 @@ def build_cache(source: Source, directory: Path, *, progress: bool = True) -> No
         desc="reading VR dataset (first load, cached afterwards)",
         unit="B",
         unit_scale=True,
-        disable=not progress,
+        disable=bars_disabled(progress, sys.stderr),
         file=sys.stderr,
         mininterval=1.0,
     ) as bar:

@@ -36,6 +36,7 @@ from hlp_drake.learners import DEFAULT_PRESET, PRESETS, DecisionModels
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.processes import interrupts_held, worker_pool
 from hlp_drake.segmentation import DEFAULT_MODE, MODES, segment_dataset
+from hlp_drake.terminal import bars_disabled
 
 TRAIN_SIZES = (3, 7, 11, 15, 19, 23)
 PROTOCOLS = ("80_20", "num_subjects", "unstructured")
@@ -154,7 +155,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         with interrupts_held():  # the workers start here
             futures = [(job[0], pool.submit(run, *job[1:]) if pool else None, job) for job in jobs]
         for label, future, job in tqdm(
-            futures, desc=f"{args.protocol} ({workers} workers)", unit="split", disable=args.quiet
+            futures,
+            desc=f"{args.protocol} ({workers} workers)",
+            unit="split",
+            disable=bars_disabled(not args.quiet),
         ):
             results.setdefault(label, []).append(future.result() if future else run(*job[1:]))
     return write_report(args, results, demonstrations, time.perf_counter() - started)

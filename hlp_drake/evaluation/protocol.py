@@ -25,6 +25,7 @@ from hlp_drake.learners.models import DecisionModels, LearnerSettings
 from hlp_drake.planner import PlannerConfig, plan
 from hlp_drake.segmentation.demonstration import GAP, OBJECT, Demonstration
 from hlp_drake.segmentation.modes import is_faithful
+from hlp_drake.terminal import bars_disabled
 
 PAPER_TABLE_I = {
     "gap_accuracy": 0.95,
@@ -186,7 +187,11 @@ def score_plans(
     faithful = is_faithful(models.mode_)
     outcomes, baselines = [], {name: [] for name in BASELINES}
     for demo in tqdm(
-        demonstrations, desc="planning test scenes", unit="scene", leave=False, disable=not progress
+        demonstrations,
+        desc="planning test scenes",
+        unit="scene",
+        leave=False,
+        disable=bars_disabled(progress),
     ):
         lengths = (demo.link_lengths.upper_arm, demo.link_lengths.forearm)
         result = plan(demo.scene, models, config, start_arm=demo.keypoints[0].arm, link_lengths=lengths)

@@ -2,7 +2,7 @@
 
     python -m hlp_drake.experiments {gen1,gen2} [--scenes 100] [--objects 5 7 9] [--seed S]
         [--workers N] [--executor local|dask] [--scheduler ADDRESS] [--config SCENARIO.yaml]
-        [--perception truth|camera] [--execution open|closed] [--uncertainty [SEED]] [--fresh] [--quiet]
+        [--perception truth|camera] [--execution open|closed] [--uncertainty [SEED]] [--fresh] [--quiet | --verbose]
         --out DIR
 
 Every scene is planned and executed with both planners (HLP and STO's straight line); scene i has
@@ -27,7 +27,8 @@ from hlp_drake.cli import (
     MAX_WORKERS,
     add_conditions,
     add_perception,
-    add_quiet,
+    add_verbosity,
+    drake_logging,
     integer,
     make_parser,
 )
@@ -88,7 +89,7 @@ def _parser() -> argparse.ArgumentParser:
     add_perception(parser)
     add_conditions(parser)
     parser.add_argument("--fresh", action="store_true", help="discard DIR's earlier results and start over")
-    add_quiet(parser)
+    add_verbosity(parser)
     parser.add_argument(
         "--out", required=True, metavar="DIR", help="output directory (resumes the run there)"
     )
@@ -104,6 +105,7 @@ def main(
     """Run the experiment of ``argv``; ``job`` and ``scenario`` replace the real (scene, planner) job
     and scenario reading (``hlp_drake.systems.execution.job``'s, which import Drake), e.g. in tests."""
     args = _parser().parse_args(argv)
+    drake_logging(args.verbose)  # before Drake is first imported
     config_yaml = None
     if args.config:
         config_yaml = read_document(args.config, missing="scenario file not found")
@@ -128,7 +130,7 @@ def main(
     )
     command = f"{PROG} {shlex.join(sys.argv[1:] if argv is None else argv)}"
     if job is None or scenario is None:
-        from hlp_drake.systems.execution import job as drake_side  # Drake is imported from here on
+        from hlp_drake.systems.execution import job as drake_side
 
         job = job or drake_side.run_job
         scenario = scenario or drake_side.scenario_yamls

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 import time
 from contextlib import closing
 from dataclasses import dataclass, replace
@@ -27,6 +28,7 @@ from hlp_drake.experiments.plots import write_plots
 from hlp_drake.experiments.results import START_OVER, ResultsFile, read_results, read_run_file, row_key
 from hlp_drake.experiments.runner import KINDS, Job, JobFunction, ScenarioResolver, make_jobs
 from hlp_drake.experiments.summary import summarise, write_summary
+from hlp_drake.terminal import bars_disabled
 from hlp_drake.what_ran import WhatRan
 
 RESULTS, CONFIG, RUN = "results.csv", "config.json", "run.json"
@@ -205,15 +207,18 @@ def _prepare(out: Path, identity: dict[str, Any], fresh: bool) -> None:
 def _run_pending(
     job: JobFunction, pending: list[Job], results: ResultsFile, settings: ExperimentSettings, total: int
 ) -> None:
-    """Run ``pending`` on the settings' executor, saving each row as it finishes, with a progress bar."""
+    """Run ``pending`` on the settings' executor, saving each row as it finishes, with a progress bar
+    on a terminal, else (in a file or a pipe) a line per finished job on stderr."""
     bar = tqdm(
         total=total,
         initial=total - len(pending),
         unit="job",
         dynamic_ncols=True,
         desc=f"{settings.kind} ({settings.worker_count} at a time)",
-        disable=not settings.progress,
+        disable=bars_disabled(settings.progress),
     )
+    lines = settings.progress and bar.disable
+    done_jobs = total - len(pending)
     finished = run_jobs(
         job, pending, executor=settings.executor, workers=settings.worker_count, scheduler=settings.scheduler
     )
@@ -222,10 +227,16 @@ def _run_pending(
             if row_key(row) != done.key:
                 raise ValueError(f"the job for {done.key} returned the row of {row_key(row)}")
             results.add(row)
-            bar.set_postfix_str(
-                f"{done.scene} {done.planner}: {'success' if row['success'] else 'failure'}", refresh=False
-            )
+            outcome = f"{done.scene} {done.planner}: {'success' if row['success'] else 'failure'}"
+            bar.set_postfix_str(outcome, refresh=False)
             bar.update()
+            done_jobs += 1
+            if lines:
+                print(
+                    f"{settings.kind}: {done_jobs} of {total} jobs done ({outcome})",
+                    file=sys.stderr,
+                    flush=True,
+                )
 
 
 def run_experiment(

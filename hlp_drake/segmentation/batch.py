@@ -15,6 +15,7 @@ from hlp_drake.segmentation.demonstration import NONE, OBJECT, Demonstration, Re
 from hlp_drake.segmentation.modes import DEFAULT_MODE, Mode, check_mode
 from hlp_drake.segmentation.segment import Rejected, segment_trial
 from hlp_drake.taskspace import TaskSpace
+from hlp_drake.terminal import bars_disabled
 
 
 @dataclass
@@ -67,7 +68,7 @@ def segment_dataset(
         for key, problem in dataset.left_out().items():
             if category_of(int(key[-3:])) in categories:
                 result.rejections.append(Rejection(key, f"unreadable data: {problem['reason']}"))
-    for record in tqdm(records, desc=f"segmenting ({mode})", unit="trial", disable=not progress):
+    for record in tqdm(records, desc=f"segmenting ({mode})", unit="trial", disable=bars_disabled(progress)):
         trial = dataset.trial(record.key)
         try:
             result.demonstrations.append(segment_trial(trial, mode=mode))

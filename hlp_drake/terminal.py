@@ -1,0 +1,20 @@
+"""Progress bars only on a terminal: in a file or a pipe their carriage returns would run into the lines."""
+
+from __future__ import annotations
+
+import sys
+from typing import TextIO
+
+
+def is_terminal(stream: TextIO | None) -> bool:
+    """Whether ``stream`` is a terminal (where a progress bar can redraw itself)."""
+    try:
+        return stream is not None and stream.isatty()
+    except (AttributeError, ValueError):  # no isatty, or closed
+        return False
+
+
+def bars_disabled(progress: bool, stream: TextIO | None = None) -> bool:
+    """tqdm's ``disable``: no bar unless ``progress`` is wanted and ``stream`` (stderr by default) is a
+    terminal."""
+    return not (progress and is_terminal(sys.stderr if stream is None else stream))

@@ -17,9 +17,13 @@ from __future__ import annotations
 import importlib
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 
 from hlp_drake import __version__
-from hlp_drake.cli import plain, run_cli
+from hlp_drake.cli import invoked_as, plain, run_cli
+
+PROG, PYTHON_M = "hlp-drake", "python -m hlp_drake"
+"""The console script's name, and how ``python -m`` runs the same (named as the user typed)."""
 
 COMMANDS = {
     "run-scene": "hlp_drake.run_scene",
@@ -35,20 +39,22 @@ COMMANDS = {
 def main(argv: Sequence[str] | None = None) -> int:
     """Run ``hlp-drake``'s command ``argv[0]`` with the rest of ``argv``."""
     args = list(sys.argv[1:] if argv is None else argv)
+    name = PYTHON_M if argv is None and Path(sys.argv[0]).name == "__main__.py" else PROG
     if not args or args[0] in ("-h", "--help"):
         print(plain(__doc__).strip())
         return 0 if args else 2
     if args[0] == "--version":
-        print(f"hlp-drake {__version__}")
+        print(f"{name} {__version__}")
         return 0
     module = COMMANDS.get(args[0])
     if module is None:
         print(
-            f"error: unknown command {args[0]!r}; choose one of {', '.join(COMMANDS)} (see hlp-drake --help)",
+            f"error: unknown command {args[0]!r}; choose one of {', '.join(COMMANDS)} (see {name} --help)",
             file=sys.stderr,
         )
         return 2
-    return run_cli(importlib.import_module(module).main, args[1:])
+    with invoked_as(f"{name} {args[0]}"):
+        return run_cli(importlib.import_module(module).main, args[1:])
 
 
 if __name__ == "__main__":

@@ -1,8 +1,9 @@
 """Shared command-line plumbing: one parser style, one progress flag, user errors as one line and exit 2.
 
 Every command (``python -m hlp_drake.X`` or ``hlp-drake X``) builds its parser with ``make_parser``:
-the help shows the module's docstring without reStructuredText markup, ``--version`` prints the
-package's version, and a usage error is one ``error: ...`` line with exit status 2. Commands with
+the help and ``--version`` name the command as the user typed it (``invoked_as``: ``hlp-drake X``
+or ``python -m hlp_drake.X``), the help shows the module's docstring without reStructuredText
+markup or a second usage, ``--version`` prints one line, the name and the version, and a usage error is one ``error: ...`` line with exit status 2. Commands with
 progress bars take ``--quiet`` (``add_quiet``) to turn them off; commands that run Drake take
 ``--quiet`` or ``--verbose`` (``add_verbosity``: Drake's INFO lines only with ``--verbose``,
 ``drake_logging``); commands that plan take ``--perception`` (``add_perception``).
@@ -12,7 +13,9 @@ from __future__ import annotations
 
 import argparse
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+from contextvars import ContextVar
 from typing import NoReturn
 
 from hlp_drake import __version__
@@ -35,18 +38,41 @@ class Parser(argparse.ArgumentParser):
         raise HlpError(f"{message} (see {self.prog} --help)")
 
 
+_INVOKED_AS: ContextVar[str | None] = ContextVar("invoked_as", default=None)
+
+
+@contextmanager
+def invoked_as(name: str) -> Iterator[None]:
+    """Name the commands whose parsers are made inside ``name``: what the user typed to run them
+    (``hlp-drake run-scene`` rather than the module's own ``python -m hlp_drake.run_scene``)."""
+    token = _INVOKED_AS.set(name)
+    try:
+        yield
+    finally:
+        _INVOKED_AS.reset(token)
+
+
+def _without_usage(text: str, prog: str) -> str:
+    """``text`` without its paragraphs that show how to call ``prog`` (argparse prints the usage)."""
+    paragraphs = text.split("\n\n")
+    return "\n\n".join(p for p in paragraphs if not p.strip().startswith(f"{prog} ")).strip()
+
+
 def make_parser(prog: str, doc: str | None, **kwargs) -> Parser:
-    """A ``Parser`` for the command ``prog``: the first paragraph of the docstring ``doc`` as its
-    description, the rest as the epilog (both plain text), and ``--version``."""
+    """A ``Parser`` for the command ``prog`` (the module's ``python -m`` name): named as the user typed
+    it (``invoked_as``), the first paragraph of the docstring ``doc`` as its description and the rest,
+    without the usage argparse prints, as the epilog (plain text, the command named as typed), and
+    ``--version`` (one line: the name and the version)."""
+    name = _INVOKED_AS.get() or prog
     head, _, rest = (doc or "").strip().partition("\n\n")
     parser = Parser(
-        prog=prog,
-        description=plain(head),
-        epilog=plain(rest) or None,
+        prog=name,
+        description=plain(head).replace(prog, name),
+        epilog=plain(_without_usage(rest, prog)).replace(prog, name) or None,
         formatter_class=argparse.RawDescriptionHelpFormatter,
         **kwargs,
     )
-    parser.add_argument("--version", action="version", version=f"%(prog)s (hlp_drake {__version__})")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     return parser
 
 

@@ -56,6 +56,39 @@ def test_hlp_drake_dispatches_to_the_commands(capsys):
     assert err.startswith("error: argument --planner: invalid choice") and "\n" not in err
 
 
+@pytest.mark.parametrize("command", sorted(COMMANDS))
+def test_help_and_version_name_the_command_as_typed_and_show_the_usage_once(command, capsys):
+    module = importlib.import_module(COMMANDS[command])
+    python_m = f"python -m hlp_drake.{command.replace('-', '_')}"  # the module's own name
+    for run, name in ((lambda argv: main([command, *argv]), f"hlp-drake {command}"), (module.main, python_m)):
+        with pytest.raises(SystemExit):
+            run(["--help"])
+        text = capsys.readouterr().out
+        assert text.startswith(f"usage: {name} ") and text.count("usage:") == 1, text
+        others = {f"hlp-drake {command}", python_m} - {name}
+        assert not any(other in text for other in others), text  # named one way only
+        # The docstring's own usage lines are left out of the epilog: argparse prints the usage.
+        after = "\n\n".join(text.split("\n\n")[2:])  # after the usage and the description
+        assert not any(line.strip().startswith(f"{name} ") for line in after.splitlines()), text
+        with pytest.raises(SystemExit):
+            run(["--version"])
+        assert capsys.readouterr().out == f"{name} {__version__}\n"
+
+
+def test_typed_names_through_the_console_script_and_python_m():
+    script = Path(sys.executable).with_name("hlp-drake")
+    runs = [([sys.executable, "-m", "hlp_drake", "run-scene"], "python -m hlp_drake run-scene")]
+    if script.exists():
+        runs.append(([str(script), "run-scene"], "hlp-drake run-scene"))
+    for argv, name in runs:
+        result = subprocess.run([*argv, "--version"], capture_output=True, text=True, timeout=60, check=False)
+        assert result.returncode == 0 and result.stdout == f"{name} {__version__}\n"
+        result = subprocess.run(
+            [*argv, "--workers", "0"], capture_output=True, text=True, timeout=60, check=False
+        )
+        assert result.returncode == 2 and result.stderr.rstrip().endswith(f"(see {name} --help)")
+
+
 def test_the_console_script_is_installed():
     script = Path(sys.executable).with_name("hlp-drake")
     if not script.exists():

@@ -21,7 +21,7 @@ import pytest
 from conftest import run_module
 
 from hlp_drake import experiments
-from hlp_drake.cli import run_cli
+from hlp_drake.cli import invoked_as, run_cli
 from hlp_drake.errors import HlpError
 from hlp_drake.experiments import ExperimentSettings, Job, make_row
 from hlp_drake.experiments.cli import main
@@ -470,9 +470,17 @@ def test_cli_fast_public_api(tmp_path, capsys):
     ]
     assert run_cli(lambda a: main(a, job=cheap_job), argv) == 0
     printed = capsys.readouterr().out
-    assert "Table III" in printed and "| 3 objects | HLP | 2 |" in printed and "summary.md" in printed
+    assert "Table III" in printed and "| 3 objects | HLP | 2 |" in printed
+    wrote = next(line for line in printed.splitlines() if line.startswith("wrote "))
+    written = {Path(name).name for name in wrote.removeprefix("wrote ").split(", ")}
+    assert written == {p.name for p in tmp_path.iterdir()} >= {"config.json", "run.json", "summary.md"}
+    assert "| condition | ratio HLP / STO of the mean total times |" in printed
     run = json.loads((tmp_path / "run.json").read_text())
     assert run["command"].startswith("python -m hlp_drake.experiments gen2 --scenes 2")
+    with invoked_as("hlp-drake experiments"):
+        assert run_cli(lambda a: main(a, job=never_called), argv) == 0
+    run = json.loads((tmp_path / "run.json").read_text())
+    assert run["command"].startswith("hlp-drake experiments gen2 --scenes 2")
     assert run["seeds"] == {"first": 5, "last": 6, "scenes": 2} and run["status"] == "complete"
     assert run["software"]["drake"] and run["software"]["numpy"] and run["machine"]["cpu_count"]
     assert "optimiser:" in run["scenario"] and "scene:" in run["scenario"]

@@ -117,3 +117,14 @@ def _docs_links() -> list[tuple[str, str]]:
 def test_the_docs_links_into_the_repository_exist(doc, link):
     # the results and limits moved from the README to docs/: their links are checked here
     assert (REPO / "docs" / link).resolve().exists(), (doc, link)
+
+
+def test_the_readme_lists_every_scenario_section():
+    import dataclasses
+
+    from hlp_drake.systems.scenario import Scenario
+
+    text = " ".join((REPO / "README.md").read_text().split())
+    start = text.index("Sections, each documented on its dataclass")
+    listed = re.findall(r"`(\w+)`", text[start : text.index(". A scene, in metres", start)])
+    assert listed == [field.name for field in dataclasses.fields(Scenario)]

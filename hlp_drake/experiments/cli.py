@@ -7,8 +7,9 @@
 
 Every scene is planned and executed with both planners (HLP and STO's straight line); scene i has
 seed S + i (gen2: for each object count). Writes DIR/results.csv (resumable: run the same command
-again after an interrupt), run.json, summary.md/.json (Table II or III beside the paper's numbers),
-success.png and times.png. Times are planning times (plan + IK + optimisation), without the
+again after an interrupt), config.json (what the rows depend on), run.json (the run's settings,
+what it ran, machine and software), summary.md/.json (Table II or III beside the paper's numbers,
+and the ratio of the planners' mean total times), success.png and times.png. Times are planning times (plan + IK + optimisation), without the
 simulated execution; run with --workers 1 for times comparable to the paper's (parallel jobs share
 the cores). With --perception camera both planners plan on the scene the world's cameras see
 (ScenePerception) while the simulation runs the true one: Table III on perceived scenes.
@@ -34,7 +35,7 @@ from hlp_drake.cli import (
 )
 from hlp_drake.documents import read_document
 from hlp_drake.experiments.executors import EXECUTORS
-from hlp_drake.experiments.experiment import DERIVED, RESULTS, ExperimentSettings, run_experiment
+from hlp_drake.experiments.experiment import CONFIG, DERIVED, RESULTS, RUN, ExperimentSettings, run_experiment
 from hlp_drake.experiments.runner import KINDS, JobFunction, ScenarioResolver
 from hlp_drake.experiments.summary import summary_markdown
 from hlp_drake.scene.generators import MAX_GENERATED
@@ -104,7 +105,8 @@ def main(
 ) -> int:
     """Run the experiment of ``argv``; ``job`` and ``scenario`` replace the real (scene, planner) job
     and scenario reading (``hlp_drake.systems.execution.job``'s, which import Drake), e.g. in tests."""
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args = parser.parse_args(argv)
     drake_logging(args.verbose)  # before Drake is first imported
     config_yaml = None
     if args.config:
@@ -128,7 +130,7 @@ def main(
         fresh=args.fresh,
         progress=not args.quiet,
     )
-    command = f"{PROG} {shlex.join(sys.argv[1:] if argv is None else argv)}"
+    command = f"{parser.prog} {shlex.join(sys.argv[1:] if argv is None else argv)}"
     if job is None or scenario is None:
         from hlp_drake.systems.execution import job as drake_side
 
@@ -136,5 +138,5 @@ def main(
         scenario = scenario or drake_side.scenario_yamls
     summary = run_experiment(settings, args.out, job=job, scenario=scenario, command=command)
     print(summary_markdown(summary), end="")
-    print(f"wrote {', '.join(str(Path(args.out) / name) for name in (RESULTS, 'run.json', *DERIVED))}")
+    print(f"wrote {', '.join(str(Path(args.out) / name) for name in (RESULTS, CONFIG, RUN, *DERIVED))}")
     return 0

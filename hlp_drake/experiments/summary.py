@@ -219,7 +219,7 @@ def summary_markdown(summary: dict[str, Any]) -> str:
         lines += _table_rows(condition)
     lines += [
         "",
-        "| condition | HLP / STO mean total time | without verification | paper |",
+        "| condition | ratio HLP / STO of the mean total times | the ratio without verification | the paper's ratio |",
         "|---|---:|---:|---:|",
     ]
     for condition in summary["conditions"]:

@@ -188,7 +188,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     result, meshcat = _run(scenario, args, started)
     print(summary(result, ran))
     if args.html:
-        write_text_atomic(args.html, meshcat.StaticHtml())
+        from hlp_drake.systems.execution.meshcat_view import with_legend
+
+        perceived = scenario.perception.source == "camera"
+        write_text_atomic(args.html, with_legend(meshcat.StaticHtml(), perceived=perceived))
         print(f"wrote {args.html}")
     if args.json:
         write_text_atomic(args.json, json.dumps({**ran.to_dict(), **result.to_dict()}, indent=2) + "\n")

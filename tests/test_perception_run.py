@@ -44,7 +44,9 @@ def test_run_scene_plans_on_the_perceived_scene_and_reports_its_errors(tmp_path)
     assert set(report["objects_moved"]) <= {o.name for o in true.objects}
     assert report["perception_source"] == "camera" and "perception camera" in result.stdout
     assert report["timings"]["perceive_s"] > record["perception_s"] > 0
-    commands = recorded(html.read_text())
+    page = html.read_text()
+    assert "what the cameras saw" in page  # the legend names the perception's colours too
+    commands = recorded(page)
     for path in (b"/drake/perception/points", b"/drake/perception/objects/Target", b"/drake/robot_plan/path"):
         assert path in commands, path
 

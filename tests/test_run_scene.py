@@ -18,6 +18,7 @@ from hlp_drake.learners.bundled import default_models
 from hlp_drake.planner import plan
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import scene_to_dict
+from hlp_drake.systems.execution.meshcat_view import camera_pose
 from hlp_drake.systems.planning.diagram import make_planning_diagram
 from hlp_drake.systems.planning.transfer import gripper_geometry
 from hlp_drake.systems.scenario import Scenario, with_conditions
@@ -112,6 +113,60 @@ def recorded(html: str) -> bytes:
     return b"".join(base64.b64decode(b) for b in re.findall(r"base64,([A-Za-z0-9+/=]+)\"\)", html))
 
 
+def three_js(point) -> tuple[float, float, float]:
+    """A world point (z up) in MeshCat's three.js frame (y up): (x, z, -y)."""
+    x, y, z = (float(v) for v in point)
+    return x, z, -y
+
+
+def recorded_camera(commands: bytes) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """The camera's position and target (three.js frame) last set in a recording's ``commands``
+    (MessagePack: a 3-array of float64 after the property's or the message's name)."""
+    import struct
+
+    def triple(marker: bytes) -> tuple[float, ...]:
+        at = commands.rindex(marker) + len(marker)
+        at = commands.index(b"value\x93", at) + len(b"value\x93")
+        values = []
+        for _ in range(3):
+            assert commands[at] == 0xCB, commands[at : at + 9]  # float64
+            values.append(struct.unpack(">d", commands[at + 1 : at + 9])[0])
+            at += 9
+        return tuple(values)
+
+    return triple(b"/Cameras/default/rotated/<object>\xa8property\xa8position"), triple(b"set_target")
+
+
+@pytest.mark.parametrize(
+    "scene",
+    [generate_scene("vr", 1), generate_scene("gen1", 3), generate_scene("gen2", 4, 9)],
+    ids=lambda scene: scene.name,
+)
+def test_the_view_looks_at_the_table_from_the_persons_side_at_45_degrees_and_fills_the_frame(scene):
+    """MeshCat's camera (a 75 degree vertical field of view; a 1280 x 800 window): above the person's
+    side (x < 0), 45 degrees up, a little to the right; every corner of the table top in view, the
+    table over more than half of the frame's width."""
+    eye, target = camera_pose(scene)
+    table = scene.table
+    view = target - eye
+    assert eye[0] < 0.0 < target[0] < table.length and eye[1] < 0.0
+    assert np.degrees(np.arcsin(-view[2] / np.linalg.norm(view))) == pytest.approx(45.0)
+    forward = view / np.linalg.norm(view)
+    right = np.cross(forward, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    focal = 1.0 / np.tan(np.radians(75.0) / 2.0)
+    corners = [(x, y, table.height) for x in (0.0, table.length) for y in (-table.width / 2, table.width / 2)]
+    seen = np.array(
+        [
+            (focal * (d @ right) / (d @ forward) / 1.6, focal * (d @ up) / (d @ forward))
+            for d in np.array(corners) - eye
+        ]
+    )
+    assert np.all(np.abs(seen) < 1.0), seen  # normalised image coordinates
+    assert np.ptp(seen[:, 0]) / 2.0 > 0.5
+
+
 def test_run_scene_end_to_end_json_and_html(tmp_path):
     out, html = tmp_path / "run.json", tmp_path / "run.html"
     result = run_module(
@@ -129,17 +184,23 @@ def test_run_scene_end_to_end_json_and_html(tmp_path):
         env={"DRAKE_ALLOW_NETWORK": "meshcat"},  # a recording needs a local MeshCat server (CI sets none)
     )
     assert result.returncode in (0, 1) and "Traceback" not in result.stderr, result.stderr
-    # The recording opens framed on the table, with both plans as paths and the robot plan's markers,
-    # and no contact forces unless asked for.
-    commands = recorded(html.read_text())
+    # The recording opens framed on the table from the person's side, the grid hidden, with both plans
+    # as thick paths, the robot plan's markers and the legend, and no contact forces unless asked for.
+    page = html.read_text()
+    commands = recorded(page)
+    eye, target = camera_pose(generate_scene("vr", 1))
+    position, looked_at = recorded_camera(commands)
+    assert position == pytest.approx(three_js(eye)) and looked_at == pytest.approx(three_js(target))
     for path in (
-        b"/Cameras/default",
-        b"/drake/plan/path",
-        b"/drake/robot_plan/path",
+        b"/drake/plan/path/00",
+        b"/drake/robot_plan/path/00",
+        b"/drake/robot_plan/path/bend_01",
         b"/drake/robot_plan/00_start",
+        b"/Grid",
     ):
         assert path in commands, path
     assert b"contact_forces" not in commands and b"animation" in commands
+    assert 'id="hlp-legend"' in page and "the robot&#x27;s path" in page
     report = json.loads(out.read_text())
     assert report["planner"] == "hlp" and report["robot_actuated_dofs"] == 10
     # What ran: in the header, the summary and the JSON.

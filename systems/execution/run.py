@@ -33,7 +33,7 @@ from hlp_drake.systems.execution.diagram import (
     execution_model_error,
     make_execution_diagram,
 )
-from hlp_drake.systems.execution.meshcat_view import draw_perception, draw_plan, frame_table
+from hlp_drake.systems.execution.meshcat_view import PLAN_LIFT, draw_perception, draw_plan, frame_table
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.cost import FinalState, pregrasp_check, reach_problem
 from hlp_drake.systems.optimiser.pool import RolloutPool
@@ -331,9 +331,13 @@ def _draw(
     """Frame the table and draw the human and robot plans (and what the cameras saw) in ``meshcat``."""
     scene = scenario.scene
     frame_table(meshcat, scene)
-    heights = {"table_height": scene.table.height, "keypoint_height": tcp_keypoint_height(scene, scenario.ik)}
-    draw_plan(meshcat, result.plan, path="plan", markers=False, **heights)
-    draw_plan(meshcat, result.robot_plan, path="robot_plan", **heights)
+    table = scene.table.height
+    on_table = table + PLAN_LIFT  # the person's plan on the table top, the robot's path at the tcp's height
+    draw_plan(meshcat, result.plan, path="plan", markers=False, table_height=table, keypoint_height=on_table)
+    keypoint_height = tcp_keypoint_height(scene, scenario.ik)
+    draw_plan(
+        meshcat, result.robot_plan, path="robot_plan", table_height=table, keypoint_height=keypoint_height
+    )
     if perception is not None:
         draw_perception(meshcat, perception)
 

@@ -68,6 +68,14 @@ class ProgressListener:
             self._bar.close()
             self._bar = None
 
+    def warning(self, message: str) -> None:
+        """``warning: message`` on ``stream``, above the open bar (if any)."""
+        line = f"warning: {message}"
+        if self._bar is not None:
+            self._bar.write(line, file=self._stream)
+        else:
+            print(line, file=self._stream, flush=True)
+
     def perceived(self, perception, seconds: float) -> None:
         if perception.ok:
             what = f"{len(perception.objects)} objects, the target {perception.objects[0].name}"

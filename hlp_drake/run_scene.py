@@ -244,7 +244,10 @@ def _run(scenario, args, started: float):
     workers = scenario.optimiser.workers
     if workers > 1:
         _print(f"rollout workers: {workers}, started when a batch of rollouts needs them")
-    with contextlib.closing(listener), RolloutPool(workers, on_rollout=listener.rollout) as pool:
+    with (
+        contextlib.closing(listener),
+        RolloutPool(workers, on_rollout=listener.rollout, on_warning=listener.warning) as pool,
+    ):
         result = plan_and_execute(
             scenario,
             pool=pool,

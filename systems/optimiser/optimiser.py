@@ -33,7 +33,7 @@ import numpy as np
 from hlp_drake.systems.optimiser.config import PERCEIVED_CHECKS, BaseNoise, StoConfig
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.cost import RolloutOutcome
-from hlp_drake.systems.optimiser.pool import RolloutPool
+from hlp_drake.systems.optimiser.pool import RolloutPool, WorkersLost
 from hlp_drake.systems.world.uncertainty import displaced_scenes
 
 if TYPE_CHECKING:
@@ -273,7 +273,8 @@ def optimise(
     budget: Budget | None = None,
     start: RolloutStart | None = None,
 ) -> StoResult:
-    """Improve ``initial`` on ``scenario``'s scene (see the module's docstring); never raises for a bad scene.
+    """Improve ``initial`` on ``scenario``'s scene (see the module's docstring); never raises for a bad
+    scene, nor when the pool gives up on its dead workers (``WorkersLost``: the result fails with its reason).
 
     Args:
         pool: the rollout workers (the caller's, who closes them).
@@ -284,7 +285,6 @@ def optimise(
         start: roll out from this state rather than the scene's (the receding-horizon controller's
             measured state; the robot's start is then not checked for collisions: it may be pushing).
     """
-    sto: StoConfig = scenario.optimiser
     budget = budget or Budget.of(scenario)
     started = time.perf_counter()
     collisions = () if start is not None else pool.world(scenario).start_collisions
@@ -297,17 +297,34 @@ def optimise(
             optimise_s=time.perf_counter() - started,
         )
     run = _Run(scenario, pool, budget, start)
+    result = StoResult(initial, None, False, "not optimised")
+    try:
+        _search(run, result, alternatives, progress, budget, started)
+    except WorkersLost as error:  # the pool gave up on its dead workers: this optimisation failed
+        result.success, result.failure_reason = False, str(error)
+    result.rollouts, result.verifications, result.rejected = run.rollouts, run.verifications, run.rejected
+    result.displaced_checks = run.verifications * len(run.displaced_scenarios())
+    result.verify_s = run.verify_s
+    result.optimise_s = time.perf_counter() - started
+    return result
+
+
+def _search(
+    run: _Run,
+    result: StoResult,
+    alternatives: Callable[[], Sequence[ControlSequence]] | None,
+    progress: Callable[[int, float], None] | None,
+    budget: Budget,
+    started: float,
+) -> None:
+    """The optimisation proper, from ``result.sequence`` (the initial one), filling ``result``."""
+    sto = run.scenario.optimiser
+    initial = result.sequence
     outcomes = run.roll([initial])
     run.settle([initial], outcomes, [0])  # may replace the outcome with its verification's
     (outcome,) = outcomes
-    result = StoResult(
-        initial,
-        outcome,
-        outcome.success,
-        outcome.failure_reason,
-        costs=[outcome.cost],
-        initial_cost=outcome.cost,
-    )
+    _accept(result, initial, outcome)
+    result.costs, result.initial_cost = [outcome.cost], outcome.cost
     _try_alternatives(run, result, alternatives, budget)
     rng = np.random.default_rng(budget.seed)
     last_iteration_s = 0.0
@@ -326,11 +343,6 @@ def optimise(
             break
     if not result.success and result.iterations >= budget.max_iterations and result.failure_reason:
         result.failure_reason = f"{result.failure_reason} (after {result.iterations} iterations)"
-    result.rollouts, result.verifications, result.rejected = run.rollouts, run.verifications, run.rejected
-    result.displaced_checks = run.verifications * len(run.displaced_scenarios())
-    result.verify_s = run.verify_s
-    result.optimise_s = time.perf_counter() - started
-    return result
 
 
 def _accept(result: StoResult, sequence: ControlSequence, outcome: RolloutOutcome) -> None:

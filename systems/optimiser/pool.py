@@ -7,15 +7,23 @@ rollout (the HLP's first, most often its only one) runs in the calling process; 
 when a batch first needs them, so a run that needs none neither waits for them nor shares its cores
 with their start. The results are the same either way: a rollout is a pure function of the scenario
 and the sequence.
+
+A worker that dies (the out-of-memory killer, a ``kill -9``) breaks its process pool: the pool is
+replaced and the batch's unfinished rollouts run again, with the same outcomes, and one warning
+says so. After ``MAX_DEATHS`` deaths in a row (no batch finished between them) the pool gives up
+with ``WorkersLost``, which ``optimise`` turns into the optimisation's failure reason.
 """
 
 from __future__ import annotations
 
 import multiprocessing
+import signal
+import sys
 import time
 from collections import OrderedDict
-from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor
+from collections.abc import Callable, Sequence
+from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from functools import cached_property
 from typing import TYPE_CHECKING, Self
 
@@ -33,6 +41,34 @@ if TYPE_CHECKING:
 WORLDS_KEPT = 4
 """Scenarios whose rollout worlds a pool (or a worker process) keeps: a scene and the displaced
 copies of it that ``optimiser.displaced_checks`` verifies on (each world built on first use)."""
+MAX_DEATHS = 3
+"""Worker deaths in a row (no batch finished between them) after which a pool gives up."""
+
+
+class WorkersLost(RuntimeError):
+    """The rollout workers died ``MAX_DEATHS`` times in a row; ``str(error)`` is the reason, one line."""
+
+
+def death_cause(processes: Sequence[multiprocessing.process.BaseProcess]) -> str:
+    """How a broken pool's dead worker ended ("signal 9", "exit status 3"), from its processes'
+    exit codes once they are joined: the pool stops the survivors with SIGTERM, so another code
+    comes first."""
+    codes = [p.exitcode for p in processes if p.exitcode not in (None, 0)]
+    own = [code for code in codes if code != -signal.SIGTERM]
+    code = (own or codes or [None])[0]
+    if code is None:
+        return "cause unknown"
+    return f"signal {-code}" if code < 0 else f"exit status {code}"
+
+
+def _finished(future: Future) -> bool:
+    """Whether ``future`` holds a result."""
+    return future.done() and not future.cancelled() and future.exception() is None
+
+
+def warn_on_stderr(message: str) -> None:
+    """Print ``warning: message`` on stderr (a pool's default ``on_warning``)."""
+    print(f"warning: {message}", file=sys.stderr, flush=True)
 
 
 class _Worlds:
@@ -84,21 +120,31 @@ class RolloutPool:
         workers: rollout processes (1: roll out here).
         on_rollout: called with every rollout's outcome as it arrives (e.g. to show progress; not
             with the verifications').
+        on_warning: called with a one-line message when a worker died and its rollouts ran again
+            (default: ``warn_on_stderr``).
 
     Attributes:
-        startup_s: how long starting the worker processes took, s (0 while none was needed).
+        startup_s: how long starting the worker processes took, s (0 while none was needed; restarts
+            after a worker died included).
     """
 
     def __init__(
-        self, workers: int = 1, *, on_rollout: Callable[[RolloutOutcome], None] | None = None
+        self,
+        workers: int = 1,
+        *,
+        on_rollout: Callable[[RolloutOutcome], None] | None = None,
+        on_warning: Callable[[str], None] = warn_on_stderr,
     ) -> None:
         if workers < 1:
             raise ValueError(f"workers must be >= 1, got {workers}")
         self.workers = int(workers)
         self.startup_s = 0.0
         self._on_rollout = on_rollout
+        self._on_warning = on_warning
         self._worlds = _Worlds()
         self._executor: ProcessPoolExecutor | None = None
+        self._deaths = 0  # in a row
+        self._lost: str | None = None  # why the pool gave up
 
     def _started(self) -> ProcessPoolExecutor:
         """The worker processes, started (and Drake imported in each) on first use."""
@@ -110,10 +156,12 @@ class RolloutPool:
                     warming = [self._executor.submit(_warm_up, 0.2) for _ in range(self.workers)]
                 for future in warming:
                     future.result()
+            except BrokenProcessPool:
+                raise  # a worker died starting: the caller replaces the pool
             except BaseException:
                 self.close(terminate=True)
                 raise
-            self.startup_s = time.perf_counter() - started
+            self.startup_s += time.perf_counter() - started
         return self._executor
 
     def world(self, scenario: Scenario) -> SceneRollouts:
@@ -147,11 +195,45 @@ class RolloutPool:
                 self._arrived((self.world(c).verify if verify else self.world(c).rollout)(s, start), verify)
                 for c, s in jobs
             ]
-        executor = self._started()
-        futures = [
-            executor.submit(_rollout_task, c.key, c.yaml, s.times, s.knots, start, verify) for c, s in jobs
-        ]
-        return [self._arrived(future.result(), verify) for future in futures]
+        outcomes: dict[int, RolloutOutcome] = {}
+        while True:
+            if self._lost is not None:
+                raise WorkersLost(self._lost)
+            futures: dict[int, Future] = {}
+            try:
+                executor = self._started()
+                with interrupts_held():  # a replaced pool's workers start here
+                    for i, (c, s) in enumerate(jobs):
+                        if i not in outcomes:
+                            futures[i] = executor.submit(
+                                _rollout_task, c.key, c.yaml, s.times, s.knots, start, verify
+                            )
+                for i, future in futures.items():
+                    outcomes[i] = self._arrived(future.result(), verify)
+            except BrokenProcessPool:
+                for i, future in futures.items():  # finished before the pool broke: kept
+                    if i not in outcomes and _finished(future):
+                        outcomes[i] = self._arrived(future.result(), verify)
+                self._replace(len(jobs) - len(outcomes))
+                continue
+            self._deaths = 0
+            return [outcomes[i] for i in range(len(jobs))]
+
+    def _replace(self, unfinished: int) -> None:
+        """Replace the broken process pool (and warn), or give up after ``MAX_DEATHS`` in a row."""
+        broken = self._executor
+        processes = list((getattr(broken, "_processes", None) or {}).values())  # private, hence getattr
+        broken.shutdown(wait=True, cancel_futures=True)  # joins the processes: their exit codes are known
+        cause = death_cause(processes)
+        self._executor = None
+        self._deaths += 1
+        if self._deaths >= MAX_DEATHS:
+            self._lost = f"the rollout workers died {self._deaths} times in a row ({cause})"
+            raise WorkersLost(self._lost)
+        again = f" and ran the batch's {unfinished} unfinished rollout{'s' if unfinished != 1 else ''} again"
+        self._on_warning(
+            f"a rollout worker died ({cause}); restarted the workers{again if unfinished else ''}"
+        )
 
     def _arrived(self, outcome: RolloutOutcome, verify: bool) -> RolloutOutcome:
         if self._on_rollout is not None and not verify:

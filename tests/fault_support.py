@@ -1,0 +1,40 @@
+"""Faults the tests inject into worker processes: module-level functions, so spawned workers (and
+dask's) can unpickle them. A fault that should happen once claims a marker file in the folder
+``FAULTS`` names (set before the workers start: they inherit the environment)."""
+
+from __future__ import annotations
+
+import os
+import signal
+from pathlib import Path
+
+FAULTS = "HLP_TEST_FAULTS"
+"""The environment variable naming the folder of the once-only faults' marker files."""
+
+
+def first_time(name: str) -> bool:
+    """True for the first caller (in any process) to claim the marker ``name``, False after."""
+    try:
+        os.close(os.open(Path(os.environ[FAULTS]) / name, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+    except FileExistsError:
+        return False
+    return True
+
+
+def die() -> None:
+    """Kill this process as the out-of-memory killer would (SIGKILL: no cleanup, no exception)."""
+    os.kill(os.getpid(), signal.SIGKILL)
+
+
+def rollout_killing_its_worker_once(*args):
+    """The rollout task, whose first call (in any worker) kills its worker process."""
+    from hlp_drake.systems.optimiser import pool
+
+    if first_time("rollout"):
+        die()
+    return pool._rollout_task(*args)
+
+
+def rollout_exiting(*args):
+    """A rollout task that always ends its worker process (exit status 3)."""
+    os._exit(3)

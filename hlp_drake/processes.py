@@ -8,12 +8,17 @@ KeyboardInterrupt (``cli.run_cli``: one line, exit 130) and stops the workers
 (``terminate_workers``). A SIGTERM to the command (``kill``, a batch scheduler's time limit) takes
 the same way out as ``Terminated``, a KeyboardInterrupt (exit 143), so no worker is left behind;
 the workers keep SIGTERM's default, which is how they are stopped.
+
+A worker that dies (the out-of-memory killer, a ``kill -9``) breaks its pool; ``shut_down_broken``
+closes such a pool and says how the worker died, for the one-line warning (``warn_on_stderr``) of
+the caller that runs its work again.
 """
 
 from __future__ import annotations
 
 import contextlib
 import signal
+import sys
 import threading
 from collections.abc import Iterator
 from typing import TYPE_CHECKING
@@ -87,3 +92,26 @@ def terminate_workers(pool: ProcessPoolExecutor) -> None:
     processes = getattr(pool, "_processes", None) or {}  # private before 3.14, hence the fallbacks
     for process in list(processes.values()):
         process.terminate()
+
+
+def death_cause(exit_codes: list[int | None]) -> str:
+    """How a broken pool's dead worker ended ("signal 9", "exit status 3"), from its processes' exit
+    codes: the pool stops the survivors with SIGTERM, so any other code comes first."""
+    codes = [code for code in exit_codes if code not in (None, 0)]
+    own = [code for code in codes if code != -signal.SIGTERM]
+    code = (own or codes or [None])[0]
+    if code is None:
+        return "cause unknown"
+    return f"signal {-code}" if code < 0 else f"exit status {code}"
+
+
+def shut_down_broken(pool: ProcessPoolExecutor) -> str:
+    """Shut down ``pool``, broken by a worker's death, and say how that worker died (``death_cause``)."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())  # private, hence getattr
+    pool.shutdown(wait=True, cancel_futures=True)  # joins the processes: their exit codes are known
+    return death_cause([process.exitcode for process in processes])
+
+
+def warn_on_stderr(message: str) -> None:
+    """Print ``warning: message`` on stderr, one line."""
+    print(f"warning: {message}", file=sys.stderr, flush=True)

@@ -10,10 +10,23 @@ import signal
 
 import numpy as np
 import pytest
-from fault_support import FAULTS, rollout_exiting, rollout_killing_its_worker_once
+from fault_support import (
+    FAULTS,
+    VICTIM,
+    job_killing_its_worker,
+    job_killing_its_worker_once,
+    rollout_exiting,
+    rollout_killing_its_worker_once,
+    steady_job,
+)
 from sto_support import on, short
 
+from hlp_drake import experiments
 from hlp_drake.cli import run_cli
+from hlp_drake.experiments import ExperimentSettings
+from hlp_drake.experiments.cli import main as experiments_main
+from hlp_drake.experiments.executors import RETRIES
+from hlp_drake.systems import scenario_yamls
 from hlp_drake.systems.optimiser import pool as pool_module
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.optimiser import optimise, sample_base_noise
@@ -118,3 +131,87 @@ def test_run_scene_with_a_rollout_worker_killed_mid_optimisation_gives_the_same_
     (line,) = warnings(err)
     assert WARNING.match(line) and "(signal 9)" in line, line
     assert without_times(disturbed) == without_times(undisturbed)
+
+
+# --- Experiments -----------------------------------------------------------------------------------
+
+GEN1 = ["gen1", "--scenes", "3", "--seed", "10", "--quiet"]  # scenes gen1-10 to gen1-12, both planners
+
+
+def run_experiments(argv: list[str], job) -> int:
+    """``python -m hlp_drake.experiments`` in this process, with ``job`` for the real planners."""
+    return run_cli(lambda args: experiments_main(args, job=job, scenario=scenario_yamls), argv)
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory) -> str:
+    """The experiment's ``results.csv``, run undisturbed in this process."""
+    out = tmp_path_factory.mktemp("reference")
+    assert run_experiments([*GEN1, "--workers", "1", "--out", str(out)], steady_job) == 0
+    return (out / "results.csv").read_text()
+
+
+def rows_of(text: str) -> dict[tuple[str, str], str]:
+    lines = text.splitlines()
+    return {tuple(line.split(",")[0:3:2]): line for line in lines[1:]}
+
+
+def test_an_experiment_job_whose_worker_dies_runs_again(tmp_path, capsys, faults, reference):
+    status = run_experiments([*GEN1, "--workers", "2", "--out", str(tmp_path)], job_killing_its_worker_once)
+    err = capsys.readouterr().err
+    assert status == 0 and (faults / "job").exists() and "Traceback" not in err
+    assert warnings(err) == [
+        "warning: the worker running gen1-11 sto died (signal 9); running that job again"
+    ]
+    assert (tmp_path / "results.csv").read_text() == reference
+
+
+def test_an_experiment_job_whose_worker_keeps_dying_gets_a_failure_row(tmp_path, capsys, reference):
+    status = run_experiments([*GEN1, "--workers", "2", "--out", str(tmp_path)], job_killing_its_worker)
+    err = capsys.readouterr().err
+    assert status == 0 and "Traceback" not in err
+    assert warnings(err) == [
+        "warning: the worker running gen1-11 sto died (signal 9); running that job again",
+        "warning: the worker running gen1-11 sto died (signal 9) again; that job is recorded as a failure",
+    ]
+    rows, expected = rows_of((tmp_path / "results.csv").read_text()), rows_of(reference)
+    assert set(rows) == set(expected)
+    assert {key: row for key, row in rows.items() if key != VICTIM} == {
+        key: row for key, row in expected.items() if key != VICTIM
+    }
+    assert f"crashed: its worker process died {RETRIES + 1} times (signal 9)" in rows[VICTIM]
+    assert ",false," in rows[VICTIM] and ",nan," in rows[VICTIM]
+    summary = experiments.run_experiment(  # resumed: every row is there, nothing runs again
+        ExperimentSettings(kind="gen1", scenes=3, seed=10, workers=2, progress=False),
+        tmp_path,
+        job=job_killing_its_worker,
+        scenario=scenario_yamls,
+    )
+    assert summary["conditions"] and rows_of((tmp_path / "results.csv").read_text()) == rows
+
+
+def test_a_lost_dask_worker_gets_its_job_rescheduled(tmp_path, capsys, faults, reference):
+    pytest.importorskip("distributed")
+    argv = [*GEN1, "--workers", "2", "--executor", "dask", "--out", str(tmp_path)]
+    status = run_experiments(argv, job_killing_its_worker_once)
+    err = capsys.readouterr().err
+    assert status == 0 and (faults / "job").exists() and "Traceback" not in err
+    assert warnings(err) == ["warning: a dask worker died running gen1-11 sto; running that job again"]
+    assert (tmp_path / "results.csv").read_text() == reference
+
+
+def test_a_dask_job_whose_workers_keep_dying_gets_a_failure_row(tmp_path, capsys, reference):
+    pytest.importorskip("distributed")
+    argv = [*GEN1, "--workers", "2", "--executor", "dask", "--out", str(tmp_path)]
+    status = run_experiments(argv, job_killing_its_worker)
+    err = capsys.readouterr().err
+    assert status == 0 and "Traceback" not in err
+    assert warnings(err) == [
+        "warning: a dask worker died running gen1-11 sto; running that job again",
+        "warning: the dask workers running gen1-11 sto died 2 times; that job is recorded as a failure",
+    ]
+    rows, expected = rows_of((tmp_path / "results.csv").read_text()), rows_of(reference)
+    assert {key: row for key, row in rows.items() if key != VICTIM} == {
+        key: row for key, row in expected.items() if key != VICTIM
+    }
+    assert f"crashed: its dask worker died {RETRIES + 1} times (KilledWorker)" in rows[VICTIM]

@@ -220,7 +220,12 @@ def _run_pending(
     lines = settings.progress and bar.disable
     done_jobs = total - len(pending)
     finished = run_jobs(
-        job, pending, executor=settings.executor, workers=settings.worker_count, scheduler=settings.scheduler
+        job,
+        pending,
+        executor=settings.executor,
+        workers=settings.worker_count,
+        scheduler=settings.scheduler,
+        warn=lambda message: bar.write(f"warning: {message}", file=sys.stderr),
     )
     with bar, closing(finished):
         for done, row in finished:

@@ -155,3 +155,23 @@ def make_row(
         "replan_rollouts": int(replan_rollouts),
         "execute_s": execute_s,
     }
+
+
+def crash_row(job: Job, reason: str) -> Row:
+    """The row of a job that crashed (``reason``: "crashed: ...", one line): a failure, its times NaN
+    (unknown: left out of the means) and its counts 0."""
+    nan = float("nan")
+    return make_row(
+        job,
+        success=False,
+        failure_reason=" ".join(reason.split())[:300],
+        plan_s=nan,
+        ik_s=nan,
+        optimise_s=nan,
+        execute_s=nan,
+        verify_s=nan,
+        rollouts=0,
+        iterations=0,
+        objects_moved=0,
+        objects_dropped=0,
+    )

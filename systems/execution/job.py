@@ -52,7 +52,7 @@ def run_job(job: Job) -> Row:
     every job has a rollout pool of its own: no job uses rollout worlds an earlier one (maybe the
     other planner on the same scene) built.
     """
-    from hlp_drake.experiments.runner import make_row  # as in scenario_yamls
+    from hlp_drake.experiments.runner import crash_row, make_row  # as in scenario_yamls
 
     settings = load_scenario(data=job.config_yaml, where="the job's scenario")
     try:
@@ -64,22 +64,7 @@ def run_job(job: Job) -> Row:
     except (Exception, SystemExit) as error:  # noqa: BLE001 - a crash is this planner's failure here
         if isinstance(error, SystemExit):
             simulation_failure(error)  # raises it again unless it is Drake's
-        reason = " ".join(f"crashed: {type(error).__name__}: {error}".split())[:300]
-        nan = float("nan")
-        return make_row(
-            job,
-            success=False,
-            failure_reason=reason,
-            plan_s=nan,
-            ik_s=nan,
-            optimise_s=nan,
-            execute_s=nan,
-            verify_s=nan,
-            rollouts=0,
-            iterations=0,
-            objects_moved=0,
-            objects_dropped=0,
-        )
+        return crash_row(job, f"crashed: {type(error).__name__}: {error}")
     t = result.timings
     return make_row(
         job,

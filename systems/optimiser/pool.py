@@ -17,17 +17,21 @@ with ``WorkersLost``, which ``optimise`` turns into the optimisation's failure r
 from __future__ import annotations
 
 import multiprocessing
-import signal
-import sys
 import time
 from collections import OrderedDict
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from functools import cached_property
 from typing import TYPE_CHECKING, Self
 
-from hlp_drake.processes import interrupts_held, terminate_workers, worker_pool
+from hlp_drake.processes import (
+    interrupts_held,
+    shut_down_broken,
+    terminate_workers,
+    warn_on_stderr,
+    worker_pool,
+)
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.cost import RolloutOutcome, RolloutSamples
 from hlp_drake.systems.optimiser.rollout_world import RolloutStart, RolloutWorld, timed_rollout
@@ -49,26 +53,9 @@ class WorkersLost(RuntimeError):
     """The rollout workers died ``MAX_DEATHS`` times in a row; ``str(error)`` is the reason, one line."""
 
 
-def death_cause(processes: Sequence[multiprocessing.process.BaseProcess]) -> str:
-    """How a broken pool's dead worker ended ("signal 9", "exit status 3"), from its processes'
-    exit codes once they are joined: the pool stops the survivors with SIGTERM, so another code
-    comes first."""
-    codes = [p.exitcode for p in processes if p.exitcode not in (None, 0)]
-    own = [code for code in codes if code != -signal.SIGTERM]
-    code = (own or codes or [None])[0]
-    if code is None:
-        return "cause unknown"
-    return f"signal {-code}" if code < 0 else f"exit status {code}"
-
-
 def _finished(future: Future) -> bool:
     """Whether ``future`` holds a result."""
     return future.done() and not future.cancelled() and future.exception() is None
-
-
-def warn_on_stderr(message: str) -> None:
-    """Print ``warning: message`` on stderr (a pool's default ``on_warning``)."""
-    print(f"warning: {message}", file=sys.stderr, flush=True)
 
 
 class _Worlds:
@@ -221,10 +208,7 @@ class RolloutPool:
 
     def _replace(self, unfinished: int) -> None:
         """Replace the broken process pool (and warn), or give up after ``MAX_DEATHS`` in a row."""
-        broken = self._executor
-        processes = list((getattr(broken, "_processes", None) or {}).values())  # private, hence getattr
-        broken.shutdown(wait=True, cancel_futures=True)  # joins the processes: their exit codes are known
-        cause = death_cause(processes)
+        cause = shut_down_broken(self._executor)
         self._executor = None
         self._deaths += 1
         if self._deaths >= MAX_DEATHS:

@@ -1,4 +1,8 @@
-"""Atomic file output: a file is either absent or complete, never half-written."""
+"""Atomic file output: a file is either absent or complete, never half-written.
+
+A write that fails (a full disk, a folder that became unwritable) leaves the earlier file as it was
+and is one ``StorageError`` naming the file and the problem (exit 1: the run failed).
+"""
 
 from __future__ import annotations
 
@@ -8,7 +12,7 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
-from hlp_drake.errors import HlpError
+from hlp_drake.errors import HlpError, StorageError
 
 
 @contextlib.contextmanager
@@ -16,25 +20,26 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     """Yield a temporary path beside ``path``; on success move it into place, on error delete it.
 
     Raises:
-        HlpError: ``path``'s folder cannot be made or written, or ``path`` cannot be replaced.
+        StorageError: ``path``'s folder cannot be made or written, writing the temporary file
+            failed (an ``OSError`` in the block, e.g. a full disk), or ``path`` cannot be replaced.
     """
     target = Path(path)
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
     except OSError as error:
-        raise HlpError(f"{target}: cannot write: {_reason(error)}") from None
+        raise StorageError(f"{target}: cannot write: {_reason(error)}") from None
     os.close(fd)
     tmp = Path(tmp_name)
     try:
-        yield tmp
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes files private; give them the usual mode
         try:
+            yield tmp
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes files private; give them the usual mode
             os.replace(tmp, target)
         except OSError as error:
-            raise HlpError(f"{target}: cannot write: {_reason(error)}") from None
+            raise StorageError(f"{target}: cannot write: {_reason(error, tmp)}") from None
     finally:
         tmp.unlink(missing_ok=True)
 
@@ -75,11 +80,14 @@ def check_writable(*paths: str | os.PathLike[str] | None) -> None:
         raise HlpError(*problems)
 
 
-def _reason(error: OSError) -> str:
-    """``error`` in a few words, naming the path it is about (e.g. a parent that is a file)."""
+def _reason(error: OSError, written: Path | None = None) -> str:
+    """``error`` in a few words, naming the path it is about (e.g. a parent that is a file) unless
+    that is ``written``, the temporary file standing for the target."""
     if isinstance(error, FileExistsError | NotADirectoryError):
         return f"{error.filename} is not a directory"
-    return f"{error.strerror or error} ({error.filename})" if error.filename else str(error.strerror or error)
+    if error.filename and (written is None or Path(error.filename) != written):
+        return f"{error.strerror or error} ({error.filename})"
+    return str(error.strerror or error)
 
 
 def write_text_atomic(path: str | os.PathLike[str], text: str) -> None:

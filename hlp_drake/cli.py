@@ -162,15 +162,16 @@ def add_conditions(parser: argparse.ArgumentParser) -> None:
 
 
 def run_cli(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | None = None) -> int:
-    """Run ``main(argv)``; print each problem of an ``HlpError`` as ``error: ...`` and return 2; a
-    Ctrl-C prints "interrupted" and returns 130, a SIGTERM "terminated" and 143 (its workers stopped)."""
+    """Run ``main(argv)``; print each problem of an ``HlpError`` as ``error: ...`` and return its
+    ``exit_status`` (2, or 1 for a ``StorageError``: the run failed); a Ctrl-C prints "interrupted"
+    and returns 130, a SIGTERM "terminated" and 143 (its workers stopped)."""
     try:
         with terminations_raised():
             return main(argv)
     except HlpError as error:
         for problem in error.problems:
             print(f"error: {problem}", file=sys.stderr)
-        return EXIT_USER_ERROR
+        return error.exit_status
     except Terminated:
         print("terminated", file=sys.stderr)
         return EXIT_TERMINATED

@@ -19,8 +19,11 @@ class HlpError(Exception):
 
     ``problems`` holds one message per problem, each one line of at most ``MAX_LINE`` characters,
     at most ``MAX_PROBLEMS`` of them and then "and N more problems"; ``count`` is how many there
-    were in all; ``str(error)`` joins the lines with "; ".
+    were in all; ``str(error)`` joins the lines with "; ". ``exit_status`` is the command's (2: bad
+    input).
     """
+
+    exit_status = 2
 
     def __init__(self, *problems: str) -> None:
         if not problems:
@@ -44,6 +47,13 @@ class DatasetError(HlpError):
 
 class ModelError(HlpError):
     """A saved model file is missing, foreign, damaged or tampered with."""
+
+
+class StorageError(HlpError):
+    """An output could not be written during a run (a full disk, a folder that became unwritable):
+    the run failed (exit 1), everything written before is intact and no file is half-written."""
+
+    exit_status = 1
 
 
 class InstallError(HlpError):

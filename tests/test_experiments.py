@@ -22,7 +22,7 @@ from conftest import run_module
 
 from hlp_drake import experiments
 from hlp_drake.cli import invoked_as, run_cli
-from hlp_drake.errors import HlpError
+from hlp_drake.errors import HlpError, StorageError
 from hlp_drake.experiments import ExperimentSettings, Job, make_row
 from hlp_drake.experiments.cli import main
 from hlp_drake.experiments.results import (
@@ -448,7 +448,7 @@ def test_durable_write_leaves_the_old_file_when_it_fails(tmp_path, monkeypatch):
     path = tmp_path / "results.csv"
     write_durable(path, results_csv([]))
     monkeypatch.setattr("os.fsync", lambda fd: (_ for _ in ()).throw(OSError("disk full")))
-    with pytest.raises(OSError, match="disk full"):
+    with pytest.raises(StorageError, match=f"{path}: cannot write: disk full"):
         write_durable(path, "scene\npartial")
     assert path.read_text() == ",".join(COLUMNS) + "\n" and not list(tmp_path.glob(".*.tmp"))
 

@@ -3,10 +3,14 @@ files. Each run survives with the same result, or ends with one line and no trac
 
 from __future__ import annotations
 
+import errno
 import json
 import os
+import pathlib
 import re
 import signal
+import stat
+import tempfile
 
 import numpy as np
 import pytest
@@ -21,7 +25,7 @@ from fault_support import (
 )
 from sto_support import on, short
 
-from hlp_drake import experiments
+from hlp_drake import atomic, experiments
 from hlp_drake.cli import run_cli
 from hlp_drake.experiments import ExperimentSettings
 from hlp_drake.experiments.cli import main as experiments_main
@@ -215,3 +219,103 @@ def test_a_dask_job_whose_workers_keep_dying_gets_a_failure_row(tmp_path, capsys
         key: row for key, row in expected.items() if key != VICTIM
     }
     assert f"crashed: its dask worker died {RETRIES + 1} times (KilledWorker)" in rows[VICTIM]
+
+
+# --- Storage -------------------------------------------------------------------------------------
+
+
+class Disk:
+    """The disk under ``folder`` fills up after ``room`` more durable writes (an fsync of a file
+    there): from then on every write of a file there fails with ENOSPC."""
+
+    def __init__(self, monkeypatch, folder: pathlib.Path, room: int) -> None:
+        self.folder, self.room = folder.resolve(), room
+        fsync, write_text = os.fsync, pathlib.Path.write_text
+
+        def fsync_here(fd: int) -> None:
+            if stat.S_ISREG(os.fstat(fd).st_mode) and self.here(os.readlink(f"/proc/self/fd/{fd}")):
+                if self.room <= 0:
+                    raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+                self.room -= 1
+            fsync(fd)
+
+        def write_text_here(path: pathlib.Path, *args, **kwargs):
+            if self.here(path) and self.room <= 0:
+                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+            return write_text(path, *args, **kwargs)
+
+        monkeypatch.setattr(os, "fsync", fsync_here)
+        monkeypatch.setattr(pathlib.Path, "write_text", write_text_here)
+
+    def here(self, path) -> bool:
+        return pathlib.Path(path).resolve().is_relative_to(self.folder)
+
+
+def no_temporary_files(folder: pathlib.Path) -> bool:
+    return not list(folder.glob(".*.tmp"))
+
+
+def test_a_full_disk_ends_the_experiment_with_one_line_keeps_its_rows_and_resumes(
+    tmp_path, monkeypatch, capsys, reference
+):
+    argv = [*GEN1, "--workers", "1", "--out", str(tmp_path)]
+    with monkeypatch.context() as patched:
+        Disk(patched, tmp_path, room=3)  # results.csv's first writes: no row, then 2 rows
+        status = run_experiments(argv, steady_job)
+    err = capsys.readouterr().err
+    assert status == 1 and "Traceback" not in err
+    assert err.splitlines() == [f"error: {tmp_path / 'results.csv'}: cannot write: No space left on device"]
+    kept = (tmp_path / "results.csv").read_text().splitlines()
+    assert len(kept) == 1 + 2 and set(kept) <= set(reference.splitlines())
+    assert (
+        no_temporary_files(tmp_path)
+        and json.loads((tmp_path / "run.json").read_text())["status"] == "running"
+    )
+    assert run_experiments(argv, steady_job) == 0  # given space again, the same command completes the table
+    assert (tmp_path / "results.csv").read_text() == reference
+    assert json.loads((tmp_path / "run.json").read_text())["jobs"]["kept"] == 2
+
+
+def test_an_output_folder_that_becomes_unwritable_ends_the_run_with_one_line(
+    tmp_path, monkeypatch, capsys, reference
+):
+    argv = [*GEN1, "--workers", "1", "--out", str(tmp_path)]
+    made, ran = tempfile.mkstemp, []
+
+    def mkstemp(*args, **kwargs):  # as a folder whose permission was taken away (root ignores chmod)
+        if len(ran) >= 2 and pathlib.Path(kwargs["dir"]) == tmp_path:
+            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), str(tmp_path))
+        return made(*args, **kwargs)
+
+    def job(job):  # in this process (--workers 1): the folder is taken away during the second job
+        ran.append(job.key)
+        return steady_job(job)
+
+    with monkeypatch.context() as patched:
+        patched.setattr(tempfile, "mkstemp", mkstemp)
+        status = run_experiments(argv, job)
+    err = capsys.readouterr().err
+    assert status == 1 and "Traceback" not in err
+    (line,) = err.splitlines()
+    assert line.startswith(f"error: {tmp_path}/") and line.endswith(
+        f"cannot write: Permission denied ({tmp_path})"
+    )
+    rows = (tmp_path / "results.csv").read_text().splitlines()
+    assert len(rows) > 1 and set(rows) <= set(reference.splitlines()) and no_temporary_files(tmp_path)
+    assert run_experiments(argv, steady_job) == 0 and (tmp_path / "results.csv").read_text() == reference
+
+
+def test_a_command_whose_output_hits_a_full_disk_exits_1_with_one_line_and_the_old_file(
+    tmp_path, monkeypatch, capsys
+):
+    target = tmp_path / "run.json"
+    target.write_text("old\n")
+
+    def write(argv) -> int:
+        atomic.write_text_atomic(target, "new\n")
+        return 0
+
+    Disk(monkeypatch, tmp_path, room=0)
+    assert run_cli(write, []) == 1
+    assert capsys.readouterr().err == f"error: {target}: cannot write: No space left on device\n"
+    assert target.read_text() == "old\n" and no_temporary_files(tmp_path)

@@ -7,7 +7,7 @@ import sys
 from collections.abc import Sequence
 from typing import Any
 
-from hlp_drake.atomic import write_text_atomic
+from hlp_drake.atomic import check_writable, write_text_atomic
 from hlp_drake.cli import make_parser, run_cli
 from hlp_drake.dataset.dataset import Dataset
 from hlp_drake.dataset.records import CATEGORIES
@@ -52,6 +52,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     summary.add_argument("--json", help="also write the summary as JSON to this file")
     args = parser.parse_args(argv)
+    check_writable(args.json)  # a bad path: exit 2, before the dataset is read
     dataset = Dataset(args.dataset)
     result = summarise(dataset)
     for problem in result["problems"]:

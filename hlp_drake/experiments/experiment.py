@@ -9,6 +9,7 @@ a job interrupted mid-way is simply run again next time.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import sys
@@ -21,7 +22,7 @@ from typing import Any
 from tqdm import tqdm
 
 from hlp_drake.atomic import check_writable, write_text_atomic
-from hlp_drake.errors import HlpError
+from hlp_drake.errors import HlpError, StorageError
 from hlp_drake.experiments.executors import EXECUTORS, check_executor, run_jobs
 from hlp_drake.experiments.metadata import git_commit, machine_info, software_versions, utc_now
 from hlp_drake.experiments.plots import write_plots
@@ -244,6 +245,16 @@ def _run_pending(
                 )
 
 
+def _finish_record(out: Path, record: dict[str, Any], started: float, results: ResultsFile) -> None:
+    """Write ``run.json`` with the run's end (time, wall seconds, rows)."""
+    record.update(
+        end_time=utc_now(),
+        wall_s=round(time.perf_counter() - started, 3),
+        jobs={**record["jobs"], "rows": len(results.rows)},
+    )
+    write_text_atomic(out / RUN, json.dumps(record, indent=2) + "\n")
+
+
 def run_experiment(
     settings: ExperimentSettings,
     out: str | os.PathLike[str],
@@ -264,7 +275,8 @@ def run_experiment(
 
     Raises:
         HlpError: bad settings or directory (one line each); KeyboardInterrupt passes through, with
-            every finished row saved.
+            every finished row saved. StorageError: an output could not be written (a full disk):
+            the rows saved before are intact, and running again resumes.
     """
     problems = settings.problems()
     if problems:
@@ -293,18 +305,14 @@ def run_experiment(
     write_text_atomic(out / RUN, json.dumps(record, indent=2) + "\n")
     try:
         _run_pending(job, pending, results, settings, len(jobs))
-        record["status"] = "complete"
     except BaseException as error:
         interrupted = isinstance(error, KeyboardInterrupt)
         record["status"] = "interrupted" if interrupted else f"failed: {type(error).__name__}"
+        with contextlib.suppress(StorageError):  # the first problem is the one to report
+            _finish_record(out, record, started, results)
         raise
-    finally:
-        record.update(
-            end_time=utc_now(),
-            wall_s=round(time.perf_counter() - started, 3),
-            jobs={**record["jobs"], "rows": len(results.rows)},
-        )
-        write_text_atomic(out / RUN, json.dumps(record, indent=2) + "\n")
+    record["status"] = "complete"
+    _finish_record(out, record, started, results)
     measured_on = _measured_on(record["machine"], settings)
     if yamls.perception_source == "camera":
         measured_on += "; the planners saw the scenes through the cameras (perception: camera)"

@@ -210,8 +210,9 @@ class ResultsFile:
         missing = [column for column in COLUMNS if column not in row]
         if missing:
             raise ValueError(f"a job returned a row without {', '.join(missing)}")
-        self.rows[row_key(row)] = {column: row[column] for column in COLUMNS}
-        self.save()
+        rows = {**self.rows, row_key(row): {column: row[column] for column in COLUMNS}}
+        write_durable(self.path, results_csv(rows.values()))  # a failed write keeps neither
+        self.rows = rows
 
     def save(self) -> None:
         write_durable(self.path, results_csv(self.rows.values()))

@@ -10,6 +10,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Sequence
 
+from hlp_drake.atomic import check_writable
 from hlp_drake.cli import MAX_SEED, integer, make_parser, run_cli
 from hlp_drake.scene.generators import KINDS, MAX_GENERATED, generate_scene
 from hlp_drake.scene.io import load_scene, save_scene
@@ -41,6 +42,7 @@ def _parser():
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
+    check_writable(getattr(args, "out", None), getattr(args, "png", None))  # bad paths: exit 2, now
     if args.command == "generate":
         scene = generate_scene(args.kind, args.seed, args.objects)
         save_scene(scene, args.out)

@@ -33,13 +33,14 @@ from hlp_drake.dataset.parse import (
     parse_movement,
     parse_table,
 )
-from hlp_drake.dataset.records import TRACKERS, category_of, trial_key
+from hlp_drake.dataset.records import ARM_PARTS, TRACKERS, category_of, trial_key
 from hlp_drake.dataset.source import PARTICIPANTS_FILE, Source
 from hlp_drake.errors import HlpError, short
 from hlp_drake.terminal import bars_disabled
 
-CACHE_VERSION = 5  # 5: values beyond parse.MAX_VALUE, files beyond source.MAX_FILE_BYTES and trials
-# listed twice are left out (4: the track array holds the kept trials' tracks only, in index order)
+CACHE_VERSION = 6  # 6: damaged interaction logs (cut short, naming an object the scene lacks) are left
+# out (5: values beyond parse.MAX_VALUE, files beyond source.MAX_FILE_BYTES and trials listed twice;
+# 4: the track array holds the kept trials' tracks only, in index order)
 COVERAGE_TOLERANCE = 0.1  # s: a track may start or end this much inside its trial (the data: <= 12 ms)
 INDEX_DIGEST = "index.sha256"  # beside index.json: a cache whose index was edited or damaged is rebuilt
 CACHE_ENV_VAR = "HLP_CACHE"
@@ -227,6 +228,14 @@ def _trial_entry(
         )
     if short_tracks:
         return None
+    strangers = _strangers(files["interactions"], files["objects_layout"])
+    if strangers:
+        line, name = strangers[0]
+        collector.problem(
+            f"{folder}/movement/interaction_log_T{number:03d}.csv",
+            f"line {line}: names {short(name, 40)!r}, which the scene does not have: trial skipped",
+        )
+        return None
     try:
         start_x = optional_float(row.get("start_pos_x"))
         scene = scene_from_layouts(files["scene_layout"], files["objects_layout"], folder, start_x=start_x)
@@ -254,6 +263,18 @@ def _trial_entry(
         "tracks": files["tracks"],
         "interactions": files["interactions"],
     }
+
+
+def _strangers(interactions: list[list], objects_layout: list[list]) -> list[tuple[int, str]]:
+    """(line, name) of every name the interaction log gives that is not the scene's (the acting
+    body may also be one of ``ARM_PARTS``); lines count the header."""
+    objects = {row[0] for row in objects_layout}
+    return [
+        (line, name)
+        for line, (_, _, dominant, non_dominant, _) in enumerate(interactions, start=2)
+        for name, known in ((dominant, objects | set(ARM_PARTS)), (non_dominant, objects))
+        if name not in known
+    ]
 
 
 def _kept_tracks(blocks: list[np.ndarray], trials: list[dict[str, Any]]) -> np.ndarray:

@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 
+from hlp_drake.dataset.records import INTERACTION_KINDS
 from hlp_drake.errors import short
 
 MOVEMENT_COLUMNS = 7  # time, pos_x, pos_y, pos_z, rot_x, rot_y, rot_z
@@ -96,7 +97,14 @@ def parse_layout(data: bytes) -> list[list]:
 
 
 def parse_interactions(data: bytes) -> list[list]:
-    """An interaction log -> rows ``[start, end or None, dominant, non_dominant, type]``."""
+    """An interaction log -> rows ``[start, end or None, dominant, non_dominant, type]``.
+
+    A log whose last line has no line end, or with a kind not in ``INTERACTION_KINDS`` (e.g. "Pus"),
+    was cut short: every log of the dataset ends its lines and uses those four kinds.
+    """
+    text = _text(data)
+    if text and not text.endswith(("\n", "\r")):
+        raise ValueError("truncated: the last line has no line end")
     parsed = []
     for i, row in enumerate(_rows(data, LOG_HEADER), start=2):
         if len(row) != len(LOG_HEADER):
@@ -109,6 +117,11 @@ def parse_interactions(data: bytes) -> list[list]:
             raise ValueError(f"line {i}: a time beyond +-{MAX_VALUE:g} s in {row[:2]!r}")
         if end is not None and end < start:
             raise ValueError(f"line {i}: ends ({end!r}) before it starts ({start!r})")
+        if row[4].strip() not in INTERACTION_KINDS:
+            raise ValueError(
+                f"line {i}: unknown interaction {short(row[4].strip(), 40)!r} (expected one of "
+                f"{', '.join(INTERACTION_KINDS)}; the file may be cut short)"
+            )
         parsed.append([start, end, row[2].strip(), row[3].strip(), row[4].strip()])
     return parsed
 

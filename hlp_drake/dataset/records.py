@@ -21,6 +21,11 @@ TRACKERS = {
     "ShoulderTracker": "upper_arm",
 }
 
+ARM_PARTS = ("Hand", "HandToWrist", "WristToElbow")
+"""The arm's parts an interaction log names as the acting body (besides the scene's objects)."""
+INTERACTION_KINDS = ("LeftGate", "RightGate", "PickedUp", "Pushed")
+"""The interaction log's kinds: the hand passing left or right of an obstacle, a pick-up, a push."""
+
 
 def category_of(trial: int) -> str:
     """Practice T001-T009, structured T010-T099, unstructured T100-T129."""

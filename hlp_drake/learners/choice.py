@@ -22,6 +22,7 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 from hlp_drake.learners.conformance import SAMPLE_WEIGHT_EQUIVALENCE
 from hlp_drake.learners.inputs import binary_classes, prediction_input, sample_weights
 from hlp_drake.learners.kernel import distance_weights
+from hlp_drake.learners.novelty import SAMPLES as NOVELTY_SAMPLES
 from hlp_drake.learners.novelty import fit_novelty, novelty_score
 from hlp_drake.learners.svm import RbfSvmClassifier
 from hlp_drake.learners.trees import BoostedTrees, boosted_tree_arrays
@@ -63,7 +64,7 @@ class RowChoiceClassifier(ClassifierMixin, BaseEstimator):
         calibration_folds: int = 2,
         novelty_neighbours: int = 5,
         novelty_quantile: float = 0.99,
-        novelty_samples: int = 1000,
+        novelty_samples: int = NOVELTY_SAMPLES,
         random_state: int = 0,
     ) -> None:
         self.learner = learner

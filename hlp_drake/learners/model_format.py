@@ -4,8 +4,9 @@ name, dtype and shape, checked before any array is used.
 Shapes are written with symbols: a number is a fixed size, a name a size every array that uses it
 must share (``F`` the row-choice features, ``P`` the kept novelty points, ...). The npz members'
 headers are read first (within ``MAX_HEADER``), so a header declaring a huge array is refused
-before anything is allocated; then the values are checked (indices in range, scales positive, every number within ``MAX_VALUE``).
-Every damage is one ``ModelError``.
+before anything is allocated; then the values are checked (indices in range, scales positive, every number within ``MAX_VALUE``),
+and the sizes against the learner settings ``models.json`` declares (``check_declared``: e.g. as many
+boosted trees as ``n_estimators``). Every damage is one ``ModelError``.
 
 Trust: ``allow_pickle=False`` and this check make a model file plain data: loading one never runs
 code. The SHA-256 in ``models.json`` only detects damage (anyone who edits the arrays can update it);
@@ -22,7 +23,7 @@ import tokenize
 import zipfile
 import zlib
 from math import comb
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -36,7 +37,11 @@ from hlp_drake.features.segment import SEGMENT_FEATURES
 from hlp_drake.learners.arm import CATEGORICAL as ARM_CATEGORICAL
 from hlp_drake.learners.direction import CATEGORICAL as DIRECTION_CATEGORICAL
 from hlp_drake.learners.encoding import N_DIRECTIONS
+from hlp_drake.learners.novelty import SAMPLES as NOVELTY_SAMPLES
 from hlp_drake.learners.trees import LEAF
+
+if TYPE_CHECKING:
+    from hlp_drake.learners.models import LearnerSettings
 
 MAX_MODEL_BYTES = 256 * 2**20
 """Largest ``models.npz`` read, bytes (the bundled one is ~0.5 MB)."""
@@ -237,6 +242,34 @@ def check_values(arrays: dict[str, np.ndarray]) -> None:
         if len(np.unique(arrays[name])) != len(arrays[name]):
             raise ValueError(f"array {name!r} repeats a class")
     _range("arm.outputs", arrays["arm.outputs"], 0, FIXED["O"])
+
+
+def check_declared(arrays: dict[str, np.ndarray], settings: LearnerSettings) -> None:
+    """Raise ``ValueError`` where the arrays' sizes disagree with the learner ``settings`` they were
+    trained with (checked shapes assumed): the boosted trees' count (``n_estimators``), nodes and
+    depth (``max_depth``), the arm's samples (``arm_max_samples``), the segment SVM's support
+    vectors (two classes of ``segment_max_per_class``) and the novelty model's points."""
+    sizes = []
+    if "row.learner.feature" in arrays:
+        trees, nodes = arrays["row.learner.feature"].shape
+        if trees != settings.n_estimators:
+            raise ValueError(
+                f"array 'row.learner.feature' holds {trees} trees, the settings declare "
+                f"n_estimators {settings.n_estimators}"
+            )
+        sizes.append(("row.learner.feature", nodes, 2 ** (settings.max_depth + 1) - 1, "nodes a tree"))
+        sizes.append(("row.learner.depth", int(arrays["row.learner.depth"]), settings.max_depth, "levels"))
+    if "row.novelty.points" in arrays:
+        sizes.append(("row.novelty.points", len(arrays["row.novelty.points"]), NOVELTY_SAMPLES, "points"))
+    if "segment.support_vectors" in arrays:
+        limit = 2 * settings.segment_max_per_class
+        sizes.append(("segment.support_vectors", len(arrays["segment.support_vectors"]), limit, "vectors"))
+    sizes.append(("arm.train", len(arrays["arm.train"]), settings.arm_max_samples, "samples"))
+    for name, size, limit, what in sizes:
+        if size > limit:
+            raise ValueError(
+                f"array {name!r} holds {size} {what}, more than its learner settings allow ({limit})"
+            )
 
 
 def digest(data: bytes) -> str:

@@ -32,6 +32,7 @@ from hlp_drake.learners.direction import CATEGORICAL as DIRECTION_CATEGORICAL
 from hlp_drake.learners.direction import DirectionClassifier
 from hlp_drake.learners.model_format import (
     MAX_MODEL_BYTES,
+    check_declared,
     check_pin,
     check_values,
     digest,
@@ -131,9 +132,14 @@ def _settings(meta: Any, where: Path) -> LearnerSettings:
     """The learner settings of the ``models.json`` document ``meta``, once every field is checked."""
     if not isinstance(meta, dict) or meta.get("format") != FORMAT:
         raise ModelError(f"{where}: not an hlp_drake model file")
-    if meta.get("version") != VERSION:
+    version = meta.get("version")
+    if version != VERSION:
+        if isinstance(version, int) and not isinstance(version, bool) and version > VERSION:
+            raise ModelError(
+                f"{where}: written by a newer hlp_drake: format {version}, this release reads {VERSION}"
+            )
         raise ModelError(
-            f"{where}: model format version {brief(meta.get('version'))}, this hlp_drake reads {VERSION}"
+            f"{where}: model format version {brief(version)}, this release reads {VERSION} (train them again)"
         )
     problems = document_problems(ModelDescription, meta, top="top level")
     settings = meta.get("settings") if isinstance(meta.get("settings"), dict) else {}
@@ -324,6 +330,7 @@ class DecisionModels:
         try:
             arrays = read_arrays(payload, expected_arrays(settings.planner, settings.row_learner))
             check_values(arrays)
+            check_declared(arrays, settings)
         except ValueError as error:
             raise ModelError(f"{npz_path}: {error}") from None
         models = cls(settings)

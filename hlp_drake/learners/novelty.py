@@ -14,6 +14,9 @@ import numpy as np
 
 from hlp_drake.learners.kernel import distance_weights
 
+SAMPLES = 1000
+"""Points a novelty model keeps at most (``RowChoiceClassifier``'s default ``novelty_samples``)."""
+
 
 def _kth_distance(Z: np.ndarray, weights: np.ndarray, k: int, exclude_self: bool = False) -> np.ndarray:
     sq = np.column_stack([Z, np.ones(len(Z)), (Z**2).sum(1)]) @ weights

@@ -6,11 +6,11 @@ from collections.abc import Iterable, Mapping
 
 import numpy as np
 
-from hlp_drake.dataset.records import Interaction
+from hlp_drake.dataset.records import ARM_PARTS, Interaction
 
 MOTION_TOLERANCE = 1e-3  # m per frame (the original's pos_change_tol)
 MOVE_KINDS = ("PickedUp", "Pushed")
-LIMBS = ("Hand", "HandToWrist", "WristToElbow")  # the acting body parts in the interaction log
+LIMBS = ARM_PARTS  # the acting body parts in the interaction log
 
 
 def motion_period(

@@ -53,6 +53,8 @@ def verdict(result) -> str:
     """The verdict line: whether the reach succeeded (the paper's success, which sets the exit status),
     and beside it whether the grasp held."""
     grasp = {None: "not attempted", True: "held", False: "did not hold"}[result.grasp_held]
+    if result.grasp_failure is not None:
+        grasp = f"did not hold ({result.grasp_failure})"
     reach = (
         "reach success (the paper's criterion, exit status 0)"
         if result.success

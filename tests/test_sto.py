@@ -231,6 +231,8 @@ def test_only_drake_failures_count_as_simulation_failures():
     assert simulation_failure(SystemExit("Failure at x.h:1 in f(): condition 'c' failed.")).startswith(
         "Failure at"
     )
+    diverged = SystemExit("Failure at x.h:2897 in SetPositions(): condition 'AllFinite(q)' failed.")
+    assert simulation_failure(diverged) == "the simulation diverged (the state turned non-finite)"
     with pytest.raises(SystemExit):
         simulation_failure(SystemExit(2))
 

@@ -83,3 +83,20 @@ def test_an_execution_from_the_verified_reach_gives_the_simulated_executions_res
     for attribute in ("objects_moved", "objects_dropped", "target_distance", "simulated_s", "grasp_held"):
         assert getattr(reused, attribute) == getattr(simulated, attribute), attribute
     assert reused.rollouts == simulated.rollouts
+
+
+def test_a_grasp_whose_simulation_diverges_leaves_the_reach_verdict_standing(scenario, monkeypatch):
+    from hlp_drake.run_scene import exit_status, verdict
+    from hlp_drake.systems.execution import run
+
+    def diverging(*args, **kwargs):
+        raise SystemExit("Failure at x.h:2897 in SetPositions(): condition 'AllFinite(q)' failed.")
+
+    monkeypatch.setattr(run, "grasp_and_lift", diverging)
+    with RolloutPool(1) as pool:
+        result = plan_and_execute(scenario, pool=pool)
+    assert result.success and result.failure_reason is None and exit_status(result) == 0
+    assert result.grasp_held is False
+    assert result.grasp_failure == "simulation failed: the simulation diverged (the state turned non-finite)"
+    assert result.to_dict()["grasp_failure"] == result.grasp_failure
+    assert "reach success" in verdict(result) and "did not hold (simulation failed" in verdict(result)

@@ -85,7 +85,8 @@ class ExecutionResult:
     object's name the true object's it was matched to, None if none).
 
     ``success`` is the paper's reach success (see ``plan_and_execute``); ``grasp_held`` is reported
-    beside it and is not part of it.
+    beside it and is not part of it (``grasp_failure``: why the grasp's simulation stopped, if it
+    failed; the reach's verdict stands).
     """
 
     planner: str
@@ -104,6 +105,7 @@ class ExecutionResult:
     rollouts: int = 0
     optimisation: dict[str, Any] = field(default_factory=dict)
     grasp_held: bool | None = None
+    grasp_failure: str | None = None
     perception: dict[str, Any] | None = None
     execution: str = "open"
     closed_loop: dict[str, Any] = field(default_factory=dict)
@@ -133,6 +135,7 @@ class ExecutionResult:
             "rollouts": self.rollouts,
             "optimisation": self.optimisation,
             "grasp_held": self.grasp_held,
+            "grasp_failure": self.grasp_failure,
             **({} if self.perception is None else {"perception": self.perception}),
             "execution": self.execution,
             "closed_loop": self.closed_loop,
@@ -409,9 +412,13 @@ def _execute(
         if problem is not None and result.failure_reason is None:
             result.failure_reason = f"in execution: {problem}"
         if problem is None:
-            result.grasp_held = grasp_and_lift(
-                simulator, command, settled, scenario, plant, plant_context, scene
-            )
+            try:
+                result.grasp_held = grasp_and_lift(
+                    simulator, command, settled, scenario, plant, plant_context, scene
+                )
+            except (RuntimeError, SystemExit) as error:  # the reach was checked: its verdict stands
+                result.grasp_held = False
+                result.grasp_failure = f"simulation failed: {simulation_failure(error)}"
     except (RuntimeError, SystemExit) as error:
         failure = simulation_failure(error)
         if result.failure_reason is None:

@@ -54,12 +54,16 @@ if TYPE_CHECKING:
 
 
 def simulation_failure(error: BaseException) -> str:
-    """The first line of a Drake simulation failure: a ``RuntimeError``, or one of Drake's internal
-    checks failing (pydrake raises those as ``SystemExit("Failure at ...")``, e.g. non-finite
-    positions after a blow-up). Any other ``SystemExit`` is raised again."""
+    """One line on a Drake simulation failure: a ``RuntimeError``'s first line, or one of Drake's
+    internal checks failing (pydrake raises those as ``SystemExit("Failure at ...")``; a state turned
+    non-finite, the contact solver having diverged, is said so). Any other ``SystemExit`` is raised
+    again."""
     if isinstance(error, SystemExit) and not str(error).startswith("Failure at"):
         raise error
-    return str(error).splitlines()[0]
+    line = str(error).splitlines()[0]
+    if "AllFinite" in line:
+        return "the simulation diverged (the state turned non-finite)"
+    return line
 
 
 @dataclass(frozen=True)

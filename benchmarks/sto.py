@@ -303,7 +303,7 @@ def main() -> None:
             "python": platform.python_version(),
         }
     }
-    steps = (Scenario().plant.time_step, 0.01)
+    steps = (0.005, Scenario().plant.time_step)
     report["throughput"] = throughput(args.throughput_rollouts, steps, args.throughput_repeats)
     print_throughput(report["throughput"], steps)
     if not args.skip_comparison:

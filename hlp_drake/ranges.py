@@ -32,9 +32,10 @@ from hlp_drake.typed_yaml import join_path
 
 MAX_SETTING = 1e9
 """Largest value of any number in the settings (a stiffness of 1e6 N/m is typical)."""
-MAX_TIME_STEP = 0.03
-"""s: the largest plant time step (at 40 ms the contact solver diverges on the default scene: an
-object sinks into the table, the state turns non-finite)."""
+MAX_TIME_STEP = 0.01
+"""s: the largest plant time step: from 15 ms on, cylinders resting untouched on the table bounce
+and walk off it (Gen II scenes), and at 40 ms the state turns non-finite (docs/results.md, "One
+execution model")."""
 MIN_TIME_STEP = 1e-4
 """s: the smallest plant time step (a simulated second then takes 10,000 steps)."""
 MIN_PERIOD = 1e-3

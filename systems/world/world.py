@@ -82,7 +82,7 @@ PLANT_RANGES = Fields(
 
 
 def default_plant_config() -> MultibodyPlantConfig:
-    """The plant settings of the world, the execution model the optimiser also rolls out on: 20 ms
+    """The plant settings of the world, the execution model the optimiser also rolls out on: 10 ms
     steps, point contact, the SAP solver and approximation, outputs from the current state.
 
     SAP simulates the gripper's mimic finger (a coupler constraint). The step and the contact geometry
@@ -90,7 +90,7 @@ def default_plant_config() -> MultibodyPlantConfig:
     the same model at 1 ms (``benchmarks/physics_models.py``; docs/results.md, "One execution model").
     """
     return MultibodyPlantConfig(
-        time_step=0.02,
+        time_step=0.01,
         penetration_allowance=0.001,
         stiction_tolerance=1e-4,
         contact_model="point",

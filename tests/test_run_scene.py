@@ -304,7 +304,10 @@ def test_the_exit_status_follows_the_reach_whatever_the_grasp(success, grasp_hel
     from hlp_drake.run_scene import exit_status, verdict
 
     result = SimpleNamespace(
-        success=success, grasp_held=grasp_held, failure_reason=None if success else "in execution: x"
+        success=success,
+        grasp_held=grasp_held,
+        grasp_failure=None,
+        failure_reason=None if success else "in execution: x",
     )
     assert exit_status(result) == status
     assert verdict(result) == f"{line} (reported, not part of success)"

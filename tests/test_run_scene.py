@@ -142,15 +142,15 @@ def recorded_camera(commands: bytes) -> tuple[tuple[float, ...], tuple[float, ..
     [generate_scene("vr", 1), generate_scene("gen1", 3), generate_scene("gen2", 4, 9)],
     ids=lambda scene: scene.name,
 )
-def test_the_view_looks_at_the_table_from_the_persons_side_at_45_degrees_and_fills_the_frame(scene):
+def test_the_view_looks_at_the_table_from_the_persons_side_and_fills_the_frame(scene):
     """MeshCat's camera (a 75 degree vertical field of view; a 1280 x 800 window): above the person's
-    side (x < 0), 45 degrees up, a little to the right; every corner of the table top in view, the
-    table over more than half of the frame's width."""
+    side (x < 0), 55 degrees up, to the left (the arm reaches from the right); every corner of the
+    table top in view, the table over nearly half of the frame's width (0.47-0.6 on Gen I and II)."""
     eye, target = camera_pose(scene)
     table = scene.table
     view = target - eye
-    assert eye[0] < 0.0 < target[0] < table.length and eye[1] < 0.0
-    assert np.degrees(np.arcsin(-view[2] / np.linalg.norm(view))) == pytest.approx(45.0)
+    assert eye[0] < 0.0 < target[0] < table.length and eye[1] > 0.0
+    assert np.degrees(np.arcsin(-view[2] / np.linalg.norm(view))) == pytest.approx(55.0)
     forward = view / np.linalg.norm(view)
     right = np.cross(forward, [0.0, 0.0, 1.0])
     right /= np.linalg.norm(right)
@@ -164,7 +164,7 @@ def test_the_view_looks_at_the_table_from_the_persons_side_at_45_degrees_and_fil
         ]
     )
     assert np.all(np.abs(seen) < 1.0), seen  # normalised image coordinates
-    assert np.ptp(seen[:, 0]) / 2.0 > 0.5
+    assert np.ptp(seen[:, 0]) / 2.0 > 0.45
 
 
 def test_run_scene_end_to_end_json_and_html(tmp_path):

@@ -183,7 +183,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     if scene is None:
         _print(f"scene {scenario.scene.name}: {len(scenario.scene.obstacles)} obstacles")
-    from hlp_drake.systems.execution.run import what_ran
+    from hlp_drake.systems.execution.result import what_ran
 
     ran = what_ran(scenario, args.config)
     _print(f"run: {ran.line()}")

@@ -102,8 +102,8 @@ __getattr__, __dir__ = lazy_exports(
         "hlp_drake.systems.execution.job": ("run_job", "scenario_yamls"),
         "hlp_drake.systems.execution.meshcat_view": ("draw_perception", "draw_plan", "frame_table"),
         "hlp_drake.systems.execution.receding_horizon": ("RecedingHorizonController",),
+        "hlp_drake.systems.execution.result": ("ExecutionResult",),
         "hlp_drake.systems.execution.run": (
-            "ExecutionResult",
             "RunListener",
             "plan_and_execute",
             "run_execution",

@@ -8,6 +8,8 @@ import os
 import signal
 from pathlib import Path
 
+from job_support import cheap_job
+
 FAULTS = "HLP_TEST_FAULTS"
 """The environment variable naming the folder of the once-only faults' marker files."""
 
@@ -44,38 +46,15 @@ VICTIM = ("gen1-11", "sto")
 """The experiment job whose worker the job faults kill."""
 
 
-def steady_job(job):
-    """A deterministic stand-in for the real job: its row drawn from (scene, planner) alone."""
-    import random
-
-    from hlp_drake.experiments import make_row
-
-    rng = random.Random(f"{job.scene}/{job.planner}")
-    success = rng.random() < 0.8
-    return make_row(
-        job,
-        success=success,
-        failure_reason=None if success else "the target is out of reach",
-        plan_s=rng.uniform(0.01, 0.1),
-        ik_s=rng.uniform(0.1, 0.5),
-        optimise_s=rng.uniform(0.5, 20.0),
-        execute_s=rng.uniform(2, 4),
-        rollouts=rng.randint(8, 80),
-        iterations=rng.randint(1, 10),
-        objects_moved=rng.randint(0, 3),
-        objects_dropped=int(not success),
-    )
-
-
 def job_killing_its_worker_once(job):
-    """``steady_job``, whose ``VICTIM``'s first run kills its worker process."""
+    """``cheap_job``, whose ``VICTIM``'s first run kills its worker process."""
     if job.key == VICTIM and first_time("job"):
         die()
-    return steady_job(job)
+    return cheap_job(job)
 
 
 def job_killing_its_worker(job):
-    """``steady_job``, whose ``VICTIM`` kills its worker process every time."""
+    """``cheap_job``, whose ``VICTIM`` kills its worker process every time."""
     if job.key == VICTIM:
         die()
-    return steady_job(job)
+    return cheap_job(job)

@@ -19,6 +19,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 from conftest import run_module
+from job_support import cheap_job
 
 from hlp_drake import experiments
 from hlp_drake.cli import invoked_as, run_cli
@@ -42,28 +43,6 @@ REQUIRED_COLUMNS = ["scene", "objects", "planner", "success", "failure_reason", 
                     "total_s", "rollouts", "objects_moved", "objects_dropped"]
 # fmt: on
 OUTPUTS = ("results.csv", "config.json", "run.json", "summary.md", "summary.json", "success.png", "times.png")
-
-
-def cheap_job(job: Job) -> dict:
-    """A deterministic stand-in for plan_and_execute: outcome and times drawn from (scene, planner)."""
-    rng = random.Random(f"{job.scene}/{job.planner}")
-    scene = job.make_scene()
-    success = rng.random() < (0.9 if job.planner == "hlp" else 0.7)
-    optimise_s = rng.uniform(0.5, 2.0) * (1 if job.planner == "hlp" else 10)
-    return make_row(
-        job,
-        success=success,
-        failure_reason=None if success else "the target is out of reach",
-        plan_s=rng.uniform(0.01, 0.1),
-        ik_s=rng.uniform(0.1, 0.5),
-        optimise_s=optimise_s,
-        verify_s=optimise_s * rng.uniform(0.2, 0.8),
-        execute_s=rng.uniform(2, 4),
-        rollouts=rng.randint(8, 80),
-        iterations=rng.randint(1, 10),
-        objects_moved=rng.randint(0, len(scene.obstacles)),
-        objects_dropped=int(not success),
-    )
 
 
 class RecordingJob:

@@ -23,8 +23,8 @@ from fault_support import (
     job_killing_its_worker_once,
     rollout_exiting,
     rollout_killing_its_worker_once,
-    steady_job,
 )
+from job_support import cheap_job
 from sto_support import on, short
 from synthetic_dataset import write_dataset
 
@@ -157,13 +157,24 @@ def run_experiments(argv: list[str], job) -> int:
 def reference(tmp_path_factory) -> str:
     """The experiment's ``results.csv``, run undisturbed in this process."""
     out = tmp_path_factory.mktemp("reference")
-    assert run_experiments([*GEN1, "--workers", "1", "--out", str(out)], steady_job) == 0
+    assert run_experiments([*GEN1, "--workers", "1", "--out", str(out)], cheap_job) == 0
     return (out / "results.csv").read_text()
 
 
 def rows_of(text: str) -> dict[tuple[str, str], str]:
     lines = text.splitlines()
     return {tuple(line.split(",")[0:3:2]): line for line in lines[1:]}
+
+
+def rows_but_the_victims_as(path, reference: str) -> dict:
+    """``path``'s rows, after checking they are the ``reference`` run's rows, ``VICTIM``'s aside (the
+    same jobs, every other row the same)."""
+    rows, expected = rows_of(path.read_text()), rows_of(reference)
+    assert set(rows) == set(expected)
+    assert {k: r for k, r in rows.items() if k != VICTIM} == {
+        k: r for k, r in expected.items() if k != VICTIM
+    }
+    return rows
 
 
 def test_an_experiment_job_whose_worker_dies_runs_again(tmp_path, capsys, faults, reference):
@@ -184,11 +195,7 @@ def test_an_experiment_job_whose_worker_keeps_dying_gets_a_failure_row(tmp_path,
         "warning: the worker running gen1-11 sto died (signal 9); running that job again",
         "warning: the worker running gen1-11 sto died (signal 9) again; that job is recorded as a failure",
     ]
-    rows, expected = rows_of((tmp_path / "results.csv").read_text()), rows_of(reference)
-    assert set(rows) == set(expected)
-    assert {key: row for key, row in rows.items() if key != VICTIM} == {
-        key: row for key, row in expected.items() if key != VICTIM
-    }
+    rows = rows_but_the_victims_as(tmp_path / "results.csv", reference)
     assert f"crashed: its worker process died {RETRIES + 1} times (signal 9)" in rows[VICTIM]
     assert ",false," in rows[VICTIM] and ",nan," in rows[VICTIM]
     summary = experiments.run_experiment(  # resumed: every row is there, nothing runs again
@@ -220,10 +227,7 @@ def test_a_dask_job_whose_workers_keep_dying_gets_a_failure_row(tmp_path, capsys
         "warning: a dask worker died running gen1-11 sto; running that job again",
         "warning: the dask workers running gen1-11 sto died 2 times; that job is recorded as a failure",
     ]
-    rows, expected = rows_of((tmp_path / "results.csv").read_text()), rows_of(reference)
-    assert {key: row for key, row in rows.items() if key != VICTIM} == {
-        key: row for key, row in expected.items() if key != VICTIM
-    }
+    rows = rows_but_the_victims_as(tmp_path / "results.csv", reference)
     assert f"crashed: its dask worker died {RETRIES + 1} times (KilledWorker)" in rows[VICTIM]
 
 
@@ -267,7 +271,7 @@ def test_a_full_disk_ends_the_experiment_with_one_line_keeps_its_rows_and_resume
     argv = [*GEN1, "--workers", "1", "--out", str(tmp_path)]
     with monkeypatch.context() as patched:
         Disk(patched, tmp_path, room=3)  # results.csv's first writes: no row, then 2 rows
-        status = run_experiments(argv, steady_job)
+        status = run_experiments(argv, cheap_job)
     err = capsys.readouterr().err
     assert status == 1 and "Traceback" not in err
     assert err.splitlines() == [f"error: {tmp_path / 'results.csv'}: cannot write: No space left on device"]
@@ -277,7 +281,7 @@ def test_a_full_disk_ends_the_experiment_with_one_line_keeps_its_rows_and_resume
         no_temporary_files(tmp_path)
         and json.loads((tmp_path / "run.json").read_text())["status"] == "running"
     )
-    assert run_experiments(argv, steady_job) == 0  # given space again, the same command completes the table
+    assert run_experiments(argv, cheap_job) == 0  # given space again, the same command completes the table
     assert (tmp_path / "results.csv").read_text() == reference
     assert json.loads((tmp_path / "run.json").read_text())["jobs"]["kept"] == 2
 
@@ -295,7 +299,7 @@ def test_an_output_folder_that_becomes_unwritable_ends_the_run_with_one_line(
 
     def job(job):  # in this process (--workers 1): the folder is taken away during the second job
         ran.append(job.key)
-        return steady_job(job)
+        return cheap_job(job)
 
     with monkeypatch.context() as patched:
         patched.setattr(tempfile, "mkstemp", mkstemp)
@@ -308,7 +312,7 @@ def test_an_output_folder_that_becomes_unwritable_ends_the_run_with_one_line(
     )
     rows = (tmp_path / "results.csv").read_text().splitlines()
     assert len(rows) > 1 and set(rows) <= set(reference.splitlines()) and no_temporary_files(tmp_path)
-    assert run_experiments(argv, steady_job) == 0 and (tmp_path / "results.csv").read_text() == reference
+    assert run_experiments(argv, cheap_job) == 0 and (tmp_path / "results.csv").read_text() == reference
 
 
 def test_a_command_whose_output_hits_a_full_disk_exits_1_with_one_line_and_the_old_file(

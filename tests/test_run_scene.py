@@ -259,7 +259,7 @@ def test_run_scene_closed_loop_with_uncertainty_end_to_end(tmp_path):
 
 
 def test_what_ran_names_the_robot_planner_execution_model_error_perception_and_scenario_file():
-    from hlp_drake.systems.execution.run import what_ran
+    from hlp_drake.systems.execution.result import what_ran
     from hlp_drake.what_ran import WhatRan
 
     plain = what_ran(Scenario())
@@ -317,7 +317,7 @@ def test_a_plan_on_a_perceived_scene_names_the_true_objects_with_the_perceived_n
     from hlp_drake.planner import HighLevelPlan
     from hlp_drake.planner.plan import PlanKeypoint
     from hlp_drake.run_progress import plan_steps
-    from hlp_drake.systems.execution.run import named_plan
+    from hlp_drake.systems.execution.result import named_plan
 
     seen = HighLevelPlan(
         scene="seen",

@@ -14,10 +14,11 @@ from sto_support import on, short
 from hlp_drake.errors import HlpError
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import SceneObject
+from hlp_drake.systems.optimiser.budget import Budget
 from hlp_drake.systems.optimiser.config import PERCEIVED_CHECKS, StoConfig
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.cost import BLOWN_UP_COST, RolloutSamples, rollout_cost
-from hlp_drake.systems.optimiser.optimiser import Budget, mppi_weights, optimise, sample_base_noise
+from hlp_drake.systems.optimiser.optimiser import mppi_weights, optimise, sample_base_noise
 from hlp_drake.systems.optimiser.pool import RolloutPool, SceneRollouts
 from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
 from hlp_drake.systems.optimiser.system import StochasticTrajectoryOptimiser

@@ -11,7 +11,8 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from hlp_drake.learners.bundled import default_models
-from hlp_drake.systems.execution.run import plan_and_execute, what_ran
+from hlp_drake.systems.execution.result import what_ran
+from hlp_drake.systems.execution.run import plan_and_execute
 from hlp_drake.systems.optimiser.pool import RolloutPool
 from hlp_drake.systems.optimiser.rollout_world import simulation_failure
 from hlp_drake.systems.scenario import load_scenario, with_conditions

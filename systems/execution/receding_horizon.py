@@ -46,9 +46,10 @@ from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import Context, LeafSystem, State
 
 from hlp_drake.scene.model import Scene
+from hlp_drake.systems.optimiser.budget import Budget
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.cost import Prediction
-from hlp_drake.systems.optimiser.optimiser import EMPTY_RESULT, Budget, StoResult, optimise
+from hlp_drake.systems.optimiser.optimiser import EMPTY_RESULT, StoResult, optimise
 from hlp_drake.systems.optimiser.rollout_world import RolloutStart
 from hlp_drake.systems.perception.accuracy import largest_displacement
 from hlp_drake.systems.perception.perception import Perception

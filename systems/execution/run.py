@@ -5,15 +5,15 @@
 The run evaluates the plan, the keyframes and the optimisation at the start, plays the optimised
 trajectory (open loop) or hands it to the receding-horizon controller (closed loop), checks the
 reach, then closes the gripper and lifts. Open loop in the optimiser's own world, the reach is the
-optimiser's verification of it on the execution model: the execution starts from where that ended.
+optimiser's accepted rollout (on the execution model itself): the execution starts from where that
+ended. The run's record is ``ExecutionResult`` (``hlp_drake.systems.execution.result``).
 A ``RunListener`` hears of every stage as it happens.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from pydrake.geometry import Meshcat
@@ -21,7 +21,6 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import EventStatus
 
 from hlp_drake.planner import HighLevelPlan
-from hlp_drake.scene.model import Scene
 from hlp_drake.systems.execution.command import (
     ClosedLoopCommand,
     OpenLoopCommand,
@@ -34,19 +33,19 @@ from hlp_drake.systems.execution.diagram import (
     make_execution_diagram,
 )
 from hlp_drake.systems.execution.meshcat_view import PLAN_LIFT, draw_perception, draw_plan, frame_table
+from hlp_drake.systems.execution.result import ExecutionResult, true_names
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.cost import FinalState, pregrasp_check, reach_problem
 from hlp_drake.systems.optimiser.pool import RolloutPool
 from hlp_drake.systems.optimiser.rollout_world import simulation_failure
-from hlp_drake.systems.perception.accuracy import match_objects, perception_record
+from hlp_drake.systems.perception.accuracy import perception_record
 from hlp_drake.systems.perception.system import perceive_world
 from hlp_drake.systems.planning.keyframes import Keyframes
-from hlp_drake.systems.world.robot import ROBOT_MODEL_NAME, TCP_FRAME
+from hlp_drake.systems.world.robot import TCP_FRAME
 from hlp_drake.systems.world.scene_models import fallen_objects, object_planar_poses
 from hlp_drake.systems.world.scene_source import SCENE_PORT
 from hlp_drake.systems.world.start_pose import tcp_keypoint_height
 from hlp_drake.systems.world.world import world_plant
-from hlp_drake.what_ran import WhatRan
 
 if TYPE_CHECKING:
     from pydrake.trajectories import PiecewisePolynomial
@@ -57,114 +56,8 @@ if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
 
 
-def what_ran(
-    scenario: Scenario, scenario_file: str | None = None, *, planners: tuple[str, ...] | None = None
-) -> WhatRan:
-    """What a run of ``scenario`` (read from ``scenario_file``; None: the built-in default) runs: its
-    robot, planner (or ``planners``), execution mode, model error's seed, perception source."""
-    uncertainty = scenario.uncertainty
-    return WhatRan(
-        robot=ROBOT_MODEL_NAME,
-        planners=planners or (scenario.planner.kind,),
-        execution="closed" if scenario.closed_loop.enabled else "open",
-        model_error_seed=uncertainty.seed if uncertainty.enabled else None,
-        perception_source=scenario.perception.source,
-        scenario_file=scenario_file,
-    )
-
-
 MOVED_TOLERANCE = 0.01  # m: an object displaced further than this counts as moved
 RECORDING_FPS = 32.0  # frames per second of a MeshCat recording
-
-
-@dataclass
-class ExecutionResult:
-    """Outcome of planning and executing one scene (``reach_reused``: the execution started where
-    the optimised sequence's verification on the execution model ended, rather than simulating the
-    reach again; see ``verified_reach``; ``true_names``: planned on a perceived scene, per perceived
-    object's name the true object's it was matched to, None if none).
-
-    ``success`` is the paper's reach success (see ``plan_and_execute``); ``grasp_held`` is reported
-    beside it and is not part of it (``grasp_failure``: why the grasp's simulation stopped, if it
-    failed; the reach's verdict stands).
-    """
-
-    planner: str
-    scene: Scene
-    plan: HighLevelPlan
-    keyframes: Keyframes
-    robot_plan: HighLevelPlan | None = None
-    success: bool = False
-    failure_reason: str | None = None
-    timings: dict[str, float] = field(default_factory=dict)
-    objects_moved: list[str] = field(default_factory=list)
-    objects_dropped: list[str] = field(default_factory=list)
-    target_distance: float | None = None
-    simulated_s: float = 0.0
-    iterations: int = 0
-    rollouts: int = 0
-    optimisation: dict[str, Any] = field(default_factory=dict)
-    grasp_held: bool | None = None
-    grasp_failure: str | None = None
-    perception: dict[str, Any] | None = None
-    execution: str = "open"
-    closed_loop: dict[str, Any] = field(default_factory=dict)
-    reach_reused: bool = False
-    true_names: dict[str, str | None] | None = None
-
-    @property
-    def rollout_passed_execution_failed(self) -> bool:
-        """The optimiser accepted a sequence (its rollout passed), and the execution failed."""
-        return bool(self.optimisation.get("success")) and not self.success
-
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "planner": self.planner,
-            "scene": self.scene.name,
-            "success": self.success,
-            "failure_reason": self.failure_reason,
-            "plan": named_plan(self.plan.to_dict(), self.true_names),
-            "ik": {"ok": self.keyframes.ok, "failures": self.keyframes.failures},
-            "robot_actuated_dofs": 10,
-            "timings": self.timings,
-            "objects_moved": self.objects_moved,
-            "objects_dropped": self.objects_dropped,
-            "target_distance": self.target_distance,
-            "simulated_s": self.simulated_s,
-            "iterations": self.iterations,
-            "rollouts": self.rollouts,
-            "optimisation": self.optimisation,
-            "grasp_held": self.grasp_held,
-            "grasp_failure": self.grasp_failure,
-            **({} if self.perception is None else {"perception": self.perception}),
-            "execution": self.execution,
-            "closed_loop": self.closed_loop,
-            "reach_reused": self.reach_reused,
-            "rollout_passed_execution_failed": self.rollout_passed_execution_failed,
-        }
-
-
-def true_names(scene: Scene, perception: Perception) -> dict[str, str | None]:
-    """Per object of the ``perception``'s scene, the name of the object of the true ``scene`` it was
-    matched to (``match_objects``), None for an object matched to none."""
-    if not perception.ok:
-        return {}
-    matched = {seen: true for true, seen in match_objects(scene, perception.scene).items()}
-    return {o.name: matched.get(o.name) for o in perception.scene.objects}
-
-
-def named_plan(plan: dict[str, Any], names: dict[str, str | None] | None) -> dict[str, Any]:
-    """A plan's JSON (``HighLevelPlan.to_dict``) whose keypoints name the true objects (``names``:
-    perceived -> true, None: planned on the true scene), each perceived name beside as ``perceived_as``."""
-    if names is None:
-        return plan
-    keypoints = []
-    for keypoint in plan["keypoints"]:
-        element = keypoint["element"]
-        if keypoint["action"] != "gap" and element is not None:
-            keypoint = {**keypoint, "element": names.get(element), "perceived_as": element}
-        keypoints.append(keypoint)
-    return {**plan, "keypoints": keypoints}
 
 
 def plan_and_execute(
@@ -346,8 +239,8 @@ def _draw(
 
 
 def verified_reach(optimisation: StoResult, scenario: Scenario) -> FinalState | None:
-    """Where the optimised sequence's verification on the execution model ended, if that was in
-    ``scenario``'s own world from the scene's start (None otherwise, e.g. planned on a perceived
+    """Where the optimised sequence's verification on the execution model ended (the accepted rollout
+    itself, unless the reduced model rolled it out), if that was in ``scenario``'s own world from the scene's start (None otherwise, e.g. planned on a perceived
     scene): the execution model is deterministic, so the execution's reach would end there too."""
     outcome = optimisation.outcome
     final = None if outcome is None or outcome.verification is None else outcome.verification.final

@@ -1,0 +1,30 @@
+"""``cheap_job``: a deterministic stand-in for the experiments' real job, a module-level function so
+process pools and dask workers can unpickle it."""
+
+from __future__ import annotations
+
+import random
+
+from hlp_drake.experiments import Job, make_row
+
+
+def cheap_job(job: Job) -> dict:
+    """A deterministic stand-in for plan_and_execute: outcome and times drawn from (scene, planner)."""
+    rng = random.Random(f"{job.scene}/{job.planner}")
+    scene = job.make_scene()
+    success = rng.random() < (0.9 if job.planner == "hlp" else 0.7)
+    optimise_s = rng.uniform(0.5, 2.0) * (1 if job.planner == "hlp" else 10)
+    return make_row(
+        job,
+        success=success,
+        failure_reason=None if success else "the target is out of reach",
+        plan_s=rng.uniform(0.01, 0.1),
+        ik_s=rng.uniform(0.1, 0.5),
+        optimise_s=optimise_s,
+        verify_s=optimise_s * rng.uniform(0.2, 0.8),
+        execute_s=rng.uniform(2, 4),
+        rollouts=rng.randint(8, 80),
+        iterations=rng.randint(1, 10),
+        objects_moved=rng.randint(0, len(scene.obstacles)),
+        objects_dropped=int(not success),
+    )

@@ -68,7 +68,7 @@ from tqdm import tqdm
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.world.robot import ROBOT_MODEL_NAME, models_directory
+from hlp_drake.systems.world.robot import MOBILE_UR5, models_directory
 from hlp_drake.systems.world.world import make_world_diagram, world_plant
 
 try:
@@ -471,7 +471,7 @@ class DrakeModel:
             simulated_s=self.world.time(),
             drift=np.linalg.norm(self.world.object_positions() - self.object_start, axis=1),
             failed="blew_up" in outcome.terms,
-            robot_end=self.world.states()[ROBOT_MODEL_NAME][: len(self.world.start_positions)],
+            robot_end=self.world.states()[MOBILE_UR5.name][: len(self.world.start_positions)],
         )
 
 

@@ -16,7 +16,8 @@ whole)::
             target: {name: Target, shape: cylinder, x: 0.7, y: 0.0, size: [0.06, 0.06, 0.12]},
             obstacles: []}
     planner: {kind: hlp}            # hlp (human-like) or sto (the straight line of the STO baseline)
-    plant: {time_step: 0.002}       # Drake's MultibodyPlantConfig
+    robot: {name: panda, ...}       # the robot (RobotDescription; --robot NAME reads a shipped one)
+    plant: {time_step: 0.01}        # Drake's MultibodyPlantConfig
     controller: {arm: {kp: 2000.0, kd: 150.0}}
     optimiser: {samples: 8, max_iterations: 20}
 """
@@ -43,6 +44,7 @@ from hlp_drake.systems.execution.command import GraspConfig
 from hlp_drake.systems.optimiser.config import ClosedLoopConfig, StoConfig
 from hlp_drake.systems.perception.cameras import MAX_CAMERAS, PerceptionConfig, camera_pose
 from hlp_drake.systems.planning.ik import IkConfig, MotionConfig
+from hlp_drake.systems.world.robot import MOBILE_UR5, RobotDescription, load_robot, with_model_beside
 from hlp_drake.systems.world.scene_models import BodiesConfig, ContactConfig
 from hlp_drake.systems.world.uncertainty import UncertaintyConfig
 from hlp_drake.systems.world.world import PLANT_RANGES, ControlConfig, default_plant_config
@@ -88,6 +90,7 @@ class Scenario:
     Attributes:
         scene: the table, start, target and obstacles (default: the bundled default scene).
         planner: the planner and its settings.
+        robot: the robot (``RobotDescription``; default the mobile UR5).
         plant: Drake's plant settings; ``time_step`` > 0 and a SAP contact approximation ("sap",
             "lagged", "similar"), which the robot's mimic finger needs.
         contact: contact materials.
@@ -106,6 +109,7 @@ class Scenario:
 
     scene: Scene = field(default_factory=default_scene)
     planner: PlannerChoiceConfig = field(default_factory=PlannerChoiceConfig)
+    robot: RobotDescription = field(default_factory=RobotDescription)
     plant: Annotated[MultibodyPlantConfig, PLANT_RANGES] = field(default_factory=default_plant_config)
     contact: ContactConfig = field(default_factory=ContactConfig)
     bodies: BodiesConfig = field(default_factory=BodiesConfig)
@@ -132,8 +136,16 @@ class Scenario:
                 raise HlpError(*problems)
 
     def problems(self, where: str = "") -> list[str]:
-        """The rules across sections: the world's obstacles, and the cameras' poses over the scene's table."""
+        """The rules across sections: the world's obstacles, the cameras' poses over the scene's table,
+        and a robot's names in its model (a robot other than the default: its model is parsed, once)."""
         problems = []
+        if self.robot != MOBILE_UR5 and not self.robot.problems():
+            from hlp_drake.systems.world.start_pose import kinematic_robot
+
+            try:
+                kinematic_robot(self.robot)
+            except HlpError as error:
+                problems += error.problems
         obstacles = getattr(self.scene, "obstacles", ())
         if isinstance(obstacles, tuple | list) and len(obstacles) > MAX_WORLD_OBSTACLES:
             problems.append(
@@ -190,6 +202,8 @@ def load_scenario(
         for name, text in sources:
             document = parse_yaml(text, name)
             scenario = load_typed(Scenario, document, defaults=scenario, where=name, top="scenario")
+            if filename is not None and name == str(filename):  # a relative model path: the file's neighbour
+                scenario = replace(scenario, robot=with_model_beside(scenario.robot, Path(filename).parent))
     finally:
         _LOADING.reset(loading)
     problems = [f"scene: {p}" for p in scene_problems(scenario.scene)] + config_problems(scenario)
@@ -205,16 +219,20 @@ def with_conditions(
     execution: str | None = None,
     uncertainty: int | None = None,
     perception: str | None = None,
+    robot: str | None = None,
 ) -> Scenario:
-    """``scenario`` executed ``execution`` ("open" or "closed"; None: as it says), with seeded
+    """``scenario`` run by ``robot`` (a shipped robot's name or a description file: ``load_robot``;
+    None: as it says), executed ``execution`` ("open" or "closed"; None: as it says), with seeded
     model error of seed ``uncertainty`` (None: as it says), its scene from ``perception`` ("truth" or
-    "camera"; None: as it says): the ``--execution``, ``--uncertainty`` and ``--perception`` options
-    of ``run_scene`` and the experiments.
+    "camera"; None: as it says): the ``--robot``, ``--execution``, ``--uncertainty`` and
+    ``--perception`` options of ``run_scene`` and the experiments.
 
     Raises:
         HlpError: the settings do not fit together so (e.g. a camera source without a camera).
     """
     changes = {}
+    if robot is not None:
+        changes["robot"] = load_robot(robot)
     if execution is not None:
         changes["closed_loop"] = replace(scenario.closed_loop, enabled=execution == "closed")
     if uncertainty is not None:

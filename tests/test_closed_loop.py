@@ -17,7 +17,7 @@ from hlp_drake.systems.optimiser.cost import Prediction, RolloutOutcome
 from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
 from hlp_drake.systems.planning.diagram import ObservedScenePlanner
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.world.robot import ROBOT_MODEL_NAME
+from hlp_drake.systems.world.robot import MOBILE_UR5
 from hlp_drake.systems.world.uncertainty import UncertaintyConfig, sample_perturbation
 from hlp_drake.systems.world.world import make_world_diagram, world_plant
 
@@ -104,7 +104,7 @@ def test_model_error_is_seeded_per_scene_and_changes_the_world(scenario):
 def test_the_observed_scene_planner_plans_on_the_observed_scene_from_where_the_robot_is(scenario):
     world = RolloutWorld(scenario)
     world.begin(forward(world.start_positions, 0.0, 1.0))
-    robot = world.states()[ROBOT_MODEL_NAME]
+    robot = world.states()[MOBILE_UR5.name]
     robot[0] += 0.02  # the base 2 cm on
     template = scenario.scene
     pushed = template.obstacles[0]

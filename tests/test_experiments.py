@@ -36,7 +36,7 @@ from hlp_drake.experiments.results import (
 from hlp_drake.experiments.runner import JobFunction
 from hlp_drake.experiments.summary import summarise
 from hlp_drake.systems import scenario_yamls
-from hlp_drake.systems.world.robot import ROBOT_MODEL_NAME
+from hlp_drake.systems.world.robot import MOBILE_UR5
 
 # fmt: off
 REQUIRED_COLUMNS = ["scene", "objects", "planner", "success", "failure_reason", "init_s", "optimise_s",
@@ -583,7 +583,7 @@ def test_run_json_and_the_summary_say_what_ran(tmp_path, capsys):
     assert run_cli(lambda a: main(a, job=cheap_job), argv) == 0
     printed = capsys.readouterr().out
     ran = {
-        "robot": ROBOT_MODEL_NAME,
+        "robot": MOBILE_UR5.name,
         "planners": ["hlp", "sto"],
         "execution": "closed",
         "model_error_seed": 4,
@@ -594,7 +594,7 @@ def test_run_json_and_the_summary_say_what_ran(tmp_path, capsys):
     summary = json.loads((out / "summary.json").read_text())
     assert {key: run[key] for key in ran} == ran == {key: summary[key] for key in ran}
     line = (
-        f"Ran: robot {ROBOT_MODEL_NAME}, planners hlp and sto, execution closed, model error seed 4, "
+        f"Ran: robot {MOBILE_UR5.name}, planners hlp and sto, execution closed, model error seed 4, "
         f"perception truth, scenario {config}."
     )
     assert line in (out / "summary.md").read_text() and line in printed

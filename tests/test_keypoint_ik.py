@@ -15,7 +15,7 @@ from hlp_drake.scene.model import Scene, SceneObject, Table
 from hlp_drake.systems.planning.ik import KeypointIk
 from hlp_drake.systems.planning.keyframes import Keyframes
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.world.robot import BASE_FOOTPRINT, GRIPPER_CLOSED, GRIPPER_OPEN, TCP_FRAME
+from hlp_drake.systems.world.robot import MOBILE_UR5
 from hlp_drake.systems.world.start_pose import start_configuration
 from hlp_drake.systems.world.world import make_world_diagram, world_plant
 from hlp_drake.taskspace import TaskSpace
@@ -93,7 +93,7 @@ def test_keyframes_put_the_tcp_on_every_waypoint(system, scene, solved):
     # Forward kinematics on the world's own plant, independent of the IK's planning model.
     plant, robot = world_plant(make_world_diagram(replace(CONFIG, scene=scene)))
     context = plant.CreateDefaultContext()
-    tcp = plant.GetFrameByName(TCP_FRAME, robot)
+    tcp = plant.GetFrameByName(MOBILE_UR5.tcp_frame, robot)
     height = scene.table.height + CONFIG.ik.height
     for q, waypoint in zip(keyframes.positions, plan.waypoints):
         plant.SetPositions(context, robot, q)
@@ -156,21 +156,23 @@ def test_gripper_closes_among_the_obstacles_and_opens_before_the_target(system, 
     assert keyframes.ok, keyframes.failures
     breaks = trajectory.get_segment_times()
     assert len(breaks) == len(plan.keypoints) + 1  # the opening in place is a knot of its own
-    np.testing.assert_allclose(fingers(trajectory, 0.0), [GRIPPER_OPEN] * 2)
-    assert 0.0 < fingers(trajectory, 0.5 * breaks[1])[0] < GRIPPER_OPEN  # closing on the way
+    np.testing.assert_allclose(fingers(trajectory, 0.0), [MOBILE_UR5.gripper_open] * 2)
+    assert 0.0 < fingers(trajectory, 0.5 * breaks[1])[0] < MOBILE_UR5.gripper_open  # closing on the way
     for t in breaks[1:3]:
-        np.testing.assert_allclose(fingers(trajectory, t), [GRIPPER_CLOSED] * 2)
+        np.testing.assert_allclose(fingers(trajectory, t), [MOBILE_UR5.gripper_closed] * 2)
     np.testing.assert_allclose(trajectory.value(breaks[3])[:9], trajectory.value(breaks[2])[:9])  # in place
     for t in breaks[3:]:
-        np.testing.assert_allclose(fingers(trajectory, t), [GRIPPER_OPEN] * 2)
+        np.testing.assert_allclose(fingers(trajectory, t), [MOBILE_UR5.gripper_open] * 2)
     # The fingers' speed limit times the pace: no faster than the trajectory allows for any joint.
-    assert breaks[3] - breaks[2] >= GRIPPER_OPEN / (CONFIG.motion.joint_speed_fraction * 0.075) - 1e-9
+    assert (
+        breaks[3] - breaks[2] >= MOBILE_UR5.gripper_open / (CONFIG.motion.joint_speed_fraction * 0.075) - 1e-9
+    )
 
     config = replace(CONFIG, motion=replace(CONFIG.motion, closed_among_obstacles=False))
     _, open_all = evaluate(ik_for(scene, config), plan)
     assert len(open_all.get_segment_times()) == len(plan.keypoints)
     for t in open_all.get_segment_times():
-        np.testing.assert_allclose(fingers(open_all, t), [GRIPPER_OPEN] * 2)
+        np.testing.assert_allclose(fingers(open_all, t), [MOBILE_UR5.gripper_open] * 2)
 
 
 def test_gripper_opens_on_the_way_to_an_approach_keypoint(system, scene):
@@ -183,10 +185,10 @@ def test_gripper_opens_on_the_way_to_an_approach_keypoint(system, scene):
     assert keyframes.ok, keyframes.failures
     breaks = trajectory.get_segment_times()
     assert len(breaks) == len(plan.keypoints)  # no knot added
-    np.testing.assert_allclose(fingers(trajectory, breaks[2]), [GRIPPER_CLOSED] * 2)
-    assert 0.0 < fingers(trajectory, 0.5 * (breaks[2] + breaks[3]))[0] < GRIPPER_OPEN
+    np.testing.assert_allclose(fingers(trajectory, breaks[2]), [MOBILE_UR5.gripper_closed] * 2)
+    assert 0.0 < fingers(trajectory, 0.5 * (breaks[2] + breaks[3]))[0] < MOBILE_UR5.gripper_open
     for t in breaks[3:]:
-        np.testing.assert_allclose(fingers(trajectory, t), [GRIPPER_OPEN] * 2)
+        np.testing.assert_allclose(fingers(trajectory, t), [MOBILE_UR5.gripper_open] * 2)
 
 
 def test_unreachable_waypoint_is_reported_for_that_keypoint(system, scene):
@@ -323,7 +325,9 @@ def test_tcp_reaches_0_95_m_past_the_front_edge_and_the_edge_itself(height):
     keyframes = solve(system, plan)
     assert_reaches(keyframes, plan, height + CONFIG.ik.height)
     # The base stays outside the table's footprint.
-    assert np.all(keyframes.positions[:, 0] + BASE_FOOTPRINT[0] / 2.0 <= CONFIG.ik.base_under_table + 1e-6)
+    assert np.all(
+        keyframes.positions[:, 0] + MOBILE_UR5.base.footprint[0] / 2.0 <= CONFIG.ik.base_under_table + 1e-6
+    )
 
 
 def test_transit_keypoints_are_reached_at_their_height_and_timed_at_the_transit_speed(system, scene):

@@ -13,7 +13,7 @@ from pydrake.geometry import Role
 
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.world.robot import ACTUATED_JOINTS
+from hlp_drake.systems.world.robot import MOBILE_UR5
 from hlp_drake.systems.world.start_pose import robot_position_names
 
 mujoco = pytest.importorskip("mujoco", reason="mujoco is an optional extra (pip install -e '.[bench]')")
@@ -52,7 +52,9 @@ def test_structure(world, scenario: Scenario) -> None:
     assert sorted(robot) == sorted(robot_position_names())
     assert len(robot) == 11
     assert model.ngeom == world.inspector.NumGeometriesWithRole(Role.kProximity)
-    assert [model.joint(model.actuator_trnid[a, 0]).name for a in range(model.nu)] == list(ACTUATED_JOINTS)
+    assert [model.joint(model.actuator_trnid[a, 0]).name for a in range(model.nu)] == list(
+        MOBILE_UR5.actuated_joints
+    )
     control = scenario.controller
     assert model.actuator("base_x_motor").gainprm[0] == control.base.kp
     assert -model.actuator("wrist_3_motor").biasprm[2] == control.wrist.kd

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.util
 import math
 import subprocess
 import sys
@@ -23,29 +24,41 @@ from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
 from hlp_drake.systems.world.robot import (
-    ACTUATED_JOINTS,
-    ARM_BASE_FRAME,
-    ARM_JOINTS,
-    ARM_MOUNT,
-    BASE_BODY,
-    BASE_FOOTPRINT,
-    BASE_JOINTS,
-    DECK_HEIGHT,
-    FLANGE_FRAME,
-    GRIPPER_JOINTS,
-    GRIPPER_MIMIC_JOINTS,
-    GRIPPER_OPEN,
-    HOME_ARM_POSITIONS,
-    MOUNT_HEIGHT,
-    RISER_RADIUS,
-    ROBOT_MODEL_NAME,
-    TCP_FRAME,
-    TCP_OFFSET,
+    MOBILE_UR5,
     add_robot,
     models_directory,
     robot_joint_limits,
     set_robot_positions,
 )
+
+
+def _script(name: str):
+    """A model-writing script of ``models/robot`` (the source of the model's dimensions)."""
+    spec = importlib.util.spec_from_file_location(name, models_directory() / "robot" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+UR5_SCRIPT = _script("make_mobile_ur5")
+ACTUATED_JOINTS = MOBILE_UR5.actuated_joints
+ARM_JOINTS = MOBILE_UR5.arm_joints
+BASE_JOINTS = MOBILE_UR5.base_joints
+GRIPPER_JOINTS = (MOBILE_UR5.gripper_joint,)
+GRIPPER_MIMIC_JOINTS = MOBILE_UR5.mimic_joints
+GRIPPER_OPEN = MOBILE_UR5.gripper_open
+HOME_ARM_POSITIONS = MOBILE_UR5.home
+ROBOT_MODEL_NAME = MOBILE_UR5.name
+TCP_FRAME = MOBILE_UR5.tcp_frame
+FLANGE_FRAME = MOBILE_UR5.flange_frame
+BASE_FOOTPRINT = MOBILE_UR5.base.footprint
+ARM_BASE_FRAME = "ur5_base"
+BASE_BODY = "base_link"
+DECK_HEIGHT = UR5_SCRIPT.DECK_HEIGHT
+MOUNT_HEIGHT = UR5_SCRIPT.MOUNT_HEIGHT
+RISER_RADIUS = UR5_SCRIPT.RISER_RADIUS
+ARM_MOUNT = UR5_SCRIPT.ARM_MOUNT_XYZ
+TCP_OFFSET = UR5_SCRIPT.TCP_DEPTH
 
 # UR5 official DH parameters (d, a, alpha) and link masses (base, shoulder, ..., wrist 3).
 UR5_DH = [

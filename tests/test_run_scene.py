@@ -22,7 +22,7 @@ from hlp_drake.systems.execution.meshcat_view import camera_pose
 from hlp_drake.systems.planning.diagram import make_planning_diagram
 from hlp_drake.systems.planning.transfer import gripper_geometry
 from hlp_drake.systems.scenario import Scenario, with_conditions
-from hlp_drake.systems.world.robot import ROBOT_MODEL_NAME
+from hlp_drake.systems.world.robot import MOBILE_UR5
 from hlp_drake.taskspace import DIRECTION_VECTORS, TaskSpace
 from hlp_drake.transfer.push import ROBOT_ACTIONS, robot_alternatives, robot_plan
 from hlp_drake.transfer.rules import TransferConfig, push_rules
@@ -205,7 +205,7 @@ def test_run_scene_end_to_end_json_and_html(tmp_path):
     assert report["planner"] == "hlp" and report["robot_actuated_dofs"] == 10
     # What ran: in the header, the summary and the JSON.
     ran = {
-        "robot": ROBOT_MODEL_NAME,
+        "robot": MOBILE_UR5.name,
         "planner": "hlp",
         "execution": "open",
         "model_error_seed": None,
@@ -213,7 +213,7 @@ def test_run_scene_end_to_end_json_and_html(tmp_path):
         "scenario_file": None,
     }
     assert {key: report[key] for key in ran} == ran
-    line = f"robot {ROBOT_MODEL_NAME}, planner hlp, execution open, model error none, perception truth, "
+    line = f"robot {MOBILE_UR5.name}, planner hlp, execution open, model error none, perception truth, "
     line += "scenario built-in default"
     assert f"run: {line}\n" in result.stdout and f"ran: {line}\n" in result.stdout
     verdicts = [v for v in result.stdout.splitlines() if v.startswith("verdict: ")]
@@ -263,9 +263,9 @@ def test_what_ran_names_the_robot_planner_execution_model_error_perception_and_s
     from hlp_drake.what_ran import WhatRan
 
     plain = what_ran(Scenario())
-    assert plain == WhatRan(ROBOT_MODEL_NAME, ("hlp",), "open", None, "truth", None)
+    assert plain == WhatRan(MOBILE_UR5.name, ("hlp",), "open", None, "truth", None)
     assert plain.line() == (
-        f"robot {ROBOT_MODEL_NAME}, planner hlp, execution open, model error none, perception truth, "
+        f"robot {MOBILE_UR5.name}, planner hlp, execution open, model error none, perception truth, "
         "scenario built-in default"
     )
     changed = with_conditions(
@@ -273,11 +273,11 @@ def test_what_ran_names_the_robot_planner_execution_model_error_perception_and_s
     )
     ran = what_ran(changed, "my.yaml")
     assert ran.line() == (
-        f"robot {ROBOT_MODEL_NAME}, planner sto, execution closed, model error seed 3, perception camera, "
+        f"robot {MOBILE_UR5.name}, planner sto, execution closed, model error seed 3, perception camera, "
         "scenario my.yaml"
     )
     assert ran.to_dict() == {
-        "robot": ROBOT_MODEL_NAME,
+        "robot": MOBILE_UR5.name,
         "planner": "sto",
         "execution": "closed",
         "model_error_seed": 3,

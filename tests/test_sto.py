@@ -45,10 +45,10 @@ def test_sequence_keeps_every_keyframe_and_bounds_the_step(trajectories):
 
 def test_base_velocity_is_integrated_and_the_start_stays():
     from hlp_drake.systems.optimiser.control_sequence import BASE_COLUMNS
-    from hlp_drake.systems.world.robot import BASE_JOINTS
+    from hlp_drake.systems.world.robot import MOBILE_UR5
     from hlp_drake.systems.world.start_pose import robot_position_names
 
-    assert tuple(robot_position_names()[i] for i in BASE_COLUMNS) == BASE_JOINTS
+    assert tuple(robot_position_names()[i] for i in BASE_COLUMNS) == MOBILE_UR5.base_joints
     sequence = ControlSequence(np.array([0.0, 0.5, 1.5]), np.zeros((3, 11)))
     velocity = np.array([[0.2, -0.1, 0.05], [0.1, 0.0, 0.0]])
     moved = sequence.with_base_velocity(velocity)

@@ -20,7 +20,7 @@ from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene, SceneObject, Table, plan_view_order
 from hlp_drake.systems.planning.keyframes import PlanningModel
 from hlp_drake.systems.scenario import Scenario, load_scenario
-from hlp_drake.systems.world.robot import ACTUATED_JOINTS, BASE_FOOTPRINT, TCP_FRAME
+from hlp_drake.systems.world.robot import MOBILE_UR5
 from hlp_drake.systems.world.scene_models import (
     add_scene,
     fallen_objects,
@@ -309,7 +309,7 @@ def test_world_diagram_builds_with_named_ports(worlds, scenes, kind):
     assert world.get_name() == "world"
     plant, robot = world_plant(world)
     assert world.GetSubsystemByName("plant") is plant
-    assert plant.num_actuators() == 10 == len(ACTUATED_JOINTS)
+    assert plant.num_actuators() == 10 == len(MOBILE_UR5.actuated_joints)
     assert plant.num_positions(robot) == 11
     starts = [plant.GetJointByName(name, robot).position_start() for name in robot_position_names()]
     assert starts == list(range(starts[0], starts[0] + 11))  # the documented order of the 11 positions
@@ -339,11 +339,13 @@ def test_robot_starts_in_front_of_the_table_with_the_tcp_above_the_start(worlds,
     world, scene = worlds[kind], scenes[kind]
     config = Scenario()
     x, y, yaw = robot_base_pose(scene, config.ik)
-    assert x + BASE_FOOTPRINT[0] / 2.0 <= -config.ik.start_base_clearance + 1e-12  # front edge off the table
+    assert (
+        x + MOBILE_UR5.base.footprint[0] / 2.0 <= -config.ik.start_base_clearance + 1e-12
+    )  # front edge off the table
     assert yaw == 0.0 and y == scene.start[1]
     plant, robot = world_plant(world)
     context = plant.CreateDefaultContext()
-    X_tcp = plant.GetFrameByName(TCP_FRAME, robot).CalcPoseInWorld(context)
+    X_tcp = plant.GetFrameByName(MOBILE_UR5.tcp_frame, robot).CalcPoseInWorld(context)
     np.testing.assert_allclose(X_tcp.translation()[:2], scene.start, atol=2e-3)
     assert X_tcp.translation()[2] == pytest.approx(scene.table.height + config.ik.height, abs=2e-3)
     R = X_tcp.rotation().matrix()
@@ -405,7 +407,7 @@ def test_a_box_pushed_by_the_gripper_slides_and_stays_on_the_table():
     simulator = Simulator(diagram)
     simulator.AdvanceTo(3.5)
     plant_context = plant.GetMyContextFromRoot(simulator.get_context())
-    tcp = plant.GetFrameByName(TCP_FRAME, robot).CalcPoseInWorld(plant_context).translation()
+    tcp = plant.GetFrameByName(MOBILE_UR5.tcp_frame, robot).CalcPoseInWorld(plant_context).translation()
     assert tcp[0] == pytest.approx(scene.start[0] + 0.30, abs=5e-3)
     poses = object_planar_poses(plant, plant_context, scene)
     box = scene.obstacle("wide_box")

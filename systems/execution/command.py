@@ -13,10 +13,10 @@ from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.solvers import Solve
 
 from hlp_drake.ranges import MAX_DURATION, NonNegativeFloat, Positive, PositiveFloat
-from hlp_drake.systems.optimiser.control_sequence import BASE_COLUMNS, ControlSequence
-from hlp_drake.systems.world.robot import GRIPPER_CLOSED, GRIPPER_JOINTS, GRIPPER_MIMIC_JOINTS, TCP_FRAME
+from hlp_drake.systems.optimiser.control_sequence import ControlSequence
+from hlp_drake.systems.world.robot import MOBILE_UR5, RobotDescription
 from hlp_drake.systems.world.scene_models import object_body
-from hlp_drake.systems.world.start_pose import ik_solver_options, kinematic_robot, robot_position_names
+from hlp_drake.systems.world.start_pose import ik_solver_options, kinematic_robot
 
 if TYPE_CHECKING:
     from pydrake.systems.analysis import Simulator
@@ -59,7 +59,7 @@ class OpenLoopCommand:
         return self._sequence.duration
 
     def final(self, root_context: Context) -> np.ndarray:
-        """The reach's last knot (11 positions)."""
+        """The reach's last knot (the robot's positions)."""
         return self._sequence.knots[-1]
 
     def then(self, root_context: Context, t0: float, times: np.ndarray, knots: np.ndarray) -> None:
@@ -96,20 +96,18 @@ __all__ = ["ClosedLoopCommand", "GraspConfig", "OpenLoopCommand"]
 
 
 # The grasp after a reach: close the fingers round the target, lift it, and check that it held.
-_NAMES = robot_position_names()
-FINGER_COLUMNS = [_NAMES.index(name) for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS]
-
-
-def lifted_configuration(q: np.ndarray, height: float, *, max_iterations: int = 200) -> np.ndarray | None:
-    """Robot positions (11) with the tcp ``height`` higher than at ``q``, same orientation, the base
+def lifted_configuration(
+    q: np.ndarray, height: float, robot: RobotDescription = MOBILE_UR5, *, max_iterations: int = 200
+) -> np.ndarray | None:
+    """Robot positions with the tcp ``height`` higher than at ``q``, same orientation, the base
     and the fingers unchanged; None if the arm cannot."""
-    plant, robot = kinematic_robot()
+    plant, instance = kinematic_robot(robot)
     context = plant.CreateDefaultContext()
-    plant.SetPositions(context, robot, q)
-    tcp = plant.GetFrameByName(TCP_FRAME, robot)
+    plant.SetPositions(context, instance, q)
+    tcp = plant.GetFrameByName(robot.tcp_frame, instance)
     pose = tcp.CalcPoseInWorld(context)
     ik = InverseKinematics(plant, context, with_joint_limits=True)
-    fixed = [*BASE_COLUMNS, *FINGER_COLUMNS]
+    fixed = [*robot.base_columns, *robot.finger_columns]
     prog = ik.get_mutable_prog()
     prog.AddBoundingBoxConstraint(q[fixed], q[fixed], ik.q()[fixed])
     target = pose.translation() + np.array([0.0, 0.0, height])
@@ -120,12 +118,14 @@ def lifted_configuration(q: np.ndarray, height: float, *, max_iterations: int = 
     return result.GetSolution(ik.q()) if result.is_success() else None
 
 
-def grasp_knots(q_end: np.ndarray, grasp: GraspConfig) -> tuple[np.ndarray, np.ndarray] | None:
+def grasp_knots(
+    q_end: np.ndarray, grasp: GraspConfig, robot: RobotDescription = MOBILE_UR5
+) -> tuple[np.ndarray, np.ndarray] | None:
     """Times (after the reach's end) and robot positions of the grasp: close the fingers at the end
     pose, lift the tcp by ``grasp.lift_height``, hold. None if the lift has no IK solution."""
     closed = np.array(q_end, dtype=float)
-    closed[FINGER_COLUMNS] = GRIPPER_CLOSED
-    lifted = lifted_configuration(closed, grasp.lift_height) if grasp.lift_height > 0 else closed
+    closed[list(robot.finger_columns)] = robot.gripper_closed
+    lifted = lifted_configuration(closed, grasp.lift_height, robot) if grasp.lift_height > 0 else closed
     if lifted is None:
         return None
     times = np.cumsum([grasp.close_s, grasp.lift_s, max(grasp.hold_s, 1e-3)])
@@ -154,7 +154,7 @@ def grasp_and_lift(simulator, command, t0, scenario, plant, plant_context, scene
     """Close the fingers at the reach's end pose (from ``t0``) and lift; whether the target rose
     with the gripper."""
     root = simulator.get_mutable_context()
-    grasp = grasp_knots(command.final(root), scenario.grasp)
+    grasp = grasp_knots(command.final(root), scenario.grasp, scenario.robot)
     if grasp is None:
         return False
     times, knots = grasp

@@ -53,7 +53,6 @@ from hlp_drake.systems.optimiser.optimiser import EMPTY_RESULT, StoResult, optim
 from hlp_drake.systems.optimiser.rollout_world import RolloutStart
 from hlp_drake.systems.perception.accuracy import largest_displacement
 from hlp_drake.systems.perception.perception import Perception
-from hlp_drake.systems.world.robot import ROBOT_MODEL_NAME
 from hlp_drake.systems.world.scene_source import declare_scene_input_port, scene_input, with_scene
 
 if TYPE_CHECKING:
@@ -143,7 +142,8 @@ class RecedingHorizonController(LeafSystem):
         self._scenario, self._pool, self._initialiser = scenario, pool, initialiser
         self._plant = plant
         objects = () if scenario.perception.source == "camera" else scenario.scene.objects
-        names = [ROBOT_MODEL_NAME] + [o.name for o in objects if plant.HasModelInstanceNamed(o.name)]
+        self._robot_name = robot_name = scenario.robot.name
+        names = [robot_name] + [o.name for o in objects if plant.HasModelInstanceNamed(o.name)]
         self._instances = {n: plant.GetModelInstanceByName(n) for n in names}
         self._state = self.DeclareVectorInputPort("state", plant.num_multibody_states())
         self._scene = declare_scene_input_port(self)
@@ -152,7 +152,7 @@ class RecedingHorizonController(LeafSystem):
         )
         self._initial = self.DeclareAbstractInputPort("initial", AbstractValue.Make(EMPTY_RESULT))
         self._record = self.DeclareAbstractState(AbstractValue.Make(ControllerRecord()))
-        nq = plant.num_positions(self._instances[ROBOT_MODEL_NAME])
+        nq = plant.num_positions(self._instances[robot_name])
         self.DeclareVectorOutputPort(
             "desired_trajectory_state",
             2 * nq,
@@ -245,7 +245,7 @@ class RecedingHorizonController(LeafSystem):
         sto = self._scenario.optimiser
         initial, alternatives, initialised = rest, None, False
         if self._initialiser is not None and self._moved_far(record, t):
-            fresh = self._initialiser(record.observed, states[ROBOT_MODEL_NAME])
+            fresh = self._initialiser(record.observed, states[self._robot_name])
             if fresh is not None:
                 initial, alternatives, initialised = fresh, (lambda: [rest]), True
         budget = Budget(
@@ -309,7 +309,7 @@ class RecedingHorizonController(LeafSystem):
         record: ControllerRecord = context.get_abstract_state(int(self._record)).get_value()
         if record.sequence is None:
             x = self._state.Eval(context)
-            robot = self._instances[ROBOT_MODEL_NAME]
+            robot = self._instances[self._robot_name]
             q = self._plant.GetPositionsFromArray(robot, x[: self._plant.num_positions()])
             output.SetFromVector(np.concatenate([q, np.zeros_like(q)]))
             return

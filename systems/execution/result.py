@@ -10,7 +10,6 @@ from hlp_drake.planner import HighLevelPlan
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.perception.accuracy import match_objects
 from hlp_drake.systems.planning.keyframes import Keyframes
-from hlp_drake.systems.world.robot import ROBOT_MODEL_NAME
 from hlp_drake.what_ran import WhatRan
 
 if TYPE_CHECKING:
@@ -25,7 +24,7 @@ def what_ran(
     robot, planner (or ``planners``), execution mode, model error's seed, perception source."""
     uncertainty = scenario.uncertainty
     return WhatRan(
-        robot=ROBOT_MODEL_NAME,
+        robot=scenario.robot.name,
         planners=planners or (scenario.planner.kind,),
         execution="closed" if scenario.closed_loop.enabled else "open",
         model_error_seed=uncertainty.seed if uncertainty.enabled else None,

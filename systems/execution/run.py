@@ -41,7 +41,6 @@ from hlp_drake.systems.optimiser.rollout_world import simulation_failure
 from hlp_drake.systems.perception.accuracy import perception_record
 from hlp_drake.systems.perception.system import perceive_world
 from hlp_drake.systems.planning.keyframes import Keyframes
-from hlp_drake.systems.world.robot import TCP_FRAME
 from hlp_drake.systems.world.scene_models import fallen_objects, object_planar_poses
 from hlp_drake.systems.world.scene_source import SCENE_PORT
 from hlp_drake.systems.world.start_pose import tcp_keypoint_height
@@ -293,7 +292,7 @@ def _execute(
             and np.hypot(*np.subtract(after[n][:2], before[n][:2])) > MOVED_TOLERANCE
         ]
         result.objects_dropped = fallen_objects(plant, plant_context, scene)
-        tcp = plant.GetFrameByName(TCP_FRAME, robot).CalcPoseInWorld(plant_context).translation()
+        tcp = plant.GetFrameByName(scenario.robot.tcp_frame, robot).CalcPoseInWorld(plant_context).translation()
         inside, result.target_distance = pregrasp_check(
             tcp,
             after[scene.target.name],

@@ -1,11 +1,12 @@
 """``ControlSequence``: the optimiser's decision variable, robot positions at knots in time.
 
-A sequence of ``n`` control steps holds ``n + 1`` knots of the robot's 11 positions
-(``robot_position_names()``) at increasing times from 0, joined by straight lines (a first-order
-hold, as the paper joins its keyframes). ``from_trajectory`` keeps every keyframe of a piecewise
-trajectory and splits its segments into steps no longer than ``max_step``. The STO family's control
-of a step is the planar velocity of the holonomic base; ``with_base_velocity`` adds such per-step
-velocities to the base's positions.
+A sequence of ``n`` control steps holds ``n + 1`` knots of the robot's positions
+(``RobotDescription.position_names``) at increasing times from 0, joined by straight lines (a
+first-order hold, as the paper joins its keyframes). ``from_trajectory`` keeps every keyframe of a
+piecewise trajectory and splits its segments into steps no longer than ``max_step``. The STO
+family's control of a step is a planar velocity (x, y, heading): of a mobile base
+(``with_base_velocity``), or of a fixed arm's tcp (``with_planar_velocity``: per knot a map from a
+planar displacement to the joints', ``hlp_drake.systems.optimiser.planar_noise``).
 """
 
 from __future__ import annotations
@@ -18,12 +19,12 @@ import numpy as np
 from pydrake.trajectories import PiecewisePolynomial
 
 BASE_COLUMNS = (0, 1, 2)
-"""Columns of a knot holding the base's x, y and yaw (the first three robot positions)."""
+"""Columns of a knot holding a mobile base's x, y and yaw (its first three positions)."""
 
 
 @dataclass(frozen=True)
 class ControlSequence:
-    """Knots (n + 1, 11) of the robot's positions at ``times`` (n + 1,), which start at 0 and increase."""
+    """Knots (n + 1, positions) of the robot's positions at ``times`` (n + 1,), which start at 0 and increase."""
 
     times: np.ndarray
     knots: np.ndarray
@@ -87,8 +88,23 @@ class ControlSequence:
         knots[1:, BASE_COLUMNS] += np.cumsum(velocity * self.steps[:, None], axis=0)
         return ControlSequence(self.times, knots)
 
+    def with_planar_velocity(self, velocity: np.ndarray, maps: np.ndarray) -> ControlSequence:
+        """This sequence with a planar velocity (n, 3) added through ``maps`` (n + 1, positions, 3):
+        knot k moves by ``maps[k]`` times the integrated displacement up to it (as
+        ``with_base_velocity`` integrates; the first knot stays)."""
+        velocity = np.asarray(velocity, dtype=float)
+        if velocity.shape != (self.num_steps, 3) or maps.shape != (*self.knots.shape, 3):
+            raise ValueError(
+                f"expected ({self.num_steps}, 3) velocities and {(*self.knots.shape, 3)} maps, got "
+                f"{velocity.shape} and {maps.shape}"
+            )
+        displacement = np.cumsum(velocity * self.steps[:, None], axis=0)
+        knots = self.knots.copy()
+        knots[1:] += np.einsum("kij,kj->ki", maps[1:], displacement)
+        return ControlSequence(self.times, knots)
+
     def joint_velocities(self) -> np.ndarray:
-        """(n, 11) velocity of every position over each step."""
+        """(n, positions) velocity of every position over each step."""
         return np.diff(self.knots, axis=0) / self.steps[:, None]
 
     def effort(self) -> float:

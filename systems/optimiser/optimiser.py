@@ -34,6 +34,7 @@ from hlp_drake.systems.optimiser.budget import Budget, BudgetedRun
 from hlp_drake.systems.optimiser.config import BaseNoise, StoConfig
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.cost import RolloutOutcome
+from hlp_drake.systems.optimiser.planar_noise import planar_shift
 from hlp_drake.systems.optimiser.pool import RolloutPool, WorkersLost
 
 if TYPE_CHECKING:
@@ -255,15 +256,16 @@ def _budget_spent(run: BudgetedRun, result: StoResult, budget: Budget, elapsed_n
 def _iterate(
     run: BudgetedRun, result: StoResult, rng: np.random.Generator, sto: StoConfig, budget: Budget
 ) -> None:
-    """One iteration: noisy base velocities round the result's sequence (and, with ``mppi``, their
+    """One iteration: noisy planar velocities (``planar_shift``) round the result's sequence (and, with ``mppi``, their
     weighted mean) rolled out; the best is accepted if it passes or costs less (monotone)."""
     best, outcome = result.sequence, result.outcome
     noise = sample_base_noise(rng, best, sto.noise, budget.samples)
-    candidates = [best.with_base_velocity(v) for v in noise]
+    shift = planar_shift(run.scenario.robot, best)
+    candidates = [shift(v) for v in noise]
     outcomes = run.roll(candidates)
     if sto.update == "mppi":
         weights = mppi_weights(np.array([o.cost for o in outcomes]), sto.mppi_temperature)
-        mean = best.with_base_velocity(np.einsum("k,knj->nj", weights, noise))
+        mean = shift(np.einsum("k,knj->nj", weights, noise))
         candidates.append(mean)
         outcomes.extend(run.roll([mean]))
     run.settle(candidates, outcomes, np.argsort([o.cost for o in outcomes], kind="stable"))

@@ -44,7 +44,6 @@ from hlp_drake.systems.optimiser.sampler import (
     sample_rollout,
 )
 from hlp_drake.systems.optimiser.sleep import AWAKE, ProximityContext
-from hlp_drake.systems.world.robot import TCP_FRAME
 from hlp_drake.systems.world.scene_models import TABLE_NAME, object_body, over_table_mask
 from hlp_drake.systems.world.start_pose import tcp_keypoint_height
 from hlp_drake.systems.world.world import add_position_trajectory, make_world_diagram, world_plant
@@ -113,7 +112,7 @@ class RolloutWorld:
         }
         self._table_bodies = {int(i) for i in plant.GetBodyIndices(plant.GetModelInstanceByName(TABLE_NAME))}
         self.robot_bodies = {int(i) for i in plant.GetBodyIndices(robot)}
-        self._tcp = plant.GetFrameByName(TCP_FRAME, robot)
+        self._tcp = plant.GetFrameByName(scenario.robot.tcp_frame, robot)
         self._tcp_height = tcp_keypoint_height(scene, scenario.ik)
         inspector = world.GetSubsystemByName("scene_graph").model_inspector()
         self.geometry_body = {

@@ -90,7 +90,7 @@ class PlanningModel:
     def __init__(self, scenario: Scenario, *, with_objects: bool = True) -> None:
         builder = DiagramBuilder()
         plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-        self.robot = add_robot(plant)
+        self.robot = add_robot(plant, scenario.robot)
         self.scene_models: SceneModels = add_scene(
             plant,
             scenario.scene,

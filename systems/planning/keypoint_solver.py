@@ -34,21 +34,7 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from hlp_drake.planner.plan import HighLevelPlan, PlanKeypoint
 from hlp_drake.systems.planning.keyframes import Keyframes, PlanningModel, describe_keypoint
-from hlp_drake.systems.world.robot import (
-    ARM_JOINTS,
-    BASE_FOOTPRINT,
-    BASE_JOINTS,
-    GRIPPER_CLOSED,
-    GRIPPER_JOINTS,
-    GRIPPER_MIMIC_JOINTS,
-    TCP_FRAME,
-)
-from hlp_drake.systems.world.start_pose import (
-    ik_solver_options,
-    robot_position_names,
-    start_configuration,
-    tcp_keypoint_height,
-)
+from hlp_drake.systems.world.start_pose import ik_solver_options, start_configuration, tcp_keypoint_height
 from hlp_drake.transfer.push import TRANSFERRED
 
 if TYPE_CHECKING:
@@ -87,11 +73,12 @@ class KeypointSolver:
         plant, robot = self._model.plant, self._model.robot
         self._plant = plant
         self._robot = robot
-        self._tcp = plant.GetFrameByName(TCP_FRAME, robot)
+        self._robot_description = description = scenario.robot
+        self._tcp = plant.GetFrameByName(description.tcp_frame, robot)
         if plant.num_positions() != plant.num_positions(robot):
             raise RuntimeError("the planning model must have no positions besides the robot's")
-        self._start = start_configuration(scene, scenario.ik, plant, robot)
-        self._names = robot_position_names()
+        self._start = start_configuration(scene, scenario.ik, plant, robot, description)
+        self._names = description.position_names
         self._index = {name: plant.GetJointByName(name, robot).position_start() for name in self._names}
         if list(self._index.values()) != list(range(len(self._names))):
             raise RuntimeError(f"unexpected position order of the robot: {self._index}")
@@ -102,13 +89,14 @@ class KeypointSolver:
         self._upper = plant.GetPositionUpperLimits().copy()
         ik = self._config.ik
         table = scene.table
-        self._upper[self._index[BASE_JOINTS[0]]] = ik.base_under_table - BASE_FOOTPRINT[0] / 2.0
-        y_limit = table.width / 2.0 + ik.base_lateral_margin
-        self._lower[self._index[BASE_JOINTS[1]]] = -y_limit
-        self._upper[self._index[BASE_JOINTS[1]]] = y_limit
-        yaw = self._index[BASE_JOINTS[2]]
-        self._lower[yaw], self._upper[yaw] = -ik.base_max_yaw, ik.base_max_yaw
-        self._gripper = [self._index[name] for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS]
+        self._base = [self._index[name] for name in description.base_joints]
+        if self._base:  # a mobile base's workspace
+            x, y, yaw = self._base
+            self._upper[x] = ik.base_under_table - description.base.footprint[0] / 2.0
+            y_limit = table.width / 2.0 + ik.base_lateral_margin
+            self._lower[y], self._upper[y] = -y_limit, y_limit
+            self._lower[yaw], self._upper[yaw] = -ik.base_max_yaw, ik.base_max_yaw
+        self._gripper = [self._index[name] for name in description.gripper_joints]
         for i in self._gripper:  # keep the gripper as at the start (open)
             self._lower[i] = self._upper[i] = self._start[i]
         self._height = tcp_keypoint_height(scene, ik)
@@ -206,12 +194,17 @@ class KeypointSolver:
         height = self._height if keypoint.height is None else self._scene.table.height + keypoint.height
         return np.array([keypoint.position[0], keypoint.position[1], height], dtype=float)
 
-    def _shifted(self, plant_context: Context, reference: np.ndarray, target: np.ndarray) -> np.ndarray:
-        """``reference`` with the base moved by the tcp's offset to ``target`` (clipped to the bounds)."""
+    def _shifted(
+        self, plant_context: Context, reference: np.ndarray, target: np.ndarray
+    ) -> np.ndarray | None:
+        """``reference`` with a mobile base moved by the tcp's offset to ``target`` (clipped to the
+        bounds); None for a fixed base."""
+        if not self._base:
+            return None
         shifted = reference.copy()
         shift = target - self.tcp_position(plant_context, reference)
-        shifted[self._index[BASE_JOINTS[0]]] += shift[0]
-        shifted[self._index[BASE_JOINTS[1]]] += shift[1]
+        shifted[self._base[0]] += shift[0]
+        shifted[self._base[1]] += shift[1]
         return np.clip(shifted, self._lower, self._upper)
 
     def _continued(
@@ -271,7 +264,7 @@ class KeypointSolver:
             )
         prog.AddQuadraticErrorCost(np.eye(len(previous)), previous, q)
         # A weak pull towards the start posture of the arm keeps it from folding up over many keypoints.
-        arm = [self._index[name] for name in ARM_JOINTS]
+        arm = [self._index[name] for name in self._robot_description.arm_joints]
         prog.AddQuadraticErrorCost(POSTURE_WEIGHT * np.eye(len(arm)), self._start[arm], q[arm])
         return prog, q
 
@@ -300,8 +293,10 @@ class KeypointSolver:
             result = Solve(loose, previous, self._options)
             if result.is_success():
                 yield result.GetSolution(loose_q), prog, q
-            yield self._shifted(plant_context, previous, target), prog, q
-            yield self._shifted(plant_context, self._start, target), prog, q
+            for reference in (previous, self._start):
+                shifted = self._shifted(plant_context, reference, target)
+                if shifted is not None:
+                    yield shifted, prog, q
             continued = self._continued(plant_context, previous, target)
             if continued is not None:  # its last step: the cost pulls towards the last posture on the way
                 yield continued, *self._program(plant_context, target, continued, clearance=True)
@@ -342,7 +337,7 @@ class KeypointSolver:
             if not ok:
                 continue
             if motion.closed_among_obstacles and keypoint.action not in ("start", *GRASP_ACTIONS):
-                q = self._with_gripper(q, GRIPPER_CLOSED)
+                q = self._with_gripper(q, self._robot_description.gripper_closed)
             elif keypoint.action == "target" and np.any(knots[-1][self._gripper] != q[self._gripper]):
                 knots.append(self._with_gripper(knots[-1], q[self._gripper][0]))  # open before sliding on
                 lifted.append(lifted[-1])

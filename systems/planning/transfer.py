@@ -20,14 +20,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
 from hlp_drake.planner import HighLevelPlan
-from hlp_drake.systems.world.robot import (
-    FLANGE_FRAME,
-    GRIPPER_JOINTS,
-    GRIPPER_MIMIC_JOINTS,
-    GRIPPER_OPEN,
-    TCP_FRAME,
-    add_robot,
-)
+from hlp_drake.systems.world.robot import MOBILE_UR5, RobotDescription, add_robot
 from hlp_drake.systems.world.scene_source import declare_scene_input_port, scene_input
 from hlp_drake.transfer.push import robot_alternatives, robot_plan
 from hlp_drake.transfer.rules import SIZE_RESOLUTION, GripperGeometry, PushRules, length, push_rules
@@ -56,23 +49,24 @@ def _extent(plant, scene_graph, context, bodies, frame) -> np.ndarray:
     return np.array([corners.min(axis=0), corners.max(axis=0)])
 
 
-@functools.cache
-def gripper_geometry() -> GripperGeometry:
-    """The robot's sizes, read from its model's collision geometry with the fingers open (once)."""
+@functools.lru_cache(maxsize=4)
+def gripper_geometry(robot: RobotDescription = MOBILE_UR5) -> GripperGeometry:
+    """The robot's sizes, read from its model's collision geometry with the fingers open (once per robot)."""
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-    robot = add_robot(plant)
+    instance = add_robot(plant, robot)
     plant.Finalize()
     diagram = builder.Build()
     context = plant.GetMyMutableContextFromRoot(diagram.CreateDefaultContext())
-    for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS:
-        plant.GetJointByName(name, robot).set_translation(context, GRIPPER_OPEN)
-    tcp = plant.GetFrameByName(TCP_FRAME, robot)
-    fingers = [plant.GetBodyByName(name, robot) for name in ("left_finger_link", "right_finger_link")]
+    for name in robot.gripper_joints:
+        plant.GetJointByName(name, instance).set_translation(context, robot.gripper_open)
+    tcp = plant.GetFrameByName(robot.tcp_frame, instance)
+    fingers = [plant.GetBodyByName(name, instance) for name in robot.finger_links]
     finger_box = _extent(plant, scene_graph, context, fingers, tcp)
-    offset = plant.GetFrameByName(FLANGE_FRAME, robot).CalcPose(context, tcp).translation()
-    wrist = plant.GetBodyByName("wrist_3_link", robot)
-    wrist_box = _extent(plant, scene_graph, context, [wrist], plant.GetFrameByName(FLANGE_FRAME, robot))
+    flange = plant.GetFrameByName(robot.flange_frame, instance)
+    offset = flange.CalcPose(context, tcp).translation()
+    wrist = plant.GetBodyByName(robot.wrist_link, instance)
+    wrist_box = _extent(plant, scene_graph, context, [wrist], flange)
     return GripperGeometry(
         tcp_offset=_rounded_up(float(np.linalg.norm(offset))),
         fingertip_reach=_rounded_up(float(finger_box[1, 2])),
@@ -86,7 +80,7 @@ class RobotPlanTransfer(LeafSystem):
 
     def __init__(self, scenario: Scenario) -> None:
         super().__init__()
-        rules = push_rules(scenario.transfer, gripper_geometry())
+        rules = push_rules(scenario.transfer, gripper_geometry(scenario.robot))
         limit = scenario.optimiser.alternatives
         self._rules = rules
         self._scene_port = declare_scene_input_port(self)

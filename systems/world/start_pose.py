@@ -1,9 +1,10 @@
 """The robot's start pose and the kinematics it is solved on (shared by the world, IK and the grasp).
 
 Frames and start pose: the world frame is the scene's (z up, x into the table from the middle of its
-front edge). The robot's base starts in front of the table facing +x; at the start the gripper
-points along +x (horizontal approach), fingers opening along y, its tcp above ``scene.start`` at
-``ik.height`` above the table top (``scene.start_yaw`` is not used: the gripper faces +x).
+front edge). A mobile base starts in front of the table facing +x, a fixed one stands where its
+description puts it; at the start the gripper points along +x (horizontal approach), fingers
+opening along y, its tcp above ``scene.start`` at ``ik.height`` above the table top
+(``scene.start_yaw`` is not used: the gripper faces +x).
 """
 
 from __future__ import annotations
@@ -21,36 +22,31 @@ from pydrake.solvers import SnoptSolver, Solve, SolverOptions
 
 from hlp_drake.errors import HlpError
 from hlp_drake.scene.model import Scene
-from hlp_drake.systems.world.robot import (
-    ARM_JOINTS,
-    BASE_FOOTPRINT,
-    BASE_JOINTS,
-    GRIPPER_JOINTS,
-    GRIPPER_MIMIC_JOINTS,
-    GRIPPER_OPEN,
-    HOME_ARM_POSITIONS,
-    TCP_FRAME,
-    add_robot,
-)
+from hlp_drake.systems.world.robot import MOBILE_UR5, RobotDescription, add_robot
 
 if TYPE_CHECKING:
     from hlp_drake.systems.planning.ik import IkConfig
 
 
-def robot_position_names() -> tuple[str, ...]:
-    """The joints of the robot's 11 positions, in model-instance order: the 10 actuated, then the mimic."""
-    return BASE_JOINTS + ARM_JOINTS + GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS
+def robot_position_names(robot: RobotDescription = MOBILE_UR5) -> tuple[str, ...]:
+    """The joints of the robot's positions, in model-instance order: the actuated, then the mimics."""
+    return robot.position_names
 
 
-def robot_base_pose(scene: Scene, ik: IkConfig) -> tuple[float, float, float]:
-    """(x, y, yaw) of the base at the start: in front of the table, facing +x, behind ``scene.start``.
+def robot_base_pose(
+    scene: Scene, ik: IkConfig, robot: RobotDescription = MOBILE_UR5
+) -> tuple[float, float, float]:
+    """(x, y, yaw) of the base at the start: a fixed base's pose; a mobile base in front of the
+    table, facing +x, behind ``scene.start``.
 
-    The base's centre stands ``ik.start_reach`` behind the start point on its line, but never closer
-    to the table than ``ik.start_base_clearance`` (its front edge then stays at x <= -clearance,
-    outside the table's footprint).
+    A mobile base's centre stands ``ik.start_reach`` behind the start point on its line, but never
+    closer to the table than ``ik.start_base_clearance`` (its front edge then stays at
+    x <= -clearance, outside the table's footprint).
     """
+    if not robot.mobile:
+        return tuple(float(v) for v in robot.base.pose)
     start_x, start_y = scene.start
-    x = min(start_x - ik.start_reach, -(BASE_FOOTPRINT[0] / 2.0 + ik.start_base_clearance))
+    x = min(start_x - ik.start_reach, -(robot.base.footprint[0] / 2.0 + ik.start_base_clearance))
     return (float(x), float(start_y), 0.0)
 
 
@@ -68,11 +64,11 @@ def tcp_keypoint_height(scene: Scene, ik: IkConfig) -> float:
     return scene.table.height + ik.height
 
 
-@functools.lru_cache(maxsize=1)
-def kinematic_robot() -> tuple[MultibodyPlant, ModelInstanceIndex]:
-    """A robot-only continuous plant for kinematics (built once, shared; do not modify it)."""
+@functools.lru_cache(maxsize=4)
+def kinematic_robot(robot: RobotDescription = MOBILE_UR5) -> tuple[MultibodyPlant, ModelInstanceIndex]:
+    """A robot-only continuous plant for kinematics (built once per robot, shared; do not modify it)."""
     plant = MultibodyPlant(time_step=0.0)
-    instance = add_robot(plant)
+    instance = add_robot(plant, robot)
     plant.Finalize()
     return plant, instance
 
@@ -99,39 +95,47 @@ def ik_solver_options(max_iterations: int) -> SolverOptions:
 
 
 def start_configuration(
-    scene: Scene, ik: IkConfig, plant: MultibodyPlant, instance: ModelInstanceIndex
+    scene: Scene,
+    ik: IkConfig,
+    plant: MultibodyPlant,
+    instance: ModelInstanceIndex,
+    robot: RobotDescription = MOBILE_UR5,
 ) -> np.ndarray:
-    """The robot's 11 start positions, in ``plant``'s order for ``instance`` (as ``SetPositions`` takes them).
+    """The robot's start positions, in ``plant``'s order for ``instance`` (as ``SetPositions`` takes them).
 
-    The base stands at ``robot_base_pose(scene, ik)``; the arm (solved by IK on a robot-only
-    kinematic model, seeded and regularised towards the ready pose ``HOME_ARM_POSITIONS``) puts the
-    tcp above ``scene.start`` at ``ik.height`` above the table top, pointing along +x with the
-    fingers opening along y; the gripper is open.
+    The base stands at ``robot_base_pose(scene, ik, robot)``; the arm (solved by IK on a robot-only
+    kinematic model, seeded and regularised towards ``robot.home``) puts the tcp above
+    ``scene.start`` at ``ik.height`` above the table top, pointing along +x with the fingers opening
+    along y; the gripper is open.
 
     Raises:
         HlpError: the start point is out of the arm's reach from that base pose.
     """
-    base = robot_base_pose(scene, ik)
-    arm = _start_arm(
-        round(base[0] - scene.start[0], 9),
-        round(tcp_keypoint_height(scene, ik), 9),
-        ik.max_iterations,
-    )
+    base = robot_base_pose(scene, ik, robot)
+    if robot.mobile:  # solved relative to the base: one solve serves every start on the same line
+        target = (round(scene.start[0] - base[0], 9), 0.0, round(tcp_keypoint_height(scene, ik), 9))
+    else:
+        target = (*(round(float(v), 9) for v in scene.start), round(tcp_keypoint_height(scene, ik), 9))
+    arm = _start_arm(robot, target, ik.max_iterations)
     if arm is None:
+        where = "the base pose" if robot.mobile else f"robot {robot.name}'s base (robot.base.pose)"
         raise HlpError(
             f"scene {scene.name or '<unnamed>'}: the arm cannot put the tcp above the start "
             f"{tuple(scene.start)} at height {tcp_keypoint_height(scene, ik):.3f} m "
-            f"from the base pose {base}"
+            f"from {where} {base}: out of its reach"
         )
-    values = dict(zip(BASE_JOINTS + ARM_JOINTS, (*base, *arm)))
-    values.update({name: GRIPPER_OPEN for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS})
+    values = dict(zip(robot.base_joints + robot.arm_joints, (*base, *arm)))
+    values.update({name: robot.gripper_open for name in robot.gripper_joints})
     return _to_plant_order(plant, instance, values)
 
 
 @functools.lru_cache(maxsize=64)
-def _start_arm(base_offset_x: float, tcp_z: float, max_iterations: int) -> tuple[float, ...] | None:
-    """Arm angles putting the tcp ``-base_offset_x`` ahead of the base at height ``tcp_z`` (cached)."""
-    plant, instance = kinematic_robot()
+def _start_arm(
+    robot: RobotDescription, target: tuple[float, float, float], max_iterations: int
+) -> tuple[float, ...] | None:
+    """Arm angles putting the tcp at ``target`` (a mobile base at the origin; a fixed one where it
+    stands), horizontal along +x (cached)."""
+    plant, instance = kinematic_robot(robot)
     context = plant.CreateDefaultContext()
     ik = InverseKinematics(plant, context, with_joint_limits=True)
     q = ik.q()
@@ -139,18 +143,20 @@ def _start_arm(base_offset_x: float, tcp_z: float, max_iterations: int) -> tuple
         plant,
         instance,
         {
-            **dict(zip(BASE_JOINTS + ARM_JOINTS, (0.0, 0.0, 0.0, *HOME_ARM_POSITIONS))),
-            **{name: GRIPPER_OPEN for name in GRIPPER_JOINTS + GRIPPER_MIMIC_JOINTS},
+            **dict(
+                zip(robot.base_joints + robot.arm_joints, (0.0,) * len(robot.base_joints) + tuple(robot.home))
+            ),
+            **{name: robot.gripper_open for name in robot.gripper_joints},
         },
     )
     fixed = np.full(len(seed), True)
-    for name in ARM_JOINTS:
+    for name in robot.arm_joints:
         fixed[plant.GetJointByName(name, instance).position_start()] = False
     prog = ik.get_mutable_prog()
     prog.AddBoundingBoxConstraint(seed[fixed], seed[fixed], q[fixed])
-    tcp = plant.GetFrameByName(TCP_FRAME, instance)
-    target = np.array([-base_offset_x, 0.0, tcp_z])
-    ik.AddPositionConstraint(tcp, np.zeros(3), plant.world_frame(), target - 1e-4, target + 1e-4)
+    tcp = plant.GetFrameByName(robot.tcp_frame, instance)
+    goal = np.array(target)
+    ik.AddPositionConstraint(tcp, np.zeros(3), plant.world_frame(), goal - 1e-4, goal + 1e-4)
     ik.AddOrientationConstraint(plant.world_frame(), tcp_rotation(0.0), tcp, RotationMatrix(), 1e-3)
     prog.AddQuadraticErrorCost(np.eye(int(np.sum(~fixed))), seed[~fixed], q[~fixed])
     result = Solve(prog, seed, ik_solver_options(max_iterations))
@@ -158,5 +164,5 @@ def _start_arm(base_offset_x: float, tcp_z: float, max_iterations: int) -> tuple
         return None
     solution = result.GetSolution(q)
     return tuple(
-        float(solution[plant.GetJointByName(name, instance).position_start()]) for name in ARM_JOINTS
+        float(solution[plant.GetJointByName(name, instance).position_start()]) for name in robot.arm_joints
     )

@@ -1,23 +1,25 @@
-"""The simulated world: the mobile UR5, a scene's table and free objects, and the robot's PD control.
+"""The simulated world: the scenario's robot, a scene's table and free objects, and the robot's PD control.
 
 ``make_world_diagram(scenario)`` returns a Diagram named ``world`` with these exported ports:
 
 Input:
-    ``robot.desired_state`` (20): desired positions then velocities of the robot's 10 actuated joints
-        in actuator order (``ACTUATED_JOINTS``: base x, y, yaw, the six UR5 joints, the left finger),
-        fed to the plant's PD-controlled actuators. Left unconnected, the controllers are disarmed
-        (only gravity compensation acts). ``desired_state_from_robot_state`` /
-        ``add_position_trajectory`` map the robot's 11 positions (with the mimic finger) onto it.
+    ``robot.desired_state``: desired positions then velocities of the robot's actuated joints in
+        actuator order (``RobotDescription.actuated_joints``: a mobile base's x, y, yaw, the arm, the
+        actuated finger; 20 for the mobile UR5), fed to the plant's PD-controlled actuators. Left
+        unconnected, the controllers are disarmed (only gravity compensation acts).
+        ``desired_state_from_robot_state`` / ``add_position_trajectory`` map the robot's positions
+        (with the mimic fingers) onto it.
 
 Outputs:
-    ``robot.state`` (22): the robot's 11 positions then 11 velocities (``robot_position_names``).
+    ``robot.state``: the robot's positions then velocities (``RobotDescription.position_names``; 22
+        for the mobile UR5).
     ``state``: the whole plant's state (robot and free objects).
     ``body_poses``: ``list[RigidTransform]`` of every body's world pose, by body index.
     ``contact_results``: the plant's ``ContactResults``.
     ``query_object``: SceneGraph's ``QueryObject`` (distance and collision queries).
 
 The plant is the subsystem ``plant`` (``world.GetSubsystemByName("plant")``) and the SceneGraph
-``scene_graph``; the robot is the model instance ``ROBOT_MODEL_NAME``. The default context has the
+``scene_graph``; the robot is the model instance ``scenario.robot.name``. The default context has the
 robot in ``start_configuration`` (``hlp_drake.systems.world.start_pose``) and every object at rest on the
 table at its scene pose.
 """
@@ -50,7 +52,7 @@ from pydrake.trajectories import Trajectory
 
 from hlp_drake.ranges import MAX_TIME_STEP, MIN_TIME_STEP, Fields, NonNegativeFloat, Positive, Rule
 from hlp_drake.systems.perception.cameras import add_cameras, label_classes
-from hlp_drake.systems.world.robot import ARM_JOINTS, BASE_JOINTS, GRIPPER_JOINTS, ROBOT_MODEL_NAME, add_robot
+from hlp_drake.systems.world.robot import RobotDescription, add_robot
 from hlp_drake.systems.world.scene_models import ContactConfig, add_scene
 from hlp_drake.systems.world.start_pose import robot_position_names, start_configuration
 
@@ -58,8 +60,8 @@ if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
     from hlp_drake.systems.world.uncertainty import WorldPerturbation
 
-GRIPPER_BODIES = ("gripper_base_link", "left_finger_link", "right_finger_link")
-WRIST_JOINTS = ARM_JOINTS[3:]
+WRIST_JOINTS = 3
+"""The arm's last joints that take ``controller.wrist``'s gains."""
 DESIRED_STATE_PORT = "robot.desired_state"
 SAP_APPROXIMATIONS = ("sap", "lagged", "similar")
 """Discrete contact approximations solved by SAP (TAMSI, "tamsi", cannot simulate the mimic finger)."""
@@ -112,10 +114,10 @@ class ControlConfig:
     """The robot's joint PD controllers (Drake's PD-controlled actuators, implicit in SAP).
 
     Attributes:
-        base: gains of the base's x and y joints (N/m, N s/m).
-        base_yaw: gains of the base's yaw joint.
-        arm: gains of the UR5's shoulder and elbow joints.
-        wrist: gains of the UR5's three wrist joints.
+        base: gains of a mobile base's x and y joints (N/m, N s/m).
+        base_yaw: gains of its yaw joint.
+        arm: gains of the arm's joints before the wrist.
+        wrist: gains of the arm's last three joints.
         gripper: gains of the actuated finger.
         gravity_compensation: add the robot's gravity torques as feed-forward actuation (computed on
             a robot-only model), so the arm holds its commanded pose without steady-state sag.
@@ -130,7 +132,11 @@ class ControlConfig:
 
 
 def _set_robot_contact(
-    plant: MultibodyPlant, scene_graph: SceneGraph, instance: ModelInstanceIndex, contact: ContactConfig
+    plant: MultibodyPlant,
+    scene_graph: SceneGraph,
+    instance: ModelInstanceIndex,
+    contact: ContactConfig,
+    robot: RobotDescription,
 ) -> None:
     """Give every robot collision geometry the configured stiffness and dissipation, and the gripper
     its friction (the other links keep the model's friction)."""
@@ -145,7 +151,7 @@ def _set_robot_contact(
             }
             if contact.relaxation_time > 0:
                 material["relaxation_time"] = contact.relaxation_time
-            if body.name() in GRIPPER_BODIES:
+            if body.name() in robot.gripper_links:
                 material["coulomb_friction"] = CoulombFriction(
                     contact.gripper_friction, contact.gripper_friction
                 )
@@ -171,13 +177,16 @@ def _filter_robot_self_contact(
     )
 
 
-def _set_pd_gains(plant: MultibodyPlant, instance: ModelInstanceIndex, control: ControlConfig) -> None:
+def _set_pd_gains(
+    plant: MultibodyPlant, instance: ModelInstanceIndex, control: ControlConfig, robot: RobotDescription
+) -> None:
     """Make every actuator of ``instance`` PD-controlled (before ``Finalize``)."""
-    groups = {name: control.base for name in BASE_JOINTS[:2]}
-    groups[BASE_JOINTS[2]] = control.base_yaw
-    groups.update({name: control.arm for name in ARM_JOINTS[:3]})
-    groups.update({name: control.wrist for name in WRIST_JOINTS})
-    groups.update({name: control.gripper for name in GRIPPER_JOINTS})
+    base, arm = robot.base_joints, robot.arm_joints
+    groups = {name: control.base for name in base[:2]}
+    groups.update({name: control.base_yaw for name in base[2:]})
+    groups.update({name: control.arm for name in arm[:-WRIST_JOINTS]})
+    groups.update({name: control.wrist for name in arm[-WRIST_JOINTS:]})
+    groups[robot.gripper_joint] = control.gripper
     seen = set()
     for i in range(plant.num_actuators()):
         actuator = plant.get_joint_actuator(JointActuatorIndex(i))
@@ -219,7 +228,7 @@ def actuated_state_selector(plant: MultibodyPlant, instance: ModelInstanceIndex)
 def desired_state_from_robot_state(
     plant: MultibodyPlant, instance: ModelInstanceIndex, q: np.ndarray, v: np.ndarray | None = None
 ) -> np.ndarray:
-    """The ``robot.desired_state`` vector holding the robot at positions ``q`` (11) with velocities ``v``."""
+    """The ``robot.desired_state`` vector holding the robot at positions ``q`` with velocities ``v``."""
     q = np.asarray(q, dtype=float)
     v = np.zeros(plant.num_velocities(instance)) if v is None else np.asarray(v, dtype=float)
     return actuated_state_selector(plant, instance) @ np.concatenate([q, v])
@@ -280,9 +289,9 @@ def make_world_diagram(
     scales = None if model_error is None else model_error.scales()
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlant(scenario.plant, builder)
-    instance = add_robot(plant)
-    _set_robot_contact(plant, scene_graph, instance, scenario.contact)
-    _set_pd_gains(plant, instance, scenario.controller)
+    instance = add_robot(plant, scenario.robot)
+    _set_robot_contact(plant, scene_graph, instance, scenario.contact, scenario.robot)
+    _set_pd_gains(plant, instance, scenario.controller, scenario.robot)
     models = add_scene(
         plant,
         scene,
@@ -297,7 +306,9 @@ def make_world_diagram(
     if cameras or (cameras is None and scenario.perception.source == "camera"):
         label_classes(plant, scene_graph, instance, models, scene)
         add_cameras(builder, scene_graph, scenario)
-    plant.SetDefaultPositions(instance, start_configuration(scene, scenario.ik, plant, instance))
+    plant.SetDefaultPositions(
+        instance, start_configuration(scene, scenario.ik, plant, instance, scenario.robot)
+    )
 
     if scenario.controller.gravity_compensation:
         _add_gravity_compensation(builder, plant, instance)
@@ -321,14 +332,19 @@ def make_world_diagram(
 
 
 def world_plant(diagram: Diagram) -> tuple[MultibodyPlant, ModelInstanceIndex]:
-    """The world diagram's plant and the robot's model instance."""
+    """The world diagram's plant and the robot's model instance (the first with actuators)."""
     plant = diagram.GetSubsystemByName("plant")
-    return plant, plant.GetModelInstanceByName(ROBOT_MODEL_NAME)
+    return plant, robot_instance(plant)
+
+
+def robot_instance(plant: MultibodyPlant) -> ModelInstanceIndex:
+    """The robot's model instance in a world's plant: the one model with actuators."""
+    return plant.get_joint_actuator(JointActuatorIndex(0)).model_instance()
 
 
 def connect_robot_command(builder: DiagramBuilder, world: Diagram, port: OutputPort, *, name: str) -> None:
-    """Drive ``world``'s ``robot.desired_state`` from ``port``: the robot's 11 positions then their
-    velocities (22, e.g. a ``TrajectorySource``'s with its derivative), through a selection gain
+    """Drive ``world``'s ``robot.desired_state`` from ``port``: the robot's positions then their
+    velocities (e.g. a ``TrajectorySource``'s with its derivative), through a selection gain
     named ``{name}_to_desired_state``. ``world`` must already be in ``builder``."""
     plant, instance = world_plant(world)
     select = builder.AddNamedSystem(
@@ -341,7 +357,7 @@ def connect_robot_command(builder: DiagramBuilder, world: Diagram, port: OutputP
 def add_position_trajectory(
     builder: DiagramBuilder, world: Diagram, trajectory: Trajectory, *, name: str = "robot_trajectory"
 ) -> TrajectorySource:
-    """Drive ``world``'s ``robot.desired_state`` from a trajectory of the robot's 11 positions.
+    """Drive ``world``'s ``robot.desired_state`` from a trajectory of the robot's positions.
 
     ``world`` must already be in ``builder``. Adds a C++ ``TrajectorySource`` (positions and their
     derivative; ``connect_robot_command``); swap trajectories per rollout with ``UpdateTrajectory``.
@@ -365,6 +381,7 @@ __all__ = [
     "default_plant_config",
     "desired_state_from_robot_state",
     "make_world_diagram",
+    "robot_instance",
     "robot_position_names",
     "world_plant",
 ]

@@ -127,6 +127,20 @@ def drake_logging(verbose: bool) -> None:
     logging.getLogger("drake").setLevel(logging.INFO if verbose else logging.WARNING)
 
 
+SHIPPED_ROBOTS = ("mobile_ur5", "panda", "iiwa14")
+"""The robots the project ships (``models/robot/NAME.yaml``; ``hlp_drake.systems.load_robot``)."""
+
+
+def add_robot_option(parser: argparse.ArgumentParser) -> None:
+    """``--robot NAME|FILE``: run a shipped robot or a description file's (the scenario's ``robot``)."""
+    parser.add_argument(
+        "--robot",
+        metavar="NAME|FILE",
+        help=f"the robot: one of {', '.join(SHIPPED_ROBOTS)} (default: the scenario's, mobile_ur5) or a "
+        "robot description .yaml file (see the README, 'Your own robot')",
+    )
+
+
 PERCEPTION_SOURCES = ("truth", "camera")
 """``perception.source``'s values (``hlp_drake.systems.perception.cameras``'s, without importing Drake)."""
 

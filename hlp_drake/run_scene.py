@@ -35,6 +35,7 @@ from hlp_drake.cli import (
     MAX_WORKERS,
     add_conditions,
     add_perception,
+    add_robot_option,
     add_verbosity,
     drake_logging,
     integer,
@@ -128,6 +129,7 @@ def _parser():
         "baseline's straight line (sto)",
     )
     add_perception(parser)
+    add_robot_option(parser)
     parser.add_argument(
         "--config",
         metavar="SCENARIO.yaml",
@@ -161,17 +163,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     from hlp_drake.scene.io import load_scene
 
     scene = None
-    if args.kind is not None:
-        scene = generate_scene(args.kind, args.seed or 0, args.objects)
-    elif args.scene is not None or args.config is None:
+    if args.kind is None and (args.scene is not None or args.config is None):
         scene = load_scene(args.scene or DEFAULT_SCENE)
-    if scene is not None:
         _print(f"scene {scene.name}: {len(scene.obstacles)} obstacles")
 
     drake_logging(args.verbose)  # Drake is imported from here on
     from hlp_drake.systems.scenario import load_scenario, with_conditions
 
-    scenario = load_scenario(args.config)
+    scenario = with_conditions(load_scenario(args.config), robot=args.robot)
+    if args.kind is not None:  # generated for the robot: a fixed one's table within its reach
+        scene = generate_scene(args.kind, args.seed or 0, args.objects, scenario.robot.workspace)
+        _print(f"scene {scene.name}: {len(scene.obstacles)} obstacles")
     scenario = replace(
         scenario,
         scene=scene or scenario.scene,
@@ -179,7 +181,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         optimiser=replace(scenario.optimiser, workers=args.workers or scenario.optimiser.workers),
     )
     scenario = with_conditions(
-        scenario, execution=args.execution, uncertainty=args.uncertainty, perception=args.perception
+        scenario,
+        execution=args.execution,
+        uncertainty=args.uncertainty,
+        perception=args.perception,
     )
     if scene is None:
         _print(f"scene {scenario.scene.name}: {len(scenario.scene.obstacles)} obstacles")

@@ -28,6 +28,7 @@ from hlp_drake.cli import (
     MAX_WORKERS,
     add_conditions,
     add_perception,
+    add_robot_option,
     add_verbosity,
     drake_logging,
     integer,
@@ -88,6 +89,7 @@ def _parser() -> argparse.ArgumentParser:
         help="scenario settings (see hlp_drake.systems.Scenario); each job has its own scene",
     )
     add_perception(parser)
+    add_robot_option(parser)
     add_conditions(parser)
     parser.add_argument("--fresh", action="store_true", help="discard DIR's earlier results and start over")
     add_verbosity(parser)
@@ -111,10 +113,10 @@ def main(
     config_yaml = None
     if args.config:
         config_yaml = read_document(args.config, missing="scenario file not found")
-    if args.execution is not None or args.uncertainty is not None:
+    if args.config or args.execution is not None or args.uncertainty is not None:
         from hlp_drake.systems.scenario import load_scenario, with_conditions
 
-        loaded = load_scenario(data=config_yaml, where=args.config or "--config")
+        loaded = load_scenario(args.config)  # a robot model's relative path: beside the file
         config_yaml = with_conditions(loaded, execution=args.execution, uncertainty=args.uncertainty).yaml
     settings = ExperimentSettings(
         kind=args.kind,
@@ -126,6 +128,7 @@ def main(
         scheduler=args.scheduler,
         config_yaml=config_yaml,
         perception=args.perception,
+        robot=args.robot,
         scenario_file=args.config,
         fresh=args.fresh,
         progress=not args.quiet,

@@ -55,6 +55,8 @@ class ExperimentSettings:
             replaced by each job's).
         perception: overrides the scenario's ``perception.source`` ("truth" or "camera"; None: the
             scenario's).
+        robot: overrides the scenario's robot (a shipped robot's name or a description file; None:
+            the scenario's).
         scenario_file: the file ``config_yaml`` was read from (None: none, the built-in default), named
             in ``run.json`` and the summary.
         fresh: start over, discarding the directory's earlier results.
@@ -69,6 +71,7 @@ class ExperimentSettings:
     scheduler: str | None = None
     config_yaml: str | None = None
     perception: str | None = None
+    robot: str | None = None
     scenario_file: str | None = None
     fresh: bool = False
     progress: bool = True
@@ -284,11 +287,18 @@ def run_experiment(
     check_executor(settings.executor, settings.scheduler)
     out = Path(out)
     yamls = scenario(
-        settings.config_yaml, single_process_rollouts=settings.parallel, perception=settings.perception
+        settings.config_yaml,
+        single_process_rollouts=settings.parallel,
+        perception=settings.perception,
+        robot=settings.robot,
     )
     config_yaml = yamls.identity
     jobs = make_jobs(
-        settings.kind, range(settings.seed, settings.seed + settings.scenes), settings.objects, yamls.job
+        settings.kind,
+        range(settings.seed, settings.seed + settings.scenes),
+        settings.objects,
+        yamls.job,
+        yamls.workspace,
     )
     identity = {"kind": settings.kind, "seed": settings.seed, "scenario": config_yaml}
     _check_directory(out, identity, settings.fresh)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from hlp_drake.errors import SceneError
-from hlp_drake.scene.generators import generate_scene
+from hlp_drake.scene.generators import Workspace, generate_scene
 from hlp_drake.scene.model import Scene
 from hlp_drake.what_ran import WhatRan
 
@@ -36,6 +36,7 @@ class Job:
     config_yaml: (
         str  # the scenario as YAML text (``Scenario.yaml``; its scene is replaced), not a Drake object
     )
+    workspace: Workspace | None = None  # a fixed robot's reach, which the scene's table is kept within
 
     @property
     def key(self) -> tuple[str, str]:
@@ -43,7 +44,7 @@ class Job:
         return self.scene, self.planner
 
     def make_scene(self) -> Scene:
-        return generate_scene(self.kind, self.seed, self.objects)
+        return generate_scene(self.kind, self.seed, self.objects, self.workspace)
 
 
 JobFunction = Callable[[Job], Row]
@@ -60,11 +61,13 @@ class ScenarioYamls:
         job: the scenario as the jobs run it, as YAML (``Job.config_yaml``).
         ran: what its jobs run: the robot, both planners, the execution mode, the model error's seed
             and the perception source (no scenario file: the run's settings name it).
+        workspace: the robot's reach if it is fixed (the generated tables are kept within it).
     """
 
     identity: str
     job: str
     ran: WhatRan
+    workspace: Workspace | None = None
 
     @property
     def perception_source(self) -> str:
@@ -76,19 +79,32 @@ class ScenarioResolver(Protocol):
     """Reads a run's scenario (``hlp_drake.systems.scenario_yamls`` is the real one).
 
     ``text``: the scenario settings as YAML (None: the defaults); ``perception`` overrides its
-    ``perception.source`` unless None; ``single_process_rollouts``: the jobs' optimiser rolls out in
-    its own process (``optimiser.workers = 1``). Raises ``HlpError`` for an invalid scenario.
+    ``perception.source`` and ``robot`` its robot (a shipped robot's name or a description file)
+    unless None; ``single_process_rollouts``: the jobs' optimiser rolls out in its own process
+    (``optimiser.workers = 1``). Raises ``HlpError`` for an invalid scenario.
     """
 
     def __call__(
-        self, text: str | None, *, single_process_rollouts: bool, perception: str | None
+        self,
+        text: str | None,
+        *,
+        single_process_rollouts: bool,
+        perception: str | None,
+        robot: str | None = None,
     ) -> ScenarioYamls: ...
 
 
-def make_jobs(kind: str, seeds: Iterable[int], objects: Iterable[int], config_yaml: str) -> list[Job]:
+def make_jobs(
+    kind: str,
+    seeds: Iterable[int],
+    objects: Iterable[int],
+    config_yaml: str,
+    workspace: Workspace | None = None,
+) -> list[Job]:
     """Every (scene, planner) job, ordered by (objects, seed, planner).
 
-    gen2: one scene per (object count, seed); gen1: one scene per seed (``objects`` is ignored).
+    gen2: one scene per (object count, seed); gen1: one scene per seed (``objects`` is ignored);
+    the tables within ``workspace`` (a fixed robot's reach).
 
     Raises:
         SceneError: a scene cannot be generated (the message names its seed).
@@ -98,14 +114,14 @@ def make_jobs(kind: str, seeds: Iterable[int], objects: Iterable[int], config_ya
     for count in counts:
         for seed in seeds:
             try:
-                scene = generate_scene(kind, seed, count)
+                scene = generate_scene(kind, seed, count, workspace)
             except SceneError as error:
                 objects_note = "" if count is None else f" with {count} objects"
                 raise SceneError(
                     f"cannot generate the {kind} scene of seed {seed}{objects_note}: {error}"
                 ) from None
             jobs += [
-                Job(kind, seed, len(scene.obstacles), scene.name, planner, config_yaml)
+                Job(kind, seed, len(scene.obstacles), scene.name, planner, config_yaml, workspace)
                 for planner in PLANNERS
             ]
     return jobs

@@ -11,7 +11,7 @@ import sys
 from collections.abc import Sequence
 
 from hlp_drake.atomic import check_writable
-from hlp_drake.cli import MAX_SEED, integer, make_parser, run_cli
+from hlp_drake.cli import MAX_SEED, add_robot_option, integer, make_parser, run_cli
 from hlp_drake.scene.generators import KINDS, MAX_GENERATED, generate_scene
 from hlp_drake.scene.io import load_scene, save_scene
 from hlp_drake.scene.rows import find_rows
@@ -27,6 +27,7 @@ def _parser():
     )
     generate.add_argument("--seed", type=integer(0, MAX_SEED), required=True)
     generate.add_argument("--out", required=True, help="output file, .yaml or .json")
+    add_robot_option(generate)
     show = commands.add_parser("show", help="draw a scene file top-down")
     show.add_argument("file")
     show.add_argument("--png", required=True, help="output PNG")
@@ -44,7 +45,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     check_writable(getattr(args, "out", None), getattr(args, "png", None))  # bad paths: exit 2, now
     if args.command == "generate":
-        scene = generate_scene(args.kind, args.seed, args.objects)
+        workspace = None
+        if args.robot is not None:  # a fixed robot's tables within its reach (imports Drake)
+            from hlp_drake.systems.world.robot import load_robot
+
+            workspace = load_robot(args.robot).workspace
+        scene = generate_scene(args.kind, args.seed, args.objects, workspace)
         save_scene(scene, args.out)
         print(f"wrote {args.out}: {scene.name}, {len(scene.obstacles)} obstacles")
     elif args.command == "show":

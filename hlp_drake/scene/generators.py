@@ -8,6 +8,10 @@ the world frame of ``hlp_drake.frames`` (front edge of the table at x = 0, y to 
   row in random order, free intervals of at least 5 mm on a 5 mm grid, target can at 0.525 m.
 - ``gen1``: Generalization I: the same two-row structure on a robot-sized table with table and object
   dimensions varied (see ``GEN1``).
+
+For a robot fixed in front of the table (a ``Workspace``: where it stands and how far it reaches),
+``gen1`` and ``gen2`` scale their tables down (``within_reach``) so that every start and target they
+place lies within its reach; a mobile robot (no workspace) gets the tables of ``GEN1``.
 - ``gen2``: Generalization II: 5, 7 or 9 (any N >= 1) boxes and cylinders placed at random, the start
   on a random point of the front edge with a random heading, the target not aligned with the start.
 - ``unstructured``: the dataset's unstructured trials (T100-T129): the VR table, N (default 6) obstacles
@@ -67,6 +71,52 @@ class RobotSceneRanges:
 
 
 GEN1 = RobotSceneRanges()
+EDGE_INSET = 0.10
+"""Gen II: the start's and the target's distance from the table's side edges at least, m."""
+
+
+@dataclass(frozen=True)
+class Workspace:
+    """Where a robot fixed in front of the table reaches: the tcp within ``reach`` of (x, y), the
+    base's place in the scene's frame (x into the table from the middle of its front edge), m."""
+
+    x: float
+    y: float
+    reach: float
+
+
+def within_reach(ranges: RobotSceneRanges, workspace: Workspace | None) -> RobotSceneRanges:
+    """``ranges`` with the table's length and width scaled by one factor (at most 1) so that the
+    farthest start or target the generators place on the largest table is within ``workspace``'s
+    reach; ``ranges`` itself for None (a mobile robot)."""
+    if workspace is None:
+        return ranges
+
+    def farthest(scale: float) -> float:  # a Gen II target in the far corner: the farthest point placed
+        x = ranges.target_band[1] * ranges.table_length[1] * scale
+        y = ranges.table_width[1] * scale / 2.0 - EDGE_INSET + abs(workspace.y)
+        return math.hypot(x - workspace.x, y)
+
+    if farthest(1.0) <= workspace.reach:
+        return ranges
+    low, high = 0.0, 1.0  # farthest() grows with the scale: bisect
+    for _ in range(40):
+        middle = (low + high) / 2.0
+        low, high = (middle, high) if farthest(middle) <= workspace.reach else (low, middle)
+    if low < MIN_TABLE_SCALE:
+        raise SceneError(
+            f"a robot reaching {workspace.reach} m from ({workspace.x}, {workspace.y}) reaches too little "
+            "of a table to generate scenes on"
+        )
+    return replace(
+        ranges,
+        table_length=tuple(low * v for v in ranges.table_length),
+        table_width=tuple(low * v for v in ranges.table_width),
+    )
+
+
+MIN_TABLE_SCALE = 0.5
+"""The smallest table scale ``within_reach`` makes (the objects still have to fit)."""
 DECIMALS = 4  # generated values are rounded to 0.1 mm / 0.1 mrad so files read cleanly
 MAX_PLACEMENT_ATTEMPTS = 2000
 MAX_SEED = 2**32 - 1
@@ -273,11 +323,11 @@ def generate_gen2(seed: int, objects: int = 7, ranges: RobotSceneRanges = GEN1) 
     rng = np.random.default_rng(seed)
     table = _robot_table(rng, ranges)
     half = table.width / 2.0
-    start = (0.0, _inset(rng, -half, half, 0.10))
+    start = (0.0, _inset(rng, -half, half, EDGE_INSET))
     start_yaw = _uniform(rng, ranges.start_yaw)
     min_offset = ranges.min_misalignment * table.width
     while True:  # target y away from the start's line; terminates: the admissible set is non-empty
-        target_y = _inset(rng, -half, half, 0.10)
+        target_y = _inset(rng, -half, half, EDGE_INSET)
         if abs(target_y - start[1]) >= min_offset:
             break
     band = [f * table.length for f in ranges.target_band]
@@ -367,13 +417,16 @@ def generate_unstructured(seed: int, objects: int = 6) -> Scene:
 FIXED_OBJECT_COUNT = {"vr": 6, "gen1": 6}
 
 
-def generate_scene(kind: str, seed: int, objects: int | None = None) -> Scene:
+def generate_scene(
+    kind: str, seed: int, objects: int | None = None, workspace: Workspace | None = None
+) -> Scene:
     """Generate a scene of ``kind`` (one of ``KINDS``) from ``seed``.
 
     Args:
         kind: "vr", "gen1", "gen2" or "unstructured".
         seed: the random seed; the same seed always gives the same scene.
         objects: number of obstacles (gen2: default 7; unstructured: default 6; vr and gen1: 6 only).
+        workspace: a fixed robot's reach: gen1 and gen2 tables within it (``within_reach``).
     """
     if kind not in KINDS:
         raise SceneError(f"unknown scene kind {brief(kind)} (expected one of {', '.join(KINDS)})")
@@ -388,7 +441,7 @@ def generate_scene(kind: str, seed: int, objects: int | None = None) -> Scene:
             raise SceneError(
                 f"{kind} scenes always have {FIXED_OBJECT_COUNT[kind]} obstacles, got --objects {objects}"
             )
-        return generate_vr(seed) if kind == "vr" else generate_gen1(seed)
+        return generate_vr(seed) if kind == "vr" else generate_gen1(seed, within_reach(GEN1, workspace))
     if kind == "gen2":
-        return generate_gen2(seed, 7 if objects is None else objects)
+        return generate_gen2(seed, 7 if objects is None else objects, within_reach(GEN1, workspace))
     return generate_unstructured(seed, 6 if objects is None else objects)

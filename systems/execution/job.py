@@ -22,11 +22,16 @@ if TYPE_CHECKING:
 
 
 def scenario_yamls(
-    text: str | None, *, single_process_rollouts: bool = False, perception: str | None = None
+    text: str | None,
+    *,
+    single_process_rollouts: bool = False,
+    perception: str | None = None,
+    robot: str | None = None,
 ) -> ScenarioYamls:
-    """The scenario of ``text`` (None: the defaults; ``perception.source`` set to ``perception``
-    unless None), read once: its YAML (the run's identity), written out in full as the jobs run it
-    (``optimiser.workers = 1`` if ``single_process_rollouts``), and what its jobs run.
+    """The scenario of ``text`` (None: the defaults; ``perception.source`` set to ``perception`` and
+    the robot to ``robot`` unless None), read once: its YAML (the run's identity), written out in
+    full as the jobs run it (``optimiser.workers = 1`` if ``single_process_rollouts``), what its
+    jobs run and the robot's workspace.
 
     Raises:
         HlpError: the scenario is invalid.
@@ -34,13 +39,18 @@ def scenario_yamls(
     # hlp_drake.experiments is imported when needed: importing hlp_drake.systems does not load it
     from hlp_drake.experiments.runner import PLANNERS, ScenarioYamls
 
-    scenario = with_conditions(load_scenario(data=text, where="--config"), perception=perception)
+    scenario = with_conditions(load_scenario(data=text, where="--config"), perception=perception, robot=robot)
     jobs = (
         replace(scenario, optimiser=replace(scenario.optimiser, workers=1))
         if single_process_rollouts
         else scenario
     )
-    return ScenarioYamls(identity=scenario.yaml, job=jobs.yaml, ran=what_ran(scenario, planners=PLANNERS))
+    return ScenarioYamls(
+        identity=scenario.yaml,
+        job=jobs.yaml,
+        ran=what_ran(scenario, planners=PLANNERS),
+        workspace=scenario.robot.workspace,
+    )
 
 
 def run_job(job: Job) -> Row:

@@ -292,7 +292,9 @@ def _execute(
             and np.hypot(*np.subtract(after[n][:2], before[n][:2])) > MOVED_TOLERANCE
         ]
         result.objects_dropped = fallen_objects(plant, plant_context, scene)
-        tcp = plant.GetFrameByName(scenario.robot.tcp_frame, robot).CalcPoseInWorld(plant_context).translation()
+        tcp = (
+            plant.GetFrameByName(scenario.robot.tcp_frame, robot).CalcPoseInWorld(plant_context).translation()
+        )
         inside, result.target_distance = pregrasp_check(
             tcp,
             after[scene.target.name],

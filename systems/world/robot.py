@@ -35,8 +35,10 @@ from pydrake.multibody.tree import Joint, JointActuatorIndex, ModelInstanceIndex
 from pydrake.systems.framework import Context
 
 import hlp_drake.models
+from hlp_drake.cli import SHIPPED_ROBOTS
 from hlp_drake.errors import HlpError, InstallError, short
 from hlp_drake.ranges import NonNegativeFloat
+from hlp_drake.scene.generators import Workspace
 
 # The project's own Drake model package (``package://hlp_drake_models/...``); no remote packages.
 MODELS_PACKAGE = "hlp_drake_models"
@@ -112,8 +114,6 @@ def new_parser(plant: MultibodyPlant) -> Parser:
 ROBOTS_FOLDER = "robot"
 """The folder of the model package holding the shipped robots: ``NAME.urdf`` and its description
 ``NAME.yaml`` each."""
-SHIPPED_ROBOTS = ("mobile_ur5", "panda", "iiwa14")
-"""The robots the project builds and ships (``--robot NAME``); ``mobile_ur5`` is the default."""
 
 
 @dataclass(frozen=True)
@@ -216,6 +216,13 @@ class RobotDescription:
     def position_names(self) -> tuple[str, ...]:
         """The joints of the robot's positions, in model-instance order: the actuated, then the mimics."""
         return (*self.actuated_joints, *self.mimic_joints)
+
+    @property
+    def workspace(self) -> Workspace | None:
+        """Where a fixed robot reaches (the scene generators keep their tables within it); None if mobile."""
+        if self.mobile:
+            return None
+        return Workspace(x=self.base.pose[0], y=self.base.pose[1], reach=self.reach)
 
     @property
     def base_columns(self) -> tuple[int, ...]:

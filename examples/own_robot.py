@@ -4,7 +4,7 @@
     python -m hlp_drake.run_scene --robot my_robot/arm6.yaml --kind gen1 --seed 3
 
 The arm stands on a pedestal in front of the table: a shoulder turning about z, two pitching joints
-(upper arm 0.40 m, forearm 0.35 m), a spherical wrist (roll, pitch, roll) and a two-finger gripper
+(upper arm and forearm 0.45 m each), a spherical wrist (roll, pitch, roll) and a two-finger gripper
 whose right finger follows the left through a ``<mimic>``. Any URDF or SDF works the same way: the
 description names its joints and frames, nothing else changes.
 """
@@ -18,12 +18,17 @@ from pathlib import Path
 MOUNT = 0.72  # the arm's mount above the floor, m: the shoulder at 0.82 m, about a table top's height
 LINKS = (  # name, parent joint origin (x, z) in the parent link, axis, lower, upper, effort, length along x
     ("shoulder", (0.0, MOUNT), "0 0 1", -math.pi, math.pi, 150.0, 0.0),
-    ("upper_arm", (0.0, 0.10), "0 1 0", -2.0, 2.0, 150.0, 0.40),
-    ("forearm", (0.40, 0.0), "0 1 0", -2.9, 2.9, 150.0, 0.35),
-    ("wrist_1", (0.35, 0.0), "1 0 0", -math.pi, math.pi, 28.0, 0.0),
+    ("upper_arm", (0.0, 0.10), "0 1 0", -2.0, 2.0, 150.0, 0.45),
+    ("forearm", (0.45, 0.0), "0 1 0", -2.9, 2.9, 150.0, 0.45),
+    ("wrist_1", (0.45, 0.0), "1 0 0", -math.pi, math.pi, 28.0, 0.0),
     ("wrist_2", (0.0, 0.0), "0 1 0", -2.0, 2.0, 28.0, 0.0),
     ("wrist_3", (0.0, 0.0), "1 0 0", -math.pi, math.pi, 28.0, 0.05),
 )
+FILTERED = {
+    "base": ("pedestal", "shoulder", "upper_arm"),
+    "wrist": ("forearm", "wrist_1", "wrist_2", "wrist_3", "palm", "left_finger", "right_finger"),
+}
+"""Groups of links whose collisions with each other are ignored (Drake's URDF extension)."""
 STROKE = 0.04  # each finger's travel from the centre, m (80 mm between the pads)
 
 
@@ -58,7 +63,7 @@ def urdf() -> str:
     """The arm as URDF text."""
     parts = [
         '<?xml version="1.0"?>',
-        '<robot name="arm6">',
+        '<robot name="arm6" xmlns:drake="http://drake.mit.edu">',
         '<material name="grey"><color rgba="0.7 0.72 0.75 1"/></material>',
         '<link name="pedestal"><inertial><origin xyz="0 0 0.36"/><mass value="20"/>'
         '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="0.1"/></inertial>'
@@ -69,7 +74,7 @@ def urdf() -> str:
     ]
     parent = "pedestal"
     for i, (name, (x, z), axis, lower, upper, effort, length) in enumerate(LINKS, start=1):
-        parts.append(_link(name, 2.0 if length else 1.0, length))
+        parts.append(_link(name, 2.0 if length else 1.0, length, 0.045 if i < 3 else 0.03))
         parts.append(
             f'<joint name="joint_{i}" type="revolute"><parent link="{parent}"/><child link="{name}"/>'
             f'<origin xyz="{x} 0 {z}"/><axis xyz="{axis}"/>'
@@ -100,6 +105,10 @@ def urdf() -> str:
             f'<limit lower="0" upper="{STROKE}" effort="100" velocity="0.1"/>{mimic}</joint>'
         )
     parts.append(_transmission("left_finger_joint"))
+    for group, members in FILTERED.items():  # neighbours that touch by design never count as collisions
+        parts.append(f'<drake:collision_filter_group name="{group}">')
+        parts += [f'<drake:member link="{link}"/>' for link in members]
+        parts.append(f'<drake:ignored_collision_filter_group name="{group}"/></drake:collision_filter_group>')
     parts.append("</robot>")
     return "\n".join(parts) + "\n"
 
@@ -108,7 +117,7 @@ DESCRIPTION = """\
 # A robot description (hlp_drake.systems.RobotDescription): the model and what the planner needs of it.
 name: arm6
 model: arm6.urdf                     # a path beside this file, a file:// or a package:// URL
-base: {kind: fixed, frame: pedestal, pose: [-0.15, 0.0, 0.0]}   # x, y, yaw in front of the table
+base: {kind: fixed, frame: pedestal, pose: [-0.25, 0.0, 0.0]}   # x, y, yaw in front of the table
 arm_joints: [joint_1, joint_2, joint_3, joint_4, joint_5, joint_6]
 gripper_joint: left_finger_joint     # actuated, prismatic: each finger's travel
 mimic_joints: [right_finger_joint]
@@ -119,7 +128,7 @@ gripper_links: [palm, left_finger, right_finger]
 finger_links: [left_finger, right_finger]
 home: [0.0, -0.6, 1.6, 0.0, -1.0, 0.0]
 gripper_open: 0.04
-reach: 0.90                          # m from the base over the table: generated tables fit it
+reach: 0.95                          # m from the base over the table: generated tables fit it
 """
 
 

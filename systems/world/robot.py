@@ -513,7 +513,7 @@ def set_robot_positions(
         raise ValueError(
             f"expected 3 base and {len(robot.arm_joints)} arm positions, got {len(base)} and {len(arm)}"
         )
-    values = dict(zip(robot.base_joints + robot.arm_joints, (*base, *arm)))
+    values = {**dict(zip(robot.base_joints, base)), **dict(zip(robot.arm_joints, arm, strict=True))}
     values.update({name: gripper for name in robot.gripper_joints})
     q = plant.GetPositions(context)
     for name, value in values.items():

@@ -124,7 +124,7 @@ def start_configuration(
             f"{tuple(scene.start)} at height {tcp_keypoint_height(scene, ik):.3f} m "
             f"from {where} {base}: out of its reach"
         )
-    values = dict(zip(robot.base_joints + robot.arm_joints, (*base, *arm)))
+    values = {**dict(zip(robot.base_joints, base)), **dict(zip(robot.arm_joints, arm, strict=True))}
     values.update({name: robot.gripper_open for name in robot.gripper_joints})
     return _to_plant_order(plant, instance, values)
 

@@ -65,12 +65,14 @@ def urdf() -> str:
         '<?xml version="1.0"?>',
         '<robot name="arm6" xmlns:drake="http://drake.mit.edu">',
         '<material name="grey"><color rgba="0.7 0.72 0.75 1"/></material>',
-        '<link name="pedestal"><inertial><origin xyz="0 0 0.36"/><mass value="20"/>'
-        '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="0.1"/></inertial>'
-        f'<visual><origin xyz="0 0 {MOUNT / 2}"/><geometry><cylinder radius="0.08" length="{MOUNT}"/></geometry>'
-        '<material name="grey"/></visual>'
-        f'<collision><origin xyz="0 0 {MOUNT / 2}"/><geometry><cylinder radius="0.08" length="{MOUNT}"/></geometry>'
-        "</collision></link>",
+        (
+            '<link name="pedestal"><inertial><origin xyz="0 0 0.36"/><mass value="20"/>'
+            '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="0.1"/></inertial>'
+            f'<visual><origin xyz="0 0 {MOUNT / 2}"/><geometry><cylinder radius="0.08" length="{MOUNT}"/></geometry>'
+            '<material name="grey"/></visual>'
+            f'<collision><origin xyz="0 0 {MOUNT / 2}"/><geometry><cylinder radius="0.08" length="{MOUNT}"/></geometry>'
+            "</collision></link>"
+        ),
     ]
     parent = "pedestal"
     for i, (name, (x, z), axis, lower, upper, effort, length) in enumerate(LINKS, start=1):
@@ -84,13 +86,19 @@ def urdf() -> str:
         parent = name
     palm = '<origin xyz="0.02 0 0"/><geometry><box size="0.04 0.12 0.05"/></geometry>'
     parts += [
-        f'<link name="palm">{_inertial(0.6, 0.04)}<visual>{palm}<material name="grey"/></visual>'
-        f"<collision>{palm}</collision></link>",
-        '<joint name="palm_joint" type="fixed"><parent link="wrist_3"/><child link="palm"/>'
-        '<origin xyz="0.05 0 0"/></joint>',
+        (
+            f'<link name="palm">{_inertial(0.6, 0.04)}<visual>{palm}<material name="grey"/></visual>'
+            f"<collision>{palm}</collision></link>"
+        ),
+        (
+            '<joint name="palm_joint" type="fixed"><parent link="wrist_3"/><child link="palm"/>'
+            '<origin xyz="0.05 0 0"/></joint>'
+        ),
         '<link name="tcp"/>',
-        f'<joint name="tcp_joint" type="fixed"><parent link="palm"/><child link="tcp"/>'
-        f'<origin xyz="0.12 0 0" rpy="0 {math.pi / 2} 0"/></joint>',
+        (
+            f'<joint name="tcp_joint" type="fixed"><parent link="palm"/><child link="tcp"/>'
+            f'<origin xyz="0.12 0 0" rpy="0 {math.pi / 2} 0"/></joint>'
+        ),
     ]
     for side, sign in (("left", 1), ("right", -1)):
         finger = '<origin xyz="0.085 0 0"/><geometry><box size="0.07 0.012 0.02"/></geometry>'

@@ -7,6 +7,7 @@ quick-start line only the part after them runs, with this interpreter as ``.venv
 
 from __future__ import annotations
 
+import importlib.util
 import re
 import shlex
 import subprocess
@@ -49,6 +50,8 @@ def run(command: str, cwd: Path) -> subprocess.CompletedProcess:
     argv = shlex.split(command)
     if argv[0] in ("python", ".venv/bin/python"):
         argv[0] = sys.executable
+    if len(argv) > 1 and argv[1].startswith("examples/"):  # the repository's example scripts
+        argv[1] = str(REPO / argv[1])
     return subprocess.run(argv, cwd=cwd, capture_output=True, text=True, timeout=600, check=False)
 
 
@@ -63,10 +66,22 @@ def test_every_bash_block_runs(tmp_path):
         assert result.returncode == 0, (command, result.stdout, result.stderr)
         if "scene show" in command:
             assert "robot plan: start ->" in result.stdout and "human plan: start ->" in result.stdout
-        if "hlp_drake.run_scene" in command:  # the quick start: the default scene, planned and grasped
+        if "--robot" in command:  # your own robot, written by the example beside it
+            assert "run: robot arm6" in result.stdout and "verdict: reach success" in result.stdout, (
+                result.stdout
+            )
+        elif "hlp_drake.run_scene" in command:  # the quick start: the default scene, planned and grasped
             for line in ("plan: start ->", "optimise: success", "verdict: reach success", "grasp held"):
                 assert line in result.stdout, (line, result.stdout)
     assert (tmp_path / "scene.png").stat().st_size > 10_000
+
+
+def _example(name: str):
+    """A script of ``examples/``, imported."""
+    spec = importlib.util.spec_from_file_location(name, REPO / "examples" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 def test_the_python_block_is_the_example_file_and_runs(tmp_path):
@@ -86,7 +101,10 @@ def test_the_yaml_blocks_load_as_a_scenario_and_a_scene(tmp_path):
     from hlp_drake.scene.io import load_scene
     from hlp_drake.systems.scenario import Scenario, load_scenario
 
-    scenario_block, scene_block = sorted(blocks("yaml"), key=lambda text: "table:" in text)
+    robot_block, scenario_block, scene_block = sorted(
+        blocks("yaml"), key=lambda text: "arm_joints:" not in text and 1 + ("table:" in text)
+    )
+    assert robot_block == _example("own_robot").DESCRIPTION  # the description the example writes
     scenario = load_scenario(data=scenario_block)
     assert scenario.planner.kind == "hlp" and scenario.optimiser.samples == 8
     assert scenario.key == Scenario().key  # the README shows the defaults

@@ -18,7 +18,7 @@ from contextlib import contextmanager
 from contextvars import ContextVar
 from typing import NoReturn
 
-from hlp_drake import __version__
+from hlp_drake import DRAKE_LOG, __version__
 from hlp_drake.errors import HlpError
 from hlp_drake.processes import Terminated, terminations_raised
 
@@ -119,11 +119,15 @@ def add_verbosity(parser: argparse.ArgumentParser) -> None:
 
 def drake_logging(verbose: bool) -> None:
     """Drake's INFO lines (e.g. ``Meshcat listening for connections at ...``) only when ``verbose``; its
-    warnings and errors always. Imports pydrake, which sets its logger's level on import."""
+    warnings and errors always; in this process and in the worker processes it starts, which inherit
+    the choice through the environment (``hlp_drake.DRAKE_LOG``, applied by a filter on the "drake"
+    logger wherever hlp_drake is imported). Imports pydrake, which sets its logger's level on import."""
     import logging
+    import os
 
     import pydrake.common  # noqa: F401 - sets the "drake" logger's level: set it afterwards
 
+    os.environ[DRAKE_LOG] = "info" if verbose else "warning"
     logging.getLogger("drake").setLevel(logging.INFO if verbose else logging.WARNING)
 
 

@@ -48,6 +48,8 @@ from hlp_drake.what_ran import WhatRan
 
 DEFAULT_SCENE = DEFAULT_SCENE_FILE
 PROG = "python -m hlp_drake.run_scene"
+PLANNER_NAMES = {"hlp": "human-like", "sto": "straight-line"}
+"""The planners as the recording's heading names them."""
 
 
 def verdict(result) -> str:
@@ -67,6 +69,15 @@ def verdict(result) -> str:
 def exit_status(result) -> int:
     """0 when the reach succeeded (the paper's success), whatever the grasp; 1 when it failed."""
     return 0 if result.success else 1
+
+
+def recording_title(result, ran: WhatRan) -> str:
+    """The recording's heading: the scene, the planner and perception, and the verdict in short."""
+    reach = "reach success" if result.success else f"reach failure: {result.failure_reason}"
+    held = {None: "", True: ", grasp held", False: ", grasp did not hold"}[result.grasp_held]
+    planners = " and ".join(PLANNER_NAMES.get(p, p) for p in ran.planners)
+    seen = "on the depth camera's view" if ran.perception_source == "camera" else "on the true scene"
+    return f"scene {result.scene.name}, {planners} planner {seen}: {reach}{held}"
 
 
 def summary(result, ran: WhatRan | None = None) -> str:
@@ -198,7 +209,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         from hlp_drake.systems.execution.meshcat_view import with_legend
 
         perceived = scenario.perception.source == "camera"
-        write_text_atomic(args.html, with_legend(meshcat.StaticHtml(), perceived=perceived))
+        page = with_legend(meshcat.StaticHtml(), perceived=perceived, title=recording_title(result, ran))
+        write_text_atomic(args.html, page)
         print(f"wrote {args.html}")
     if args.json:
         write_text_atomic(args.json, json.dumps({**ran.to_dict(), **result.to_dict()}, indent=2) + "\n")

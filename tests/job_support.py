@@ -28,3 +28,12 @@ def cheap_job(job: Job) -> dict:
         objects_moved=rng.randint(0, len(scene.obstacles)),
         objects_dropped=int(not success),
     )
+
+
+def drake_info_job(job: Job) -> dict:
+    """``cheap_job`` after a Drake INFO line: a MeshCat server starting (``Meshcat listening for
+    connections at ...``; needs ``DRAKE_ALLOW_NETWORK=meshcat``), as a job on a worker process might log."""
+    from pydrake.geometry import Meshcat, MeshcatParams
+
+    Meshcat(MeshcatParams(host="localhost"))
+    return cheap_job(job)

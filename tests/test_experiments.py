@@ -19,9 +19,9 @@ from pathlib import Path
 import pandas as pd
 import pytest
 from conftest import run_module
-from job_support import cheap_job
+from job_support import cheap_job, drake_info_job
 
-from hlp_drake import experiments
+from hlp_drake import DRAKE_LOG, experiments
 from hlp_drake.cli import invoked_as, run_cli
 from hlp_drake.errors import HlpError, StorageError
 from hlp_drake.experiments import ExperimentSettings, Job, make_row
@@ -572,6 +572,29 @@ def test_without_a_terminal_progress_is_a_line_per_job_without_carriage_returns(
     ]
     assert run_cli(lambda a: main(a, job=never_called), [*argv, "--quiet"]) == 0
     assert capsys.readouterr().err == ""
+
+
+@pytest.mark.parametrize(("executor", "verbose"), [("local", False), ("local", True), ("dask", False)])
+def test_drake_info_lines_from_worker_processes_only_with_verbose(
+    tmp_path, capfd, monkeypatch, executor, verbose
+):
+    """Each job logs a Drake INFO line in a worker process (spawned, or dask's): like the command's
+    own, it reaches stderr only with --verbose (the workers inherit the choice)."""
+    if executor == "dask":
+        pytest.importorskip("distributed")
+    monkeypatch.setenv("DRAKE_ALLOW_NETWORK", "meshcat")  # the job's MeshCat server, a local one
+    monkeypatch.delenv(DRAKE_LOG, raising=False)  # the command sets it; restored afterwards
+    argv = ["gen1", "--scenes", "1", "--workers", "2", "--executor", executor, "--out", str(tmp_path)]
+    assert run_cli(lambda a: main(a, job=drake_info_job), [*argv, *(["--verbose"] if verbose else [])]) == 0
+    err = capfd.readouterr().err  # the workers' stderr too: they write to the same file descriptor
+    info = [line for line in err.splitlines() if line.startswith("INFO:drake:")]
+    if verbose:
+        assert len(info) == 2 and all("Meshcat listening for connections" in line for line in info), err
+    else:
+        assert info == [] and "INFO" not in err, err
+        assert [line.split(" (")[0] for line in err.splitlines()] == [
+            f"gen1: {n} of 2 jobs done" for n in (1, 2)
+        ]
 
 
 def test_run_json_and_the_summary_say_what_ran(tmp_path, capsys):

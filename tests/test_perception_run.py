@@ -45,7 +45,10 @@ def test_run_scene_plans_on_the_perceived_scene_and_reports_its_errors(tmp_path)
     assert report["perception_source"] == "camera" and "perception camera" in result.stdout
     assert report["timings"]["perceive_s"] > record["perception_s"] > 0
     page = html.read_text()
-    assert "what the cameras saw" in page  # the legend names the perception's colours too
+    # The legend says what the perception view draws: the fitted objects and the camera's points.
+    assert "perceived (translucent): the target and obstacles fitted to the depth camera" in page
+    assert "the depth camera&#x27;s points at the start" in page
+    assert "human-like planner on the depth camera&#x27;s view" in page  # the heading
     commands = recorded(page)
     for path in (b"/drake/perception/points", b"/drake/perception/objects/Target", b"/drake/robot_plan/path"):
         assert path in commands, path

@@ -113,6 +113,27 @@ def recorded(html: str) -> bytes:
     return b"".join(base64.b64decode(b) for b in re.findall(r"base64,([A-Za-z0-9+/=]+)\"\)", html))
 
 
+def messages(html: str) -> list[dict]:
+    """The MeshCat messages a static HTML recording replays, decoded (MessagePack)."""
+    import base64
+    import re
+
+    import msgpack
+
+    found = re.findall(r"base64,([A-Za-z0-9+/=]+)\"\)", html)
+    return [msgpack.unpackb(base64.b64decode(b), raw=False, strict_map_key=False) for b in found]
+
+
+def animation_tracks(html: str) -> dict[str, dict[str, list[tuple[int, object]]]]:
+    """The recording's animation: per scene-tree path, per track (``.position``, ``.visible``, ...),
+    its (frame, value) keys."""
+    (animation,) = [m for m in messages(html) if m["type"] == "set_animation"]
+    return {
+        a["path"]: {t["name"]: [(k["time"], k["value"]) for k in t["keys"]] for t in a["clip"]["tracks"]}
+        for a in animation["animations"]
+    }
+
+
 def three_js(point) -> tuple[float, float, float]:
     """A world point (z up) in MeshCat's three.js frame (y up): (x, z, -y)."""
     x, y, z = (float(v) for v in point)
@@ -234,6 +255,33 @@ def test_run_scene_end_to_end_json_and_html(tmp_path):
     assert report["optimisation"]["final_cost"] <= report["optimisation"]["initial_cost"]
     for stage in ("plan: start -> ", "IK: ", "optimise: ", "execute: "):  # each stage, as it happens
         assert stage in result.stdout, stage
+
+
+def test_the_recording_highlights_each_pushed_obstacle_while_it_is_pushed_and_says_what_ran(tmp_path):
+    """The default scene's two pushes: each obstacle's highlight is hidden at the start, shown from
+    about when the robot starts pushing it (it has barely moved yet) to its release (it has moved
+    several centimetres meanwhile), then hidden; the heading names the scene and the verdict."""
+    out, html = tmp_path / "run.json", tmp_path / "run.html"
+    args = ("--workers", "1", "--quiet", "--json", str(out), "--html", str(html))
+    result = run_module("hlp_drake.run_scene", *args, env={"DRAKE_ALLOW_NETWORK": "meshcat"})
+    assert result.returncode == 0, result.stderr
+    report = json.loads(out.read_text())
+    moves = [k["element"] for k in report["plan"]["keypoints"] if k["action"] == "move"]
+    page = html.read_text()
+    tracks = animation_tracks(page)
+    highlighted = {
+        path.split("/")[3]: t[".visible"] for path, t in tracks.items() if path.endswith("/pushed")
+    }
+    assert sorted(highlighted) == sorted(moves) and len(moves) == 2
+    for name, keys in highlighted.items():
+        assert [shown for _, shown in keys] == [False, True, False], (name, keys)
+        start, end = keys[1][0], keys[2][0]
+        position = np.array([value for _, value in tracks[f"/drake/visualizer/{name}/{name}"][".position"]])
+        before = np.linalg.norm(position[start, :2] - position[0, :2])
+        during = np.linalg.norm(position[end, :2] - position[start, :2])
+        assert during > 0.05 and before < 0.25 * during, (name, before, during)
+    title = "scene default (gen1 seed 3), human-like planner on the true scene: reach success, grasp "
+    assert title in page and 'id="hlp-clock"' in page
 
 
 @pytest.mark.slow  # ~20 s of CPU: the 2 ms execution with a re-optimisation every second

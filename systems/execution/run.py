@@ -32,7 +32,14 @@ from hlp_drake.systems.execution.diagram import (
     execution_model_error,
     make_execution_diagram,
 )
-from hlp_drake.systems.execution.meshcat_view import PLAN_LIFT, draw_perception, draw_plan, frame_table
+from hlp_drake.systems.execution.meshcat_view import (
+    PLAN_LIFT,
+    draw_perception,
+    draw_plan,
+    frame_table,
+    highlight_pushes,
+    push_times,
+)
 from hlp_drake.systems.execution.result import ExecutionResult, true_names
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.cost import FinalState, pregrasp_check, reach_problem
@@ -265,8 +272,17 @@ def _execute(
     root = simulator.get_mutable_context()
     settle_s = scenario.optimiser.settle_s  # after the trajectory ends, before objects are checked
     listener.executing(command.end(root) + settle_s + grasp.close_s + grasp.lift_s + grasp.hold_s)
-    simulator.set_monitor(lambda context: listener.simulated(context.get_time()) or EventStatus.DidNothing())
     plant_context = plant.GetMyContextFromRoot(simulator.get_context())
+    tcp_frame = plant.GetFrameByName(scenario.robot.tcp_frame, robot)
+    track: list[tuple[float, np.ndarray]] = []  # recorded: the tcp over time, to time the pushes
+
+    def monitor(context) -> EventStatus:
+        listener.simulated(context.get_time())
+        if meshcat is not None:
+            track.append((context.get_time(), tcp_frame.CalcPoseInWorld(plant_context).translation()))
+        return EventStatus.DidNothing()
+
+    simulator.set_monitor(monitor)
     names = [o.name for o in scene.objects]
     before = object_planar_poses(plant, plant_context, names)
     if meshcat is not None:
@@ -292,9 +308,7 @@ def _execute(
             and np.hypot(*np.subtract(after[n][:2], before[n][:2])) > MOVED_TOLERANCE
         ]
         result.objects_dropped = fallen_objects(plant, plant_context, scene)
-        tcp = (
-            plant.GetFrameByName(scenario.robot.tcp_frame, robot).CalcPoseInWorld(plant_context).translation()
-        )
+        tcp = tcp_frame.CalcPoseInWorld(plant_context).translation()
         inside, result.target_distance = pregrasp_check(
             tcp,
             after[scene.target.name],
@@ -321,8 +335,29 @@ def _execute(
         simulator.clear_monitor()
         result.simulated_s = float(simulator.get_context().get_time())
         if meshcat is not None:
+            _highlight_pushes(meshcat, scenario, result, track)
             meshcat.StopRecording()
             meshcat.PublishRecording()
+
+
+def _highlight_pushes(
+    meshcat: Meshcat, scenario: Scenario, result: ExecutionResult, track: list[tuple[float, np.ndarray]]
+) -> None:
+    """Colour each object the robot plan pushes in the recording while the tcp (``track``: simulated
+    time, position) goes from its push's start to its end (``highlight_pushes``)."""
+    if not track:
+        return
+    times = np.array([t for t, _ in track])
+    tcp = np.array([p for _, p in track])
+    pushes = push_times(
+        result.robot_plan,
+        times,
+        tcp,
+        table_height=scenario.scene.table.height,
+        keypoint_height=tcp_keypoint_height(scenario.scene, scenario.ik),
+        names=result.true_names,
+    )
+    highlight_pushes(meshcat, result.scene, pushes)
 
 
 class RunListener:

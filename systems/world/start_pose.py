@@ -104,7 +104,8 @@ def start_configuration(
     """The robot's start positions, in ``plant``'s order for ``instance`` (as ``SetPositions`` takes them).
 
     The base stands at ``robot_base_pose(scene, ik, robot)``; the arm (solved by IK on a robot-only
-    kinematic model, seeded and regularised towards ``robot.home``) puts the tcp above
+    kinematic model, seeded and regularised towards ``robot.home``; a fixed arm also from up to
+    ``START_ATTEMPTS - 1`` seeded random postures) puts the tcp above
     ``scene.start`` at ``ik.height`` above the table top, pointing along +x with the fingers opening
     along y; the gripper is open.
 
@@ -127,6 +128,11 @@ def start_configuration(
     values = {**dict(zip(robot.base_joints, base)), **dict(zip(robot.arm_joints, arm, strict=True))}
     values.update({name: robot.gripper_open for name in robot.gripper_joints})
     return _to_plant_order(plant, instance, values)
+
+
+START_ATTEMPTS = 12
+"""Starts of a fixed arm's start-pose IK: its home, then seeded random postures within its limits."""
+START_SEED = 0
 
 
 @functools.lru_cache(maxsize=64)
@@ -159,7 +165,17 @@ def _start_arm(
     ik.AddPositionConstraint(tcp, np.zeros(3), plant.world_frame(), goal - 1e-4, goal + 1e-4)
     ik.AddOrientationConstraint(plant.world_frame(), tcp_rotation(0.0), tcp, RotationMatrix(), 1e-3)
     prog.AddQuadraticErrorCost(np.eye(int(np.sum(~fixed))), seed[~fixed], q[~fixed])
-    result = Solve(prog, seed, ik_solver_options(max_iterations))
+    options = ik_solver_options(max_iterations)
+    result = Solve(prog, seed, options)
+    if not result.is_success() and not robot.mobile:  # a fixed arm: more starts, the same on every run
+        rng = np.random.default_rng(START_SEED)
+        lower = np.maximum(plant.GetPositionLowerLimits(), -math.pi)
+        upper = np.minimum(plant.GetPositionUpperLimits(), math.pi)
+        for _ in range(START_ATTEMPTS - 1):
+            other = np.where(fixed, seed, rng.uniform(lower, upper))
+            result = Solve(prog, other, options)
+            if result.is_success():
+                break
     if not result.is_success():
         return None
     solution = result.GetSolution(q)

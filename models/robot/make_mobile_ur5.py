@@ -33,17 +33,44 @@ the footprint):
   left finger's opening direction.
 
 Geometry is primitives only (boxes and cylinders). Wheels, caps, rings and stripes are visual only.
+The URDF helpers (primitives, links, joints, inertias) are in ``urdf_writer.py``, shared with
+``make_arms.py``.
 """
 
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # urdf_writer.py beside this script
+
+from urdf_writer import (
+    IDENTITY,
+    PI,
+    Link,
+    Pose,
+    Vec,
+    add,
+    apply,
+    box,
+    box_inertia,
+    collision_group,
+    combined_inertia,
+    compose,
+    cyl,
+    cyl_span,
+    cylinder_inertia,
+    joint_xml,
+    nums,
+    rot,
+    rpy_matrix,
+    sub,
+    transmission_xml,
+    transpose,
+)
+
 OUTPUT = Path(__file__).resolve().with_name("mobile_ur5.urdf")
-PI = math.pi
 
 # --- UR5 (official DH parameters, link masses, centres of mass in the DH link frames) -----------
 UR5_DH = (  # (d, a, alpha) of links 1..6
@@ -104,51 +131,6 @@ MATERIALS = {
     "base_yellow": (0.96, 0.76, 0.10, 1.0),
 }
 
-# --- Small rigid-transform helpers (3x3 lists), enough to place the UR5 centres of mass ---------
-Mat = tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
-Vec = tuple[float, float, float]
-
-
-def _rot(axis: str, angle: float) -> Mat:
-    c, s = math.cos(angle), math.sin(angle)
-    if axis == "x":
-        return ((1.0, 0.0, 0.0), (0.0, c, -s), (0.0, s, c))
-    if axis == "y":
-        return ((c, 0.0, s), (0.0, 1.0, 0.0), (-s, 0.0, c))
-    return ((c, -s, 0.0), (s, c, 0.0), (0.0, 0.0, 1.0))
-
-
-def _mul(a: Mat, b: Mat) -> Mat:
-    return tuple(tuple(sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3)) for i in range(3))
-
-
-def _apply(r: Mat, v: Vec) -> Vec:
-    return tuple(sum(r[i][k] * v[k] for k in range(3)) for i in range(3))
-
-
-def _transpose(r: Mat) -> Mat:
-    return tuple(tuple(r[j][i] for j in range(3)) for i in range(3))
-
-
-def _add(a: Vec, b: Vec) -> Vec:
-    return tuple(x + y for x, y in zip(a, b))
-
-
-def _sub(a: Vec, b: Vec) -> Vec:
-    return tuple(x - y for x, y in zip(a, b))
-
-
-Pose = tuple[Mat, Vec]
-IDENTITY: Mat = _rot("z", 0.0)
-
-
-def _compose(a: Pose, b: Pose) -> Pose:
-    return _mul(a[0], b[0]), _add(a[1], _apply(a[0], b[1]))
-
-
-def _rpy(roll: float, pitch: float, yaw: float) -> Mat:
-    return _mul(_rot("z", yaw), _mul(_rot("y", pitch), _rot("x", roll)))
-
 
 # UR layout of the arm: (joint, parent, child, origin xyz, origin rpy, axis) in the parent link.
 UR5_JOINTS = (
@@ -171,207 +153,15 @@ FLANGE_ORIGIN = ((0, UR5_DH[5][0], 0), (-PI / 2, 0, 0))  # ur5_flange in wrist_3
 
 def ur5_coms() -> list[Vec]:
     """Centres of mass of links 1..6 expressed in this model's link frames (at q = 0 both agree)."""
-    dh_pose: Pose = (_rot("z", PI), (0.0, 0.0, 0.0))  # DH base in ur5_base_link
+    dh_pose: Pose = (rot("z", PI), (0.0, 0.0, 0.0))  # DH base in ur5_base_link
     link_pose: Pose = (IDENTITY, (0.0, 0.0, 0.0))
     coms = []
     for (d, a, alpha), com, joint in zip(UR5_DH, UR5_COMS_DH, UR5_JOINTS):
-        dh_pose = _compose(dh_pose, (_rot("x", alpha), (a, 0.0, d)))
-        link_pose = _compose(link_pose, (_rpy(*joint[4]), tuple(float(v) for v in joint[3])))
-        p_world = _add(dh_pose[1], _apply(dh_pose[0], com))
-        coms.append(_apply(_transpose(link_pose[0]), _sub(p_world, link_pose[1])))
+        dh_pose = compose(dh_pose, (rot("x", alpha), (a, 0.0, d)))
+        link_pose = compose(link_pose, (rpy_matrix(*joint[4]), tuple(float(v) for v in joint[3])))
+        p_world = add(dh_pose[1], apply(dh_pose[0], com))
+        coms.append(apply(transpose(link_pose[0]), sub(p_world, link_pose[1])))
     return coms
-
-
-# --- Inertias ----------------------------------------------------------------------------------
-def cylinder_inertia(mass: float, radius: float, length: float, axis: str) -> Vec:
-    """(ixx, iyy, izz) of a solid cylinder about its centre, its axis along ``axis``."""
-    along = mass * radius**2 / 2.0
-    across = mass * (3.0 * radius**2 + length**2) / 12.0
-    return tuple(along if a == axis else across for a in "xyz")
-
-
-def box_inertia(mass: float, size: Vec) -> Vec:
-    x, y, z = size
-    return (mass * (y * y + z * z) / 12.0, mass * (x * x + z * z) / 12.0, mass * (x * x + y * y) / 12.0)
-
-
-def combined_inertia(parts: list[tuple[float, Vec, Vec]]) -> tuple[float, Vec, tuple[float, ...]]:
-    """Mass, centre of mass and (ixx, iyy, izz, ixy, ixz, iyz) about it (URDF signs: ixy = -sum m x y)
-    of rigid parts (mass, centre of mass, principal (ixx, iyy, izz) about it, axes along the link's)."""
-    mass = sum(m for m, _, _ in parts)
-    com = tuple(sum(m * c[i] for m, c, _ in parts) / mass for i in range(3))
-    ixx = iyy = izz = ixy = ixz = iyz = 0.0
-    for m, c, (jxx, jyy, jzz) in parts:
-        dx, dy, dz = _sub(c, com)
-        ixx += jxx + m * (dy * dy + dz * dz)
-        iyy += jyy + m * (dx * dx + dz * dz)
-        izz += jzz + m * (dx * dx + dy * dy)
-        ixy -= m * dx * dy
-        ixz -= m * dx * dz
-        iyz -= m * dy * dz
-    return mass, com, (ixx, iyy, izz, ixy, ixz, iyz)
-
-
-# --- URDF text -----------------------------------------------------------------------------------
-def num(x: float) -> str:
-    text = f"{x:.12g}"
-    return "0" if text in ("0", "-0") else text
-
-
-def nums(values) -> str:
-    return " ".join(num(float(v)) for v in values)
-
-
-AXIS_RPY = {"x": (0.0, PI / 2, 0.0), "y": (PI / 2, 0.0, 0.0), "z": (0.0, 0.0, 0.0)}
-
-
-class Shape:
-    """A primitive with its pose in the link: ``box`` (size) or ``cylinder`` (radius, length, axis)."""
-
-    def __init__(
-        self,
-        kind: str,
-        xyz: Vec,
-        *,
-        size: Vec = (0, 0, 0),
-        radius: float = 0.0,
-        length: float = 0.0,
-        axis: str = "z",
-        rpy: Vec = (0.0, 0.0, 0.0),
-    ) -> None:
-        self.kind, self.xyz, self.size, self.radius, self.length = kind, xyz, size, radius, length
-        self.rpy = AXIS_RPY[axis] if kind == "cylinder" else rpy
-
-    def xml(self) -> str:
-        if self.kind == "box":
-            geometry = f'<box size="{nums(self.size)}"/>'
-        else:
-            geometry = f'<cylinder radius="{num(self.radius)}" length="{num(self.length)}"/>'
-        return f'<origin xyz="{nums(self.xyz)}" rpy="{nums(self.rpy)}"/><geometry>{geometry}</geometry>'
-
-
-def cyl(axis: str, center: Vec, radius: float, length: float) -> Shape:
-    return Shape("cylinder", center, radius=radius, length=length, axis=axis)
-
-
-def box(center: Vec, size: Vec) -> Shape:
-    return Shape("box", center, size=size)
-
-
-def span(axis: str, lo: float, hi: float, at: Vec = (0.0, 0.0, 0.0)) -> tuple[Vec, float]:
-    """Centre and length of a segment [lo, hi] along ``axis`` through point ``at``."""
-    centre = list(at)
-    centre["xyz".index(axis)] = (lo + hi) / 2.0
-    return tuple(centre), hi - lo
-
-
-def cyl_span(axis: str, lo: float, hi: float, radius: float, at: Vec = (0.0, 0.0, 0.0)) -> Shape:
-    centre, length = span(axis, lo, hi, at)
-    return cyl(axis, centre, radius, length)
-
-
-class Link:
-    def __init__(self, name: str, comment: str = "") -> None:
-        self.name, self.comment = name, comment
-        self.inertial: tuple[float, Vec, tuple[float, ...]] | None = None
-        self.visuals: list[tuple[Shape, str]] = []
-        self.collisions: list[Shape] = []
-
-    def mass(self, mass: float, com: Vec, inertia: tuple[float, ...]) -> Link:
-        """``inertia`` about ``com``: (ixx, iyy, izz) or (ixx, iyy, izz, ixy, ixz, iyz)."""
-        self.inertial = (mass, com, inertia)
-        return self
-
-    def add(self, shape: Shape, material: str, *, collide: bool = True) -> Link:
-        self.visuals.append((shape, material))
-        if collide:
-            self.collisions.append(shape)
-        return self
-
-    def xml(self) -> list[str]:
-        lines = [f"  <!-- {self.comment} -->"] if self.comment else []
-        lines.append(f'  <link name="{self.name}">')
-        if self.inertial is not None:
-            mass, com, inertia = self.inertial
-            ixx, iyy, izz, ixy, ixz, iyz = (*inertia, 0.0, 0.0, 0.0)[:6]
-            lines += [
-                "    <inertial>",
-                f'      <origin xyz="{nums(com)}" rpy="0 0 0"/>',
-                f'      <mass value="{num(mass)}"/>',
-                (
-                    f'      <inertia ixx="{num(ixx)}" ixy="{num(ixy)}" ixz="{num(ixz)}" iyy="{num(iyy)}"'
-                    f' iyz="{num(iyz)}" izz="{num(izz)}"/>'
-                ),
-                "    </inertial>",
-            ]
-        for i, (shape, material) in enumerate(self.visuals):
-            lines.append(
-                f'    <visual name="{self.name}_visual_{i}">{shape.xml()}'
-                f'<material name="{material}"/></visual>'
-            )
-        for i, shape in enumerate(self.collisions):
-            lines.append(f'    <collision name="{self.name}_collision_{i}">{shape.xml()}</collision>')
-        lines.append("  </link>")
-        return lines
-
-
-def joint_xml(
-    name: str,
-    kind: str,
-    parent: str,
-    child: str,
-    xyz=(0, 0, 0),
-    rpy=(0, 0, 0),
-    *,
-    axis: Vec | None = None,
-    limit: tuple[float, float, float, float] | None = None,
-    damping: float | None = None,
-    mimic: str | None = None,
-) -> list[str]:
-    lines = [
-        f'  <joint name="{name}" type="{kind}">',
-        f'    <parent link="{parent}"/>',
-        f'    <child link="{child}"/>',
-        f'    <origin xyz="{nums(xyz)}" rpy="{nums(rpy)}"/>',
-    ]
-    if axis is not None:
-        lines.append(f'    <axis xyz="{nums(axis)}"/>')
-    if limit is not None:
-        lower, upper, effort, velocity = limit
-        lines.append(
-            f'    <limit lower="{num(lower)}" upper="{num(upper)}" effort="{num(effort)}" '
-            f'velocity="{num(velocity)}"/>'
-        )
-    if damping is not None:
-        lines.append(f'    <dynamics damping="{num(damping)}" friction="0"/>')
-    if mimic is not None:
-        lines.append(f'    <mimic joint="{mimic}" multiplier="1" offset="0"/>')
-    lines.append("  </joint>")
-    return lines
-
-
-def transmission_xml(joint: str) -> list[str]:
-    stem = joint.removesuffix("_joint")
-    return [
-        f'  <transmission name="{stem}_transmission">',
-        "    <type>transmission_interface/SimpleTransmission</type>",
-        (
-            f'    <joint name="{joint}"><hardwareInterface>hardware_interface/EffortJointInterface'
-            "</hardwareInterface></joint>"
-        ),
-        f'    <actuator name="{stem}_motor"><mechanicalReduction>1</mechanicalReduction></actuator>',
-        "  </transmission>",
-    ]
-
-
-def collision_group(name: str, members: tuple[str, ...]) -> list[str]:
-    lines = [f'  <drake:collision_filter_group name="{name}">']
-    lines += [f'    <drake:member link="{m}"/>' for m in members]
-    lines += [
-        f'    <drake:ignored_collision_filter_group name="{name}"/>',
-        "  </drake:collision_filter_group>",
-    ]
-    return lines
 
 
 # --- The model -----------------------------------------------------------------------------------

@@ -118,11 +118,20 @@ class ArmSpec:
     finger_base: float  # finger joints' origin along the palm's z
     tcp: float
     hand_yaw: float  # the palm (and tcp) about the flange's z
+    hand_bracket: float  # > 0: an angle bracket, the palm this far out along the flange's z, turned to face its x
     forward_kinematics: object
     mount: float
     home: tuple[float, ...]
     home_tcp: tuple[float, float, float]
     home_pitch: float  # at most, rad
+
+    def hand_mount(self) -> RigidTransform:
+        """The palm's pose in the flange's frame."""
+        if self.hand_bracket == 0.0:
+            return RigidTransform(RotationMatrix.MakeZRotation(self.hand_yaw))
+        # approach (z) along the flange's x, the palm's x along the flange's z (the flange points down)
+        turned = RotationMatrix(np.array([[0.0, 0.0, 1.0], [0.0, -1.0, 0.0], [1.0, 0.0, 0.0]]))
+        return RigidTransform(turned, [0.0, 0.0, self.hand_bracket])
 
     @property
     def pedestal(self) -> str:
@@ -147,6 +156,7 @@ PANDA = ArmSpec(
     finger_base=0.0584,
     tcp=0.1034,
     hand_yaw=-math.pi / 4,
+    hand_bracket=0.0,
     forward_kinematics=panda_flange,
     mount=MAKE_ARMS.PANDA_MOUNT,
     home=MAKE_ARMS.PANDA_HOME,
@@ -171,10 +181,11 @@ IIWA = ArmSpec(
     finger_base=0.087,
     tcp=0.13,
     hand_yaw=0.0,
+    hand_bracket=MAKE_ARMS.WSG_BRACKET,
     forward_kinematics=iiwa_flange,
     mount=MAKE_ARMS.IIWA_MOUNT,
     home=MAKE_ARMS.IIWA_HOME,
-    home_tcp=(0.50, 0.0, 0.81),
+    home_tcp=(0.45, 0.0, 0.81),
     home_pitch=0.08,
 )
 ARMS = (PANDA, IIWA)
@@ -298,10 +309,9 @@ def test_arm_stands_on_its_pedestal_and_the_tcp_sits_on_the_hand(robot: Robot):
     X_world_base = robot.frame(spec.links[0]).CalcPoseInWorld(context)
     assert X_world_base.IsNearlyEqualTo(RigidTransform([0.0, 0.0, spec.mount]), 1e-12)
     X_flange_tcp = plant.CalcRelativeTransform(context, robot.frame(spec.flange), robot.frame("tcp"))
-    expected = RigidTransform(RotationMatrix.MakeZRotation(spec.hand_yaw), [0.0, 0.0, spec.tcp])
-    assert X_flange_tcp.IsNearlyEqualTo(expected, 1e-12)
     X_flange_palm = plant.CalcRelativeTransform(context, robot.frame(spec.flange), robot.frame(spec.palm))
-    assert X_flange_palm.IsNearlyEqualTo(RigidTransform(RotationMatrix.MakeZRotation(spec.hand_yaw)), 1e-12)
+    assert X_flange_palm.IsNearlyEqualTo(spec.hand_mount(), 1e-9)
+    assert X_flange_tcp.IsNearlyEqualTo(spec.hand_mount() @ RigidTransform([0.0, 0.0, spec.tcp]), 1e-9)
 
 
 def test_pedestal_column_carries_the_arm(robot: Robot):

@@ -24,15 +24,18 @@ the axis:
   horizontal hand reaches the points near the axis only with the wrist folded over the base, with
   the tcp at least 0.41 m above the mount: from 0.36 m up, (0.25, 0) is lost over a 0.70 m table
   (R = 0), and lower mounts lose far reach over a 0.80 m table.
-* iiwa 14, mount 0.87 m: its elbow (+-120 deg) keeps the wrist at least 0.41 m from the shoulder
-  and its wrist lies on the tool axis, so the horizontal gripper reaches points near the axis only
-  through the pedestal: R 0.86 / 0.95 m reached but 0 clear (x on the centre line from 0.45 /
-  0.50 m), R50 0.86 / 0.95 m in every grade, x up to 0.95 / 1.00 m. 0.87 m makes the smaller R
-  (reached) and R50 (clear) over the two tables largest (R50 clear: 0.86 m from 0.85 to 0.88 m;
-  0 below 0.75 m, where (0.5, 0) is out of reach).
+* iiwa 14, mount 0.20 m, its gripper on an angle bracket (``WSG_BRACKET``: the approach along the
+  flange's x, the flange pointing down, as in iiwa cells). Its elbow (+-120 deg) keeps the wrist at
+  least 0.41 m from the shoulder; with the gripper straight on the flange the wrist lies on the tool
+  axis and the horizontal gripper reaches points near the axis only through its own pedestal (R 0
+  clear at every mount, x from 0.45 m at 0.87 m). On the bracket, with the shoulder low, the wrist
+  sits above the shoulder near the axis: R 0.98 / 0.95 m reached and free of self-collision, 0.76 /
+  0.70 m clear of the table (0.70 / 0.80 m table), x on the centre line from 0.10-0.15 m. Lower
+  mounts lose reach over the table (0.15 m: 0.70 / 0.65 m clear), higher ones the points near the
+  axis (0.30 m: x from 0.40 m over a 0.70 m table).
 
 Ready configurations (``PANDA_HOME``, ``IIWA_HOME``; ``measure_reach.py --home``): the tcp 0.06 m
-above a 0.75 m table, pointing along +x (the iiwa's pitched 0.06 rad down) with the fingers
+above a 0.75 m table, 0.40 m (Panda) and 0.45 m (iiwa) in front of the axis, pointing along +x with the fingers
 opening along y, clear of the arm, the pedestal and a table whose edge is 0.20 m in front of the
 axis.
 
@@ -107,12 +110,12 @@ IIWA_OUTPUT = HERE / "iiwa14.urdf"
 # --- Pedestals -----------------------------------------------------------------------------------
 PANDA_MOUNT = 0.35
 """Height of the Panda's mount (top of its pedestal) above the floor, m (measure_reach.py)."""
-IIWA_MOUNT = 0.87
+IIWA_MOUNT = 0.20
 """Height of the iiwa's mount (top of its pedestal) above the floor, m (measure_reach.py)."""
 PANDA_HOME = (0.5033, -1.0687, -0.5957, -2.8551, -2.7321, 2.7179, -0.1122)
 """Panda ready configuration: tcp at (0.40, 0, 0.81) m, exactly horizontal (the Panda's J6 range
 keeps the hand from pointing forward with the arm in a vertical plane, so the elbow swings aside)."""
-IIWA_HOME = (0.0, 1.6757, 0.0, -1.9141, 0.0, -1.9586, 0.0)
+IIWA_HOME = (-1.667, 0.4998, -0.9336, 1.7007, -0.4002, -1.7409, 0.5327)
 """iiwa ready configuration: tcp at (0.50, 0, 0.81) m, pitched 0.06 rad down (the wrist housing,
 on the tool axis 0.26 m behind the tcp, then clears the table top), the arm in the x-z plane (found
 as ``measure_reach.py --home`` finds it, ``--home-x 0.5 --home-tolerance 0.07``, with joints 1, 3,
@@ -190,6 +193,7 @@ WSG_BODY_MASS, WSG_FINGER_MASS = 1.1, 0.05  # 1.2 kg with the fingers
 WSG_FINGER_SIZE = (0.02, 0.012, 0.06)  # x, thickness along y, length along z from the housing
 WSG_FINGER_STROKE = 0.055  # per finger: 0 closed, 0.055 open (110 mm between the pads)
 WSG_FINGER_FORCE, WSG_FINGER_SPEED = 80.0, 0.2
+WSG_BRACKET = 0.06  # the angle bracket: the gripper's axis this far from the flange along its z
 WSG_TCP = 0.13  # tcp along the approach axis from the flange: mid-pad, 17 mm in from the tips
 IIWA_MATERIALS = {
     "kuka_orange": (1.0, 0.42, 0.04, 1.0),
@@ -438,7 +442,11 @@ def iiwa_links() -> list[Link]:
 
 
 def wsg_links() -> list[Link]:
-    flange = Link("iiwa_flange", "the iiwa's flange: DH frame 7 (the orientation of iiwa_link_7)")
+    flange = Link(
+        "iiwa_flange",
+        "the iiwa's flange: DH frame 7 (the orientation of iiwa_link_7), carrying the angle bracket",
+    )
+    flange.add(cyl_span("z", 0.0, WSG_BRACKET, 0.045), "kuka_dark")  # the bracket's stem along the flange's z
     body = Link("wsg_body", "WSG 50 sized gripper; frame = iiwa_flange; fingers open along y")
     bx, by, bz = WSG_BODY_SIZE
     body.add(cyl_span("z", 0.0, WSG_COUPLING, 0.045), "kuka_dark")
@@ -467,7 +475,11 @@ def iiwa14_urdf(mount: float = IIWA_MOUNT) -> str:
     body = joint_xml("iiwa_mount_joint", "fixed", "iiwa14_pedestal", "iiwa_link_0", (0, 0, mount))
     body += arm_joints(IIWA_JOINTS, IIWA_LIMITS)
     body += joint_xml("iiwa_flange_joint", "fixed", "iiwa_link_7", "iiwa_flange", (0, 0, IIWA_FLANGE))
-    body += joint_xml("wsg_mount_joint", "fixed", "iiwa_flange", "wsg_body")
+    # An angle bracket: the gripper's approach along the flange's x, WSG_BRACKET out along its z, so
+    # the tool axis is off the wrist (a horizontal gripper with the flange pointing down, as iiwa cells do).
+    body += joint_xml(
+        "wsg_mount_joint", "fixed", "iiwa_flange", "wsg_body", (0, 0, WSG_BRACKET), (PI, -PI / 2, 0)
+    )
     body += gripper_joints(
         "wsg_body",
         ("wsg_left_finger", "wsg_right_finger"),

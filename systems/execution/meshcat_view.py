@@ -68,26 +68,36 @@ BACKGROUND = ([0.97, 0.97, 0.98], [0.85, 0.86, 0.88])
 """The background's top and bottom colours: plain and light, the scene in front of it."""
 
 
-def camera_pose(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
+FIXED_BASE_VIEW = (math.radians(65.0), math.radians(-110.0), 1.3)
+"""(elevation, azimuth, distance) for a robot fixed before the middle of the table's front edge: its
+arm stands between the person's side and the table, so the camera looks from the left, a little
+from the far side, higher and farther out (checked in screenshots of the panda and the iiwa14)."""
+
+
+def camera_pose(scene: Scene, *, fixed_base: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """(where the camera is, the point it looks at) in the world, for ``scene``'s table: from the
     person's side (x < 0), ``VIEW_ELEVATION`` up and ``VIEW_AZIMUTH`` to the side, looking just in
-    front of the table top's centre so that its near edge stays in view."""
+    front of the table top's centre so that its near edge stays in view; for a ``fixed_base``
+    robot, ``FIXED_BASE_VIEW``."""
     table = scene.table
     target = np.array([0.35 * table.length, 0.0, table.height - 0.05])
-    distance = VIEW_DISTANCE * max(table.length, table.width)
+    elevation, azimuth, scale = (
+        FIXED_BASE_VIEW if fixed_base else (VIEW_ELEVATION, VIEW_AZIMUTH, VIEW_DISTANCE)
+    )
+    distance = scale * max(table.length, table.width)
     direction = np.array(
         [
-            -math.cos(VIEW_ELEVATION) * math.cos(VIEW_AZIMUTH),
-            -math.cos(VIEW_ELEVATION) * math.sin(VIEW_AZIMUTH),
-            math.sin(VIEW_ELEVATION),
+            -math.cos(elevation) * math.cos(azimuth),
+            -math.cos(elevation) * math.sin(azimuth),
+            math.sin(elevation),
         ]
     )
     return target + distance * direction, target
 
 
-def frame_table(meshcat: Meshcat, scene: Scene) -> None:
+def frame_table(meshcat: Meshcat, scene: Scene, *, fixed_base: bool = False) -> None:
     """Frame ``scene``'s table (``camera_pose``) on a plain background, the grid and axes hidden."""
-    camera, target = camera_pose(scene)
+    camera, target = camera_pose(scene, fixed_base=fixed_base)
     meshcat.SetCameraPose(camera, target)
     meshcat.SetProperty("/Grid", "visible", False)
     meshcat.SetProperty("/Axes", "visible", False)

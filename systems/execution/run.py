@@ -232,7 +232,7 @@ def _draw(
 ) -> None:
     """Frame the table and draw the human and robot plans (and what the cameras saw) in ``meshcat``."""
     scene = scenario.scene
-    frame_table(meshcat, scene)
+    frame_table(meshcat, scene, fixed_base=not scenario.robot.mobile)
     table = scene.table.height
     on_table = table + PLAN_LIFT  # the person's plan on the table top, the robot's path at the tcp's height
     draw_plan(meshcat, result.plan, path="plan", markers=False, table_height=table, keypoint_height=on_table)

@@ -202,3 +202,25 @@ def test_a_users_own_arm_runs_a_scene_end_to_end(own_robot, tmp_path):
     record = json.loads(out.read_text())
     assert record["robot"] == "arm6"
     assert result.returncode == 0, result.stdout + result.stderr
+
+
+def test_a_fixed_arms_recording_looks_past_the_arm():
+    from hlp_drake.systems.execution.meshcat_view import camera_pose
+
+    scene = generate_scene("gen1", 5, workspace=load_robot("panda").workspace)
+    person_side, target = camera_pose(scene)
+    beside, same_target = camera_pose(scene, fixed_base=True)
+    np.testing.assert_array_equal(target, same_target)
+    assert person_side[0] < 0 < person_side[1]  # behind the front edge, to the left
+    assert beside[0] > 0 and beside[1] > 0 and beside[2] > person_side[2]  # over the table, from the left
+
+
+def test_a_start_out_of_a_fixed_arms_reach_is_that_jobs_failure():
+    from hlp_drake.experiments.runner import Job
+    from hlp_drake.systems.execution.job import run_job
+
+    robot = replace(load_robot("panda"), base=replace(load_robot("panda").base, pose=(-0.02, 0.0, 0.0)))
+    job = Job("gen2", 20, 7, "gen2-7-20", "hlp", Scenario(robot=robot).yaml, Workspace(-0.3, 0.0, 0.88))
+    row = run_job(job)
+    assert row["success"] is False and "the arm cannot put the tcp above the start" in row["failure_reason"]
+    assert "out of its reach" in row["failure_reason"] and not row["failure_reason"].startswith("crashed")

@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
+from hlp_drake.errors import HlpError
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.systems.execution.result import what_ran
 from hlp_drake.systems.execution.run import plan_and_execute
@@ -56,8 +57,9 @@ def scenario_yamls(
 def run_job(job: Job) -> Row:
     """Plan and execute ``job``'s scene in the Drake world.
 
-    An exception (or one of Drake's internal checks failing, which pydrake raises as ``SystemExit``)
-    is recorded as this planner's failure on this scene ("crashed: ..."), its times as NaN (left
+    A scene the robot cannot run (``HlpError``, e.g. a start out of a fixed arm's reach) is this
+    planner's failure with that reason; any other exception (or one of Drake's internal checks
+    failing, which pydrake raises as ``SystemExit``) is recorded as its failure ("crashed: ..."), its times as NaN (left
     out of the means), rather than ending the run. The bundled decision models are loaded
     before the timed call, so a worker's first scene is not charged for loading them, and
     every job has a rollout pool of its own: no job uses rollout worlds an earlier one (maybe the
@@ -72,6 +74,8 @@ def run_job(job: Job) -> Row:
         )
         with RolloutPool(scenario.optimiser.workers) as pool:
             result = plan_and_execute(scenario, pool=pool, models=default_models())
+    except HlpError as error:  # the scene does not suit the robot, e.g. a start out of its reach
+        return crash_row(job, str(error))
     except (Exception, SystemExit) as error:  # noqa: BLE001 - a crash is this planner's failure here
         if isinstance(error, SystemExit):
             simulation_failure(error)  # raises it again unless it is Drake's

@@ -219,7 +219,7 @@ def test_a_start_out_of_a_fixed_arms_reach_is_that_jobs_failure():
     from hlp_drake.experiments.runner import Job
     from hlp_drake.systems.execution.job import run_job
 
-    robot = replace(load_robot("panda"), base=replace(load_robot("panda").base, pose=(-0.02, 0.0, 0.0)))
+    robot = replace(load_robot("panda"), base=replace(load_robot("panda").base, pose=(-0.1, 0.85, 0.0)))
     job = Job("gen2", 20, 7, "gen2-7-20", "hlp", Scenario(robot=robot).yaml, Workspace(-0.3, 0.0, 0.88))
     row = run_job(job)
     assert row["success"] is False and "the arm cannot put the tcp above the start" in row["failure_reason"]

@@ -118,7 +118,9 @@ class ArmSpec:
     finger_base: float  # finger joints' origin along the palm's z
     tcp: float
     hand_yaw: float  # the palm (and tcp) about the flange's z
-    hand_bracket: float  # > 0: an angle bracket, the palm this far out along the flange's z, turned to face its x
+    hand_bracket: (
+        float  # > 0: an angle bracket, the palm this far out along the flange's z, turned to face its x
+    )
     forward_kinematics: object
     mount: float
     home: tuple[float, ...]

@@ -68,7 +68,7 @@ from tqdm import tqdm
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.world.robot import MOBILE_UR5, models_directory
+from hlp_drake.systems.world.robot_description import MOBILE_UR5, models_directory
 from hlp_drake.systems.world.world import make_world_diagram, world_plant
 
 try:

@@ -130,17 +130,19 @@ __getattr__, __dir__ = lazy_exports(
         "hlp_drake.systems.planning.transfer": ("RobotPlanTransfer", "gripper_geometry"),
         "hlp_drake.systems.scenario": ("PlannerChoiceConfig", "Scenario", "load_scenario"),
         "hlp_drake.systems.world.robot": (
+            "add_robot",
+            "configure_parser",
+            "robot_joint_limits",
+            "set_robot_positions",
+        ),
+        "hlp_drake.systems.world.robot_description": (
             "MOBILE_UR5",
             "MODELS_PACKAGE",
             "SHIPPED_ROBOTS",
             "BaseConfig",
             "RobotDescription",
-            "add_robot",
             "load_robot",
-            "configure_parser",
             "models_directory",
-            "robot_joint_limits",
-            "set_robot_positions",
         ),
         "hlp_drake.systems.world.scene_models": (
             "SceneModels",

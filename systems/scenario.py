@@ -44,7 +44,12 @@ from hlp_drake.systems.execution.command import GraspConfig
 from hlp_drake.systems.optimiser.config import ClosedLoopConfig, StoConfig
 from hlp_drake.systems.perception.cameras import MAX_CAMERAS, PerceptionConfig, camera_pose
 from hlp_drake.systems.planning.ik import IkConfig, MotionConfig
-from hlp_drake.systems.world.robot import MOBILE_UR5, RobotDescription, load_robot, with_model_beside
+from hlp_drake.systems.world.robot_description import (
+    MOBILE_UR5,
+    RobotDescription,
+    load_robot,
+    with_model_beside,
+)
 from hlp_drake.systems.world.scene_models import BodiesConfig, ContactConfig
 from hlp_drake.systems.world.uncertainty import UncertaintyConfig
 from hlp_drake.systems.world.world import PLANT_RANGES, ControlConfig, default_plant_config

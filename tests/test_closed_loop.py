@@ -17,7 +17,7 @@ from hlp_drake.systems.optimiser.cost import Prediction, RolloutOutcome
 from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
 from hlp_drake.systems.planning.diagram import ObservedScenePlanner
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.world.robot import MOBILE_UR5
+from hlp_drake.systems.world.robot_description import MOBILE_UR5
 from hlp_drake.systems.world.uncertainty import UncertaintyConfig, sample_perturbation
 from hlp_drake.systems.world.world import make_world_diagram, world_plant
 

@@ -36,7 +36,7 @@ from hlp_drake.experiments.results import (
 from hlp_drake.experiments.runner import JobFunction
 from hlp_drake.experiments.summary import summarise
 from hlp_drake.systems import scenario_yamls
-from hlp_drake.systems.world.robot import MOBILE_UR5
+from hlp_drake.systems.world.robot_description import MOBILE_UR5
 
 # fmt: off
 REQUIRED_COLUMNS = ["scene", "objects", "planner", "success", "failure_reason", "init_s", "optimise_s",

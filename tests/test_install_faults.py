@@ -11,7 +11,7 @@ import pytest
 from conftest import run_module
 
 from hlp_drake.errors import MAX_LINE
-from hlp_drake.systems.world.robot import models_directory
+from hlp_drake.systems.world.robot_description import models_directory
 
 # run_scene with its model package read from the folder argv[1] (a damaged copy of the installed one).
 _WITH_PACKAGE = (

@@ -15,7 +15,7 @@ from hlp_drake.scene.model import Scene, SceneObject, Table
 from hlp_drake.systems.planning.ik import KeypointIk
 from hlp_drake.systems.planning.keyframes import Keyframes
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.world.robot import MOBILE_UR5
+from hlp_drake.systems.world.robot_description import MOBILE_UR5
 from hlp_drake.systems.world.start_pose import start_configuration
 from hlp_drake.systems.world.world import make_world_diagram, world_plant
 from hlp_drake.taskspace import TaskSpace

@@ -13,7 +13,7 @@ from pydrake.geometry import Role
 
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.world.robot import MOBILE_UR5
+from hlp_drake.systems.world.robot_description import MOBILE_UR5
 from hlp_drake.systems.world.start_pose import robot_position_names
 
 mujoco = pytest.importorskip("mujoco", reason="mujoco is an optional extra (pip install -e '.[bench]')")

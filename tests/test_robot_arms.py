@@ -23,7 +23,8 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
-from hlp_drake.systems.world.robot import MODELS_PACKAGE, models_directory, new_parser
+from hlp_drake.systems.world.robot import new_parser
+from hlp_drake.systems.world.robot_description import MODELS_PACKAGE, models_directory
 
 ROBOT_DIR = models_directory() / "robot"
 PRIMITIVES = (Box, Cylinder, Capsule, Sphere)

@@ -15,11 +15,12 @@ from conftest import REPO
 
 from hlp_drake.cli import SHIPPED_ROBOTS
 from hlp_drake.errors import HlpError
-from hlp_drake.scene.generators import GEN1, Workspace, generate_scene, within_reach
+from hlp_drake.scene.generators import GEN1, generate_scene
+from hlp_drake.scene.workspace import Workspace, within_reach
 from hlp_drake.systems import Scenario, load_scenario
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
 from hlp_drake.systems.optimiser.planar_noise import planar_maps, planar_shift
-from hlp_drake.systems.world.robot import MOBILE_UR5, BaseConfig, RobotDescription, load_robot
+from hlp_drake.systems.world.robot_description import MOBILE_UR5, BaseConfig, RobotDescription, load_robot
 from hlp_drake.systems.world.start_pose import kinematic_robot
 
 EXAMPLE = REPO / "examples" / "own_robot.py"

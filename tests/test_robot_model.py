@@ -23,13 +23,8 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
-from hlp_drake.systems.world.robot import (
-    MOBILE_UR5,
-    add_robot,
-    models_directory,
-    robot_joint_limits,
-    set_robot_positions,
-)
+from hlp_drake.systems.world.robot import add_robot, robot_joint_limits, set_robot_positions
+from hlp_drake.systems.world.robot_description import MOBILE_UR5, models_directory
 
 
 def _script(name: str):

@@ -22,7 +22,7 @@ from hlp_drake.systems.execution.meshcat_view import camera_pose
 from hlp_drake.systems.planning.diagram import make_planning_diagram
 from hlp_drake.systems.planning.transfer import gripper_geometry
 from hlp_drake.systems.scenario import Scenario, with_conditions
-from hlp_drake.systems.world.robot import MOBILE_UR5
+from hlp_drake.systems.world.robot_description import MOBILE_UR5
 from hlp_drake.taskspace import DIRECTION_VECTORS, TaskSpace
 from hlp_drake.transfer.push import ROBOT_ACTIONS, robot_alternatives, robot_plan
 from hlp_drake.transfer.rules import TransferConfig, push_rules

@@ -45,7 +45,7 @@ def test_sequence_keeps_every_keyframe_and_bounds_the_step(trajectories):
 
 def test_base_velocity_is_integrated_and_the_start_stays():
     from hlp_drake.systems.optimiser.control_sequence import BASE_COLUMNS
-    from hlp_drake.systems.world.robot import MOBILE_UR5
+    from hlp_drake.systems.world.robot_description import MOBILE_UR5
     from hlp_drake.systems.world.start_pose import robot_position_names
 
     assert tuple(robot_position_names()[i] for i in BASE_COLUMNS) == MOBILE_UR5.base_joints

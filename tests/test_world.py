@@ -20,7 +20,7 @@ from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene, SceneObject, Table, plan_view_order
 from hlp_drake.systems.planning.keyframes import PlanningModel
 from hlp_drake.systems.scenario import Scenario, load_scenario
-from hlp_drake.systems.world.robot import MOBILE_UR5
+from hlp_drake.systems.world.robot_description import MOBILE_UR5
 from hlp_drake.systems.world.scene_models import (
     add_scene,
     fallen_objects,

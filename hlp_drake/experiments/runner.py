@@ -13,8 +13,9 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from hlp_drake.errors import SceneError
-from hlp_drake.scene.generators import Workspace, generate_scene
+from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene
+from hlp_drake.scene.workspace import Workspace
 from hlp_drake.what_ran import WhatRan
 
 PLANNERS = ("hlp", "sto")  # the planners of Tables II and III: human-like plan; STO's straight line

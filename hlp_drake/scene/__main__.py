@@ -47,7 +47,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command == "generate":
         workspace = None
         if args.robot is not None:  # a fixed robot's tables within its reach (imports Drake)
-            from hlp_drake.systems.world.robot import load_robot
+            from hlp_drake.systems.world.robot_description import load_robot
 
             workspace = load_robot(args.robot).workspace
         scene = generate_scene(args.kind, args.seed, args.objects, workspace)

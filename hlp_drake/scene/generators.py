@@ -9,9 +9,7 @@ the world frame of ``hlp_drake.frames`` (front edge of the table at x = 0, y to 
 - ``gen1``: Generalization I: the same two-row structure on a robot-sized table with table and object
   dimensions varied (see ``GEN1``).
 
-For a robot fixed in front of the table (a ``Workspace``: where it stands and how far it reaches),
-``gen1`` and ``gen2`` scale their tables down (``within_reach``) so that every start and target they
-place lies within its reach; a mobile robot (no workspace) gets the tables of ``GEN1``.
+For a robot fixed before the table, gen1 and gen2 keep their tables within its reach (``workspace``).
 - ``gen2``: Generalization II: 5, 7 or 9 (any N >= 1) boxes and cylinders placed at random, the start
   on a random point of the front edge with a random heading, the target not aligned with the start.
 - ``unstructured``: the dataset's unstructured trials (T100-T129): the VR table, N (default 6) obstacles
@@ -34,6 +32,7 @@ from hlp_drake.scene.constants import KINDS, MAX_GENERATED
 from hlp_drake.scene.geometry import footprint
 from hlp_drake.scene.model import Scene, SceneObject, Table
 from hlp_drake.scene.validation import validate_scene
+from hlp_drake.scene.workspace import EDGE_INSET, Workspace, within_reach
 
 # --- The VR study (reference notes 1.2): metres, world frame. -----------------------------------
 VR_TABLE = Table(length=0.60, width=0.74, height=0.73)
@@ -71,52 +70,6 @@ class RobotSceneRanges:
 
 
 GEN1 = RobotSceneRanges()
-EDGE_INSET = 0.10
-"""Gen II: the start's and the target's distance from the table's side edges at least, m."""
-
-
-@dataclass(frozen=True)
-class Workspace:
-    """Where a robot fixed in front of the table reaches: the tcp within ``reach`` of (x, y), the
-    base's place in the scene's frame (x into the table from the middle of its front edge), m."""
-
-    x: float
-    y: float
-    reach: float
-
-
-def within_reach(ranges: RobotSceneRanges, workspace: Workspace | None) -> RobotSceneRanges:
-    """``ranges`` with the table's length and width scaled by one factor (at most 1) so that the
-    farthest start or target the generators place on the largest table is within ``workspace``'s
-    reach; ``ranges`` itself for None (a mobile robot)."""
-    if workspace is None:
-        return ranges
-
-    def farthest(scale: float) -> float:  # a Gen II target in the far corner: the farthest point placed
-        x = ranges.target_band[1] * ranges.table_length[1] * scale
-        y = ranges.table_width[1] * scale / 2.0 - EDGE_INSET + abs(workspace.y)
-        return math.hypot(x - workspace.x, y)
-
-    if farthest(1.0) <= workspace.reach:
-        return ranges
-    low, high = 0.0, 1.0  # farthest() grows with the scale: bisect
-    for _ in range(40):
-        middle = (low + high) / 2.0
-        low, high = (middle, high) if farthest(middle) <= workspace.reach else (low, middle)
-    if low < MIN_TABLE_SCALE:
-        raise SceneError(
-            f"a robot reaching {workspace.reach} m from ({workspace.x}, {workspace.y}) reaches too little "
-            "of a table to generate scenes on"
-        )
-    return replace(
-        ranges,
-        table_length=tuple(low * v for v in ranges.table_length),
-        table_width=tuple(low * v for v in ranges.table_width),
-    )
-
-
-MIN_TABLE_SCALE = 0.5
-"""The smallest table scale ``within_reach`` makes (the objects still have to fit)."""
 DECIMALS = 4  # generated values are rounded to 0.1 mm / 0.1 mrad so files read cleanly
 MAX_PLACEMENT_ATTEMPTS = 2000
 MAX_SEED = 2**32 - 1

@@ -14,7 +14,7 @@ from pydrake.solvers import Solve
 
 from hlp_drake.ranges import MAX_DURATION, NonNegativeFloat, Positive, PositiveFloat
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
-from hlp_drake.systems.world.robot import MOBILE_UR5, RobotDescription
+from hlp_drake.systems.world.robot_description import MOBILE_UR5, RobotDescription
 from hlp_drake.systems.world.scene_models import object_body
 from hlp_drake.systems.world.start_pose import ik_solver_options, kinematic_robot
 

@@ -15,7 +15,7 @@ import numpy as np
 from pydrake.multibody.tree import JacobianWrtVariable
 
 from hlp_drake.systems.optimiser.control_sequence import ControlSequence
-from hlp_drake.systems.world.robot import RobotDescription
+from hlp_drake.systems.world.robot_description import RobotDescription
 from hlp_drake.systems.world.start_pose import kinematic_robot
 
 DAMPING = 1e-2

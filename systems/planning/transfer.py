@@ -20,7 +20,8 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
 from hlp_drake.planner import HighLevelPlan
-from hlp_drake.systems.world.robot import MOBILE_UR5, RobotDescription, add_robot
+from hlp_drake.systems.world.robot import add_robot
+from hlp_drake.systems.world.robot_description import MOBILE_UR5, RobotDescription
 from hlp_drake.systems.world.scene_source import declare_scene_input_port, scene_input
 from hlp_drake.transfer.push import robot_alternatives, robot_plan
 from hlp_drake.transfer.rules import SIZE_RESOLUTION, GripperGeometry, PushRules, length, push_rules

@@ -22,7 +22,8 @@ from pydrake.solvers import SnoptSolver, Solve, SolverOptions
 
 from hlp_drake.errors import HlpError
 from hlp_drake.scene.model import Scene
-from hlp_drake.systems.world.robot import MOBILE_UR5, RobotDescription, add_robot
+from hlp_drake.systems.world.robot import add_robot
+from hlp_drake.systems.world.robot_description import MOBILE_UR5, RobotDescription
 
 if TYPE_CHECKING:
     from hlp_drake.systems.planning.ik import IkConfig

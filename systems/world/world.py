@@ -52,7 +52,8 @@ from pydrake.trajectories import Trajectory
 
 from hlp_drake.ranges import MAX_TIME_STEP, MIN_TIME_STEP, Fields, NonNegativeFloat, Positive, Rule
 from hlp_drake.systems.perception.cameras import add_cameras, label_classes
-from hlp_drake.systems.world.robot import RobotDescription, add_robot
+from hlp_drake.systems.world.robot import add_robot
+from hlp_drake.systems.world.robot_description import RobotDescription
 from hlp_drake.systems.world.scene_models import ContactConfig, add_scene
 from hlp_drake.systems.world.start_pose import robot_position_names, start_configuration
 

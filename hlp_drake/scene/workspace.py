@@ -1,0 +1,63 @@
+"""``Workspace``: where a robot fixed in front of the table reaches, and the generators' tables kept
+within it (``within_reach``)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
+
+from hlp_drake.errors import SceneError
+
+if TYPE_CHECKING:
+    from hlp_drake.scene.generators import RobotSceneRanges
+
+EDGE_INSET = 0.10
+"""Gen II: the start's and the target's distance from the table's side edges at least, m."""
+
+
+@dataclass(frozen=True)
+class Workspace:
+    """Where a robot fixed in front of the table reaches: the tcp within ``reach`` of (x, y), the
+    base's place in the scene's frame (x into the table from the middle of its front edge), m."""
+
+    x: float
+    y: float
+    reach: float
+
+
+def within_reach(ranges: RobotSceneRanges, workspace: Workspace | None) -> RobotSceneRanges:
+    """``ranges`` with the table's length and width scaled by one factor (at most 1) so that the
+    farthest start or target the generators place on the largest table is within ``workspace``'s
+    reach; ``ranges`` itself for None (a mobile robot)."""
+    if workspace is None:
+        return ranges
+
+    def farthest(scale: float) -> float:  # a Gen II target in the far corner: the farthest point placed
+        x = ranges.target_band[1] * ranges.table_length[1] * scale
+        y = ranges.table_width[1] * scale / 2.0 - EDGE_INSET + abs(workspace.y)
+        return math.hypot(x - workspace.x, y)
+
+    if farthest(1.0) <= workspace.reach:
+        return ranges
+    low, high = 0.0, 1.0  # farthest() grows with the scale: bisect
+    for _ in range(40):
+        middle = (low + high) / 2.0
+        low, high = (middle, high) if farthest(middle) <= workspace.reach else (low, middle)
+    if low < MIN_TABLE_SCALE:
+        raise SceneError(
+            f"a robot reaching {workspace.reach} m from ({workspace.x}, {workspace.y}) reaches too little "
+            "of a table to generate scenes on"
+        )
+    return replace(
+        ranges,
+        table_length=tuple(low * v for v in ranges.table_length),
+        table_width=tuple(low * v for v in ranges.table_width),
+    )
+
+
+MIN_TABLE_SCALE = 0.5
+"""The smallest table scale ``within_reach`` makes (the objects still have to fit)."""
+
+
+__all__ = ["EDGE_INSET", "MIN_TABLE_SCALE", "Workspace", "within_reach"]

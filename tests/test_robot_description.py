@@ -220,8 +220,27 @@ def test_a_start_out_of_a_fixed_arms_reach_is_that_jobs_failure():
     from hlp_drake.experiments.runner import Job
     from hlp_drake.systems.execution.job import run_job
 
-    robot = replace(load_robot("panda"), base=replace(load_robot("panda").base, pose=(-0.1, 0.85, 0.0)))
+    panda = load_robot("panda")  # a reach claimed beyond the arm's: the start 1.2 m to the side is out of it
+    robot = replace(panda, reach=1.5, base=replace(panda.base, pose=(-0.1, 1.2, 0.0)))
     job = Job("gen2", 20, 7, "gen2-7-20", "hlp", Scenario(robot=robot).yaml, Workspace(-0.3, 0.0, 0.88))
     row = run_job(job)
     assert row["success"] is False and "the arm cannot put the tcp above the start" in row["failure_reason"]
     assert "out of its reach" in row["failure_reason"] and not row["failure_reason"].startswith("crashed")
+
+
+def test_a_start_close_before_the_pedestal_tilts_within_the_keypoints_tolerance():
+    from hlp_drake.systems.world.start_pose import _start_arm, start_configuration, tcp_keypoint_height
+
+    iiwa = load_robot("iiwa14")
+    scene = generate_scene("gen2", 16, 7, iiwa.workspace)  # the start 0.2 m before the pedestal, a low table
+    ik = Scenario(robot=iiwa).ik
+    goal = (*scene.start, tcp_keypoint_height(scene, ik))
+    assert _start_arm(iiwa, tuple(round(v, 9) for v in goal), ik.max_iterations) is None  # not horizontal
+    plant, instance = kinematic_robot(iiwa)
+    context = plant.CreateDefaultContext()
+    plant.SetPositions(context, instance, start_configuration(scene, ik, plant, instance, iiwa))
+    pose = plant.GetFrameByName(iiwa.tcp_frame, instance).CalcPoseInWorld(context)
+    np.testing.assert_allclose(pose.translation(), goal, atol=2e-4)
+    approach, fingers = pose.rotation().matrix()[:, 2], pose.rotation().matrix()[:, 1]
+    assert 1e-3 < np.arccos(approach[0]) <= ik.approach_tolerance + 1e-6  # tilted, within the keypoints' cone
+    assert abs(fingers[2]) <= np.sin(ik.roll_tolerance) + 1e-6  # the fingers still open sideways

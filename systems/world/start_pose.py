@@ -108,7 +108,10 @@ def start_configuration(
     kinematic model, seeded and regularised towards ``robot.home``; a fixed arm also from up to
     ``START_ATTEMPTS - 1`` seeded random postures) puts the tcp above
     ``scene.start`` at ``ik.height`` above the table top, pointing along +x with the fingers opening
-    along y; the gripper is open.
+    along y; the gripper is open. Where that exact orientation is out of reach (a start close in front
+    of a fixed arm's pedestal, where the wrist cannot fold back far enough), the start takes the
+    keypoints' own tolerance instead: the approach axis within ``ik.approach_tolerance`` of +x, the
+    finger axis within ``ik.roll_tolerance`` of the horizontal.
 
     Raises:
         HlpError: the start point is out of the arm's reach from that base pose.
@@ -118,7 +121,9 @@ def start_configuration(
         target = (round(scene.start[0] - base[0], 9), 0.0, round(tcp_keypoint_height(scene, ik), 9))
     else:
         target = (*(round(float(v), 9) for v in scene.start), round(tcp_keypoint_height(scene, ik), 9))
-    arm = _start_arm(robot, target, ik.max_iterations)
+    arm = _start_arm(robot, target, ik.max_iterations) or _start_arm(
+        robot, target, ik.max_iterations, (ik.approach_tolerance, ik.roll_tolerance)
+    )
     if arm is None:
         where = "the base pose" if robot.mobile else f"robot {robot.name}'s base (robot.base.pose)"
         raise HlpError(
@@ -138,10 +143,14 @@ START_SEED = 0
 
 @functools.lru_cache(maxsize=64)
 def _start_arm(
-    robot: RobotDescription, target: tuple[float, float, float], max_iterations: int
+    robot: RobotDescription,
+    target: tuple[float, float, float],
+    max_iterations: int,
+    tolerance: tuple[float, float] | None = None,
 ) -> tuple[float, ...] | None:
     """Arm angles putting the tcp at ``target`` (a mobile base at the origin; a fixed one where it
-    stands), horizontal along +x (cached)."""
+    stands), horizontal along +x: exactly, or with ``tolerance`` = (the approach axis' largest angle
+    from +x, the finger axis' from the horizontal), rad (cached)."""
     plant, instance = kinematic_robot(robot)
     context = plant.CreateDefaultContext()
     ik = InverseKinematics(plant, context, with_joint_limits=True)
@@ -163,8 +172,16 @@ def _start_arm(
     prog.AddBoundingBoxConstraint(seed[fixed], seed[fixed], q[fixed])
     tcp = plant.GetFrameByName(robot.tcp_frame, instance)
     goal = np.array(target)
-    ik.AddPositionConstraint(tcp, np.zeros(3), plant.world_frame(), goal - 1e-4, goal + 1e-4)
-    ik.AddOrientationConstraint(plant.world_frame(), tcp_rotation(0.0), tcp, RotationMatrix(), 1e-3)
+    world = plant.world_frame()
+    ik.AddPositionConstraint(tcp, np.zeros(3), world, goal - 1e-4, goal + 1e-4)
+    if tolerance is None:
+        ik.AddOrientationConstraint(world, tcp_rotation(0.0), tcp, RotationMatrix(), 1e-3)
+    else:
+        approach, roll = tolerance
+        ik.AddAngleBetweenVectorsConstraint(world, [1.0, 0.0, 0.0], tcp, [0.0, 0.0, 1.0], 0.0, approach)
+        ik.AddAngleBetweenVectorsConstraint(
+            world, [0.0, 0.0, 1.0], tcp, [0.0, 1.0, 0.0], math.pi / 2 - roll, math.pi / 2 + roll
+        )
     prog.AddQuadraticErrorCost(np.eye(int(np.sum(~fixed))), seed[~fixed], q[~fixed])
     options = ik_solver_options(max_iterations)
     result = Solve(prog, seed, options)

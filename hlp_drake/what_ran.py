@@ -1,7 +1,8 @@
 """What a run ran, said the same way in its header, its summary and its JSON.
 
 ``WhatRan`` names the robot, the planner(s), the execution mode, the model error's seed (None: no
-model error), the perception source and the scenario file (None: the built-in default scenario).
+model error), the perception source, the scenario file (None: the built-in default scenario) and,
+for an experiment on another robot's tables (``--tables``), that robot.
 ``line()`` is the text a person reads; ``to_dict()`` the keys of ``run_scene``'s JSON and of the
 experiments' ``run.json`` and ``summary.json``.
 """
@@ -26,6 +27,8 @@ class WhatRan:
     model_error_seed: int | None
     perception_source: str
     scenario_file: str | None = None
+    tables: str | None = None
+    """The robot whose reach the generated tables were kept within, if not the run's own (None)."""
 
     def line(self) -> str:
         """``robot mobile_ur5, planner hlp, execution open, model error none, perception truth,
@@ -35,6 +38,7 @@ class WhatRan:
         return (
             f"robot {self.robot}, {planners}, execution {self.execution}, model error {error}, "
             f"perception {self.perception_source}, scenario {self.scenario_file or BUILT_IN_SCENARIO}"
+            + (f", tables of {self.tables}" if self.tables else "")
         )
 
     def to_dict(self) -> dict[str, Any]:
@@ -49,6 +53,7 @@ class WhatRan:
             "model_error_seed": self.model_error_seed,
             "perception_source": self.perception_source,
             "scenario_file": self.scenario_file,
+            **({"tables": self.tables} if self.tables else {}),
         }
 
     @classmethod
@@ -65,4 +70,5 @@ class WhatRan:
             model_error_seed=record["model_error_seed"],
             perception_source=record["perception_source"],
             scenario_file=record["scenario_file"],
+            tables=record.get("tables"),
         )

@@ -659,3 +659,26 @@ def test_local_pool_workers_are_renewed_every_jobs_per_worker_jobs(monkeypatch):
     assert len(pids) == 6 and os.getpid() not in pids
     chunks = [set(pids[:4]), set(pids[4:])]  # 2 jobs per worker, 2 workers: fresh ones after 4 jobs
     assert not chunks[0] & chunks[1]
+
+
+def test_another_robots_tables_are_the_runs_scenes_and_part_of_its_identity(tmp_path, capsys):
+    from hlp_drake.systems.world.robot_description import load_robot
+
+    workspaces = []
+
+    def job(job: Job) -> dict:
+        workspaces.append(job.workspace)
+        return cheap_job(job)
+
+    argv = ["gen2", "--objects", "7", "--scenes", "2", "--workers", "1", "--quiet", "--out", str(tmp_path)]
+    assert run_cli(lambda a: main(a, job=job), [*argv, "--tables", "panda"]) == 0
+    assert workspaces == [load_robot("panda").workspace] * 4  # the mobile UR5 on the Panda's tables
+    assert "robot mobile_ur5" in capsys.readouterr().out
+    run = json.loads((tmp_path / "run.json").read_text())
+    assert run["robot"] == "mobile_ur5" and run["tables"] == "panda"
+    assert "scenario built-in default, tables of panda." in (tmp_path / "summary.md").read_text()
+    assert run_cli(lambda a: main(a, job=job), argv) == 2  # its own tables: other scenes, refused
+    assert "different tables" in capsys.readouterr().err
+    assert run_cli(lambda a: main(a, job=never_called), [*argv, "--tables", "panda"]) == 0  # resumed: all kept
+    assert run_cli(lambda a: main(a, job=job), [*argv, "--tables", "no_such_robot"]) == 2
+    assert capsys.readouterr().err.strip().startswith("error: --tables: robot 'no_such_robot'")

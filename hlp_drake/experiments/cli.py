@@ -90,6 +90,12 @@ def _parser() -> argparse.ArgumentParser:
     )
     add_perception(parser)
     add_robot_option(parser)
+    parser.add_argument(
+        "--tables",
+        metavar="NAME|FILE",
+        help="generate the tables within this robot's reach instead of --robot's (e.g. --robot "
+        "mobile_ur5 --tables panda: the mobile UR5 on the Panda's scenes)",
+    )
     add_conditions(parser)
     parser.add_argument("--fresh", action="store_true", help="discard DIR's earlier results and start over")
     add_verbosity(parser)
@@ -129,6 +135,7 @@ def main(
         config_yaml=config_yaml,
         perception=args.perception,
         robot=args.robot,
+        tables=args.tables,
         scenario_file=args.config,
         fresh=args.fresh,
         progress=not args.quiet,

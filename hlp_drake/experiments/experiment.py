@@ -36,7 +36,7 @@ RESULTS, CONFIG, RUN = "results.csv", "config.json", "run.json"
 DERIVED = ("summary.md", "summary.json", "success.png", "times.png")
 MAX_RECORD_BYTES = 16 << 20
 """A larger ``config.json`` or ``run.json`` is refused (a run's are a few kB to a few MB)."""
-IDENTITY_LABELS = {"kind": "kind", "seed": "seed", "scenario": "scenario"}
+IDENTITY_LABELS = {"kind": "kind", "seed": "seed", "scenario": "scenario", "tables": "tables"}
 
 
 @dataclass(frozen=True)
@@ -57,6 +57,8 @@ class ExperimentSettings:
             scenario's).
         robot: overrides the scenario's robot (a shipped robot's name or a description file; None:
             the scenario's).
+        tables: generate the tables within this robot's reach rather than the run's own robot's
+            (the same scenes for two robots; None: the run's robot's).
         scenario_file: the file ``config_yaml`` was read from (None: none, the built-in default), named
             in ``run.json`` and the summary.
         fresh: start over, discarding the directory's earlier results.
@@ -72,6 +74,7 @@ class ExperimentSettings:
     config_yaml: str | None = None
     perception: str | None = None
     robot: str | None = None
+    tables: str | None = None
     scenario_file: str | None = None
     fresh: bool = False
     progress: bool = True
@@ -113,7 +116,7 @@ def _check_directory(out: Path, identity: dict[str, Any], fresh: bool) -> None:
     config = out / CONFIG
     if config.exists():
         earlier = _read_record(config)
-        differs = [label for key, label in IDENTITY_LABELS.items() if earlier.get(key) != identity[key]]
+        differs = [label for key, label in IDENTITY_LABELS.items() if earlier.get(key) != identity.get(key)]
         if differs:
             raise HlpError(
                 f"{out} holds a run with a different {', '.join(differs)} "
@@ -291,6 +294,7 @@ def run_experiment(
         single_process_rollouts=settings.parallel,
         perception=settings.perception,
         robot=settings.robot,
+        tables=settings.tables,
     )
     config_yaml = yamls.identity
     jobs = make_jobs(
@@ -301,6 +305,8 @@ def run_experiment(
         yamls.workspace,
     )
     identity = {"kind": settings.kind, "seed": settings.seed, "scenario": config_yaml}
+    if yamls.ran.tables:  # another robot's tables: other scenes (absent otherwise, as before)
+        identity["tables"] = yamls.ran.tables
     _check_directory(out, identity, settings.fresh)
     check_writable(*(out / name for name in (RESULTS, CONFIG, RUN, *DERIVED)))
     results = ResultsFile(out / RESULTS, [] if settings.fresh else read_results(out / RESULTS, settings.kind))

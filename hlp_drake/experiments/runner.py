@@ -81,7 +81,7 @@ class ScenarioResolver(Protocol):
 
     ``text``: the scenario settings as YAML (None: the defaults); ``perception`` overrides its
     ``perception.source`` and ``robot`` its robot (a shipped robot's name or a description file)
-    unless None; ``single_process_rollouts``: the jobs' optimiser rolls out in its own process
+    unless None; ``tables``: the generated tables are kept within that robot's reach instead; ``single_process_rollouts``: the jobs' optimiser rolls out in its own process
     (``optimiser.workers = 1``). Raises ``HlpError`` for an invalid scenario.
     """
 
@@ -92,6 +92,7 @@ class ScenarioResolver(Protocol):
         single_process_rollouts: bool,
         perception: str | None,
         robot: str | None = None,
+        tables: str | None = None,
     ) -> ScenarioYamls: ...
 
 

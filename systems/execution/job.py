@@ -17,6 +17,7 @@ from hlp_drake.systems.execution.run import plan_and_execute
 from hlp_drake.systems.optimiser.pool import RolloutPool
 from hlp_drake.systems.optimiser.rollout_world import simulation_failure
 from hlp_drake.systems.scenario import load_scenario, with_conditions
+from hlp_drake.systems.world.robot_description import load_robot
 
 if TYPE_CHECKING:
     from hlp_drake.experiments.runner import Job, Row, ScenarioYamls
@@ -28,11 +29,13 @@ def scenario_yamls(
     single_process_rollouts: bool = False,
     perception: str | None = None,
     robot: str | None = None,
+    tables: str | None = None,
 ) -> ScenarioYamls:
     """The scenario of ``text`` (None: the defaults; ``perception.source`` set to ``perception`` and
     the robot to ``robot`` unless None), read once: its YAML (the run's identity), written out in
     full as the jobs run it (``optimiser.workers = 1`` if ``single_process_rollouts``), what its
-    jobs run and the robot's workspace.
+    jobs run and the workspace the tables are kept within: the robot's, or that of ``tables`` (a
+    shipped robot's name or a description file) to run this robot on another's tables.
 
     Raises:
         HlpError: the scenario is invalid.
@@ -46,11 +49,15 @@ def scenario_yamls(
         if single_process_rollouts
         else scenario
     )
+    try:
+        other = None if tables is None else load_robot(tables)
+    except HlpError as error:
+        raise HlpError(f"--tables: {error}") from None
     return ScenarioYamls(
         identity=scenario.yaml,
         job=jobs.yaml,
-        ran=what_ran(scenario, planners=PLANNERS),
-        workspace=scenario.robot.workspace,
+        ran=replace(what_ran(scenario, planners=PLANNERS), tables=other and other.name),
+        workspace=(other or scenario.robot).workspace,
     )
 
 

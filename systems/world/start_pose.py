@@ -2,9 +2,10 @@
 
 Frames and start pose: the world frame is the scene's (z up, x into the table from the middle of its
 front edge). A mobile base starts in front of the table facing +x, a fixed one stands where its
-description puts it; at the start the gripper points along +x (horizontal approach), fingers
-opening along y, its tcp above ``scene.start`` at ``ik.height`` above the table top
-(``scene.start_yaw`` is not used: the gripper faces +x).
+description puts it; at the start the gripper points along +x (horizontal approach; within the
+keypoints' tolerance where that is out of reach), fingers opening along y, its tcp above
+``scene.start`` at ``ik.height`` above the table top (``scene.start_yaw`` is not used: the gripper
+faces +x).
 """
 
 from __future__ import annotations

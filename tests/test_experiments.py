@@ -679,6 +679,7 @@ def test_another_robots_tables_are_the_runs_scenes_and_part_of_its_identity(tmp_
     assert "scenario built-in default, tables of panda." in (tmp_path / "summary.md").read_text()
     assert run_cli(lambda a: main(a, job=job), argv) == 2  # its own tables: other scenes, refused
     assert "different tables" in capsys.readouterr().err
-    assert run_cli(lambda a: main(a, job=never_called), [*argv, "--tables", "panda"]) == 0  # resumed: all kept
+    resumed = [*argv, "--tables", "panda"]  # all rows kept: nothing runs again
+    assert run_cli(lambda a: main(a, job=never_called), resumed) == 0
     assert run_cli(lambda a: main(a, job=job), [*argv, "--tables", "no_such_robot"]) == 2
     assert capsys.readouterr().err.strip().startswith("error: --tables: robot 'no_such_robot'")

@@ -26,6 +26,7 @@ from hlp_drake.cli import invoked_as, run_cli
 from hlp_drake.errors import HlpError, StorageError
 from hlp_drake.experiments import ExperimentSettings, Job, make_row
 from hlp_drake.experiments.cli import main
+from hlp_drake.experiments.plots import plot_title
 from hlp_drake.experiments.results import (
     COLUMNS,
     EARLIER_COLUMNS,
@@ -677,6 +678,11 @@ def test_another_robots_tables_are_the_runs_scenes_and_part_of_its_identity(tmp_
     run = json.loads((tmp_path / "run.json").read_text())
     assert run["robot"] == "mobile_ur5" and run["tables"] == "panda"
     assert "scenario built-in default, tables of panda." in (tmp_path / "summary.md").read_text()
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert (
+        plot_title(summary)
+        == "Table III: Generalization II, mobile_ur5 on panda's tables (2 scenes per condition)"
+    )
     assert run_cli(lambda a: main(a, job=job), argv) == 2  # its own tables: other scenes, refused
     assert "different tables" in capsys.readouterr().err
     resumed = [*argv, "--tables", "panda"]  # all rows kept: nothing runs again

@@ -92,9 +92,13 @@ def _grouped_bars(
         _label_bars(axes, bars, values, label)
 
 
-def _title(summary: dict[str, Any]) -> str:
+def plot_title(summary: dict[str, Any]) -> str:
+    """The plots' title: the table, the robot (on another robot's tables), the scenes per condition."""
     scenes = max((s["n"] for c in summary["conditions"] for s in c["planners"].values()), default=0)
-    return f"{summary['table']} ({scenes} scene{'s' if scenes != 1 else ''} per condition)"
+    robot = summary.get("robot")  # absent from a summary written before robots were named
+    ran = "" if robot is None else f", {robot}"
+    ran += f" on {summary['tables']}'s tables" if summary.get("tables") else ""
+    return f"{summary['table']}{ran} ({scenes} scene{'s' if scenes != 1 else ''} per condition)"
 
 
 def _legend_below(figure: plt.Figure, axes: plt.Axes) -> None:
@@ -117,7 +121,7 @@ def plot_success(summary: dict[str, Any], path: Path) -> None:
     _grouped_bars(axes, summary, "success_pct", lambda v: f"{v:.0f}", errors=lambda s: s["success_ci95"])
     axes.set_ylim(0, 105)
     axes.set_ylabel("success rate (%), with 95 % interval")
-    axes.set_title(_title(summary))
+    axes.set_title(plot_title(summary))
     figure.tight_layout()
     _legend_below(figure, axes)
     save_png(figure, path)
@@ -131,7 +135,7 @@ def plot_times(summary: dict[str, Any], path: Path) -> None:
         _grouped_bars(axes, summary, field, lambda v: f"{v:.2f}")
         axes.set_title(f"mean {TIME_LABELS[field]} time")
         axes.set_ylabel("seconds per scene")
-    figure.suptitle(f"{_title(summary)}: planning time (execution excluded)")
+    figure.suptitle(f"{plot_title(summary)}: planning time (execution excluded)")
     figure.tight_layout()
     _legend_below(figure, panels[0])
     save_png(figure, path)

@@ -15,7 +15,7 @@ import os
 import sys
 import time
 from contextlib import closing
-from dataclasses import dataclass, replace
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -306,7 +306,8 @@ def run_experiment(
     )
     identity = {"kind": settings.kind, "seed": settings.seed, "scenario": config_yaml}
     if yamls.ran.tables:  # another robot's tables: other scenes (absent otherwise, as before)
-        identity["tables"] = yamls.ran.tables
+        reach = None if yamls.workspace is None else asdict(yamls.workspace)
+        identity["tables"] = {"robot": yamls.ran.tables, "workspace": reach}
     _check_directory(out, identity, settings.fresh)
     check_writable(*(out / name for name in (RESULTS, CONFIG, RUN, *DERIVED)))
     results = ResultsFile(out / RESULTS, [] if settings.fresh else read_results(out / RESULTS, settings.kind))

@@ -81,7 +81,8 @@ class ScenarioResolver(Protocol):
 
     ``text``: the scenario settings as YAML (None: the defaults); ``perception`` overrides its
     ``perception.source`` and ``robot`` its robot (a shipped robot's name or a description file)
-    unless None; ``tables``: the generated tables are kept within that robot's reach instead; ``single_process_rollouts``: the jobs' optimiser rolls out in its own process
+    unless None; ``tables``: the generated tables are kept within that robot's reach instead;
+    ``single_process_rollouts``: the jobs' optimiser rolls out in its own process
     (``optimiser.workers = 1``). Raises ``HlpError`` for an invalid scenario.
     """
 

@@ -143,6 +143,24 @@ def test_generated_tables_stay_within_a_fixed_robots_reach():
         within_reach(GEN1, Workspace(x=-0.15, y=0.0, reach=0.3))
 
 
+def test_a_fixed_robots_gen2_tables_hold_as_much_clutter_for_their_size_as_the_mobile_robots():
+    def coverage(workspace: Workspace | None) -> float:  # obstacle footprint / table area, mean of 30
+        shares = []
+        for seed in range(30):
+            scene = generate_scene("gen2", seed, 7, workspace)
+            area = sum(
+                o.size[0] * o.size[1] * (np.pi / 4 if o.shape == "cylinder" else 1.0) for o in scene.obstacles
+            )
+            shares.append(area / (scene.table.length * scene.table.width))
+        return float(np.mean(shares))
+
+    workspace = Workspace(x=-0.3, y=0.0, reach=0.88)
+    assert within_reach(GEN1, workspace).table_length[1] < 0.7 * GEN1.table_length[1]
+    assert coverage(workspace) == pytest.approx(coverage(None), rel=0.15)
+    heights = [o.size[2] for seed in range(30) for o in generate_scene("gen2", seed, 7, workspace).obstacles]
+    assert max(heights) > 0.18  # heights are not scaled
+
+
 def test_a_fixed_arms_planar_noise_moves_its_tcp_in_the_plane(own_robot):
     robot = load_robot(own_robot)
     plant, instance = kinematic_robot(robot)

@@ -29,7 +29,12 @@ class Workspace:
 def within_reach(ranges: RobotSceneRanges, workspace: Workspace | None) -> RobotSceneRanges:
     """``ranges`` with the table's length and width scaled by one factor (at most 1) so that the
     farthest start or target the generators place on the largest table is within ``workspace``'s
-    reach; ``ranges`` itself for None (a mobile robot)."""
+    reach; ``ranges`` itself for None (a mobile robot).
+
+    Gen II's obstacle footprints (box depth and width, cylinder diameter) scale by the same factor, as
+    Gen I's scale with the table's width: a smaller table holds as much clutter for its size, not the
+    same objects crowded three times as densely. Heights and the target (the gripper's) do not scale.
+    """
     if workspace is None:
         return ranges
 
@@ -49,11 +54,8 @@ def within_reach(ranges: RobotSceneRanges, workspace: Workspace | None) -> Robot
             f"a robot reaching {workspace.reach} m from ({workspace.x}, {workspace.y}) reaches too little "
             "of a table to generate scenes on"
         )
-    return replace(
-        ranges,
-        table_length=tuple(low * v for v in ranges.table_length),
-        table_width=tuple(low * v for v in ranges.table_width),
-    )
+    scaled = ("table_length", "table_width", "box_depth", "box_width", "cylinder_diameter")
+    return replace(ranges, **{name: tuple(low * v for v in getattr(ranges, name)) for name in scaled})
 
 
 MIN_TABLE_SCALE = 0.5

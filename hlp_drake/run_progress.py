@@ -95,6 +95,8 @@ class ProgressListener:
     def solved(self, keyframes, trajectory, seconds: float) -> None:
         solved = sum(keyframes.success)
         failed = "" if keyframes.ok else f"; failed: {'; '.join(keyframes.failures)}"
+        if keyframes.skipped:
+            failed += f"; left out: {'; '.join(keyframes.skipped)}"
         self._line(
             f"IK: {solved} of {len(keyframes.success)} keyframes, a {trajectory.end_time():.1f} s "
             f"trajectory ({seconds:.2f} s){failed}"

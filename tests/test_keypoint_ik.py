@@ -208,6 +208,24 @@ def test_unreachable_waypoint_is_reported_for_that_keypoint(system, scene):
     )
 
 
+def test_an_unreachable_lifted_transit_is_left_out_and_the_way_goes_straight_on(system, scene):
+    """A transit waypoint the arm cannot reach (over the table close before a fixed arm's pedestal)
+    is the robot's own addition: the trajectory goes without it; any other keypoint is needed."""
+    good = through_gaps(scene, to_target=False).keypoints
+    far = (scene.table.length + 3.0, 0.0)
+    lifted = PlanKeypoint("transit", far, row=0, element="0", height=0.3)
+    keyframes, trajectory = evaluate(system, HighLevelPlan(scene=scene.name, keypoints=(*good, lifted)))
+    assert keyframes.ok and keyframes.failures == []
+    assert keyframes.success == (True, True, True, False)
+    assert keyframes.skipped == [keyframes.messages[3]] and "transit" in keyframes.messages[3]
+    np.testing.assert_allclose(
+        trajectory.value(trajectory.end_time()).ravel()[:9], keyframes.positions[2][:9], atol=1e-9
+    )
+    needed = PlanKeypoint("gap", far, row=0, element="0")
+    keyframes, _ = evaluate(system, HighLevelPlan(scene=scene.name, keypoints=(*good, needed)))
+    assert not keyframes.ok and keyframes.skipped == [] and keyframes.failures == [keyframes.messages[3]]
+
+
 def test_outputs_are_cached_until_the_plan_changes(system, scene):
     context = system.CreateDefaultContext()
     port = system.get_input_port(0)

@@ -80,7 +80,11 @@ class ExecutionResult:
             "success": self.success,
             "failure_reason": self.failure_reason,
             "plan": named_plan(self.plan.to_dict(), self.true_names),
-            "ik": {"ok": self.keyframes.ok, "failures": self.keyframes.failures},
+            "ik": {
+                "ok": self.keyframes.ok,
+                "failures": self.keyframes.failures,
+                "skipped": self.keyframes.skipped,
+            },
             "robot_actuated_dofs": 10,
             "timings": self.timings,
             "objects_moved": self.objects_moved,

@@ -18,6 +18,11 @@ if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
 
 
+SKIPPABLE_ACTIONS = ("transit",)
+"""The keypoints a trajectory can go without: a lifted waypoint the arm cannot reach (over the table
+close before a fixed arm's pedestal) is left out, and the way goes straight on to the next keypoint."""
+
+
 @dataclass(frozen=True)
 class Keyframes:
     """The IK result of a plan.
@@ -46,13 +51,25 @@ class Keyframes:
 
     @property
     def ok(self) -> bool:
-        """True when there are keyframes, all succeeded, and the plan had no problem."""
-        return not self.problems and len(self.success) > 0 and all(self.success)
+        """True when there are keyframes, all but skippable ones succeeded, and the plan had no problem."""
+        return not self.problems and len(self.success) > 0 and not self._failed(skippable=False)
 
     @property
     def failures(self) -> list[str]:
-        """Every problem and failure message."""
-        return [*self.problems, *(m for m, ok in zip(self.messages, self.success) if not ok)]
+        """Every problem and the failure messages of the keypoints the trajectory needs."""
+        return [*self.problems, *self._failed(skippable=False)]
+
+    @property
+    def skipped(self) -> list[str]:
+        """The failure messages of the skippable keypoints (``SKIPPABLE_ACTIONS``) the trajectory left out."""
+        return self._failed(skippable=True)
+
+    def _failed(self, *, skippable: bool) -> list[str]:
+        return [
+            message
+            for message, ok, keypoint in zip(self.messages, self.success, self.keypoints)
+            if not ok and (keypoint.action in SKIPPABLE_ACTIONS) == skippable
+        ]
 
     @classmethod
     def empty(cls, start: np.ndarray, problem: str | None = None) -> Keyframes:

@@ -1,7 +1,7 @@
 """Make, draw and check scene files: python -m hlp_drake.scene {generate,show,validate}.
 
 python -m hlp_drake.scene generate --kind vr|gen1|gen2|unstructured --seed N [--objects K] --out FILE
-python -m hlp_drake.scene show FILE --png OUT.png [--plan]
+python -m hlp_drake.scene show FILE --png OUT.png [--plan [--robot NAME|FILE]]
 python -m hlp_drake.scene validate FILE
 """
 
@@ -9,12 +9,17 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from hlp_drake.atomic import check_writable
 from hlp_drake.cli import MAX_SEED, add_robot_option, integer, make_parser, run_cli
 from hlp_drake.scene.generators import KINDS, MAX_GENERATED, generate_scene
 from hlp_drake.scene.io import load_scene, save_scene
 from hlp_drake.scene.rows import find_rows
+
+if TYPE_CHECKING:
+    from hlp_drake.scene.model import Scene
+    from hlp_drake.systems.world.robot_description import RobotDescription
 
 
 def _parser():
@@ -36,6 +41,7 @@ def _parser():
         action="store_true",
         help="draw the human-like plan (bundled models) and the pushing robot's plan over it",
     )
+    add_robot_option(show)
     validate = commands.add_parser("validate", help="check a scene file")
     validate.add_argument("file")
     return parser
@@ -45,11 +51,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     check_writable(getattr(args, "out", None), getattr(args, "png", None))  # bad paths: exit 2, now
     if args.command == "generate":
-        workspace = None
-        if args.robot is not None:  # a fixed robot's tables within its reach (imports Drake)
-            from hlp_drake.systems.world.robot_description import load_robot
-
-            workspace = load_robot(args.robot).workspace
+        robot = _robot(args.robot)
+        workspace = None if robot is None else robot.workspace  # a fixed robot's tables within its reach
         scene = generate_scene(args.kind, args.seed, args.objects, workspace)
         save_scene(scene, args.out)
         print(f"wrote {args.out}: {scene.name}, {len(scene.obstacles)} obstacles")
@@ -57,7 +60,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         from hlp_drake.scene.plot import save_scene_png
 
         scene = load_scene(args.file)
-        plans = _plans(scene) if args.plan else {}
+        robot = _robot(args.robot)  # checked with or without --plan
+        plans = _plans(scene, robot) if args.plan else {}
         save_scene_png(scene, args.png, plans=plans)
         for label, plan in plans.items():
             print(f"{label}: {' -> '.join(k.action for k in plan.keypoints) or plan.reason}")
@@ -69,8 +73,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     return 0
 
 
-def _plans(scene) -> dict:
-    """The human-like plan of ``scene`` and the pushing robot's plan of it (imports Drake)."""
+def _robot(name_or_file: str | None) -> RobotDescription | None:
+    """The robot description ``--robot`` names (imports Drake), None without it."""
+    if name_or_file is None:
+        return None
+    from hlp_drake.systems.world.robot_description import load_robot
+
+    return load_robot(name_or_file)
+
+
+def _plans(scene: Scene, robot: RobotDescription | None) -> dict:
+    """The human-like plan of ``scene`` and ``robot``'s plan of it (the mobile UR5's if None; imports
+    Drake)."""
     from hlp_drake.learners.bundled import default_models
     from hlp_drake.planner import plan
     from hlp_drake.systems.planning.transfer import gripper_geometry
@@ -79,9 +93,10 @@ def _plans(scene) -> dict:
     from hlp_drake.transfer.rules import push_rules
 
     human = plan(scene, default_models())
+    geometry = gripper_geometry() if robot is None else gripper_geometry(robot)
     return {
         "human plan": human,
-        "robot plan": robot_plan(human, scene, push_rules(Scenario().transfer, gripper_geometry())),
+        "robot plan": robot_plan(human, scene, push_rules(Scenario().transfer, geometry)),
     }
 
 

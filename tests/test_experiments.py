@@ -689,3 +689,31 @@ def test_another_robots_tables_are_the_runs_scenes_and_part_of_its_identity(tmp_
     assert run_cli(lambda a: main(a, job=never_called), resumed) == 0
     assert run_cli(lambda a: main(a, job=job), [*argv, "--tables", "no_such_robot"]) == 2
     assert capsys.readouterr().err.strip().startswith("error: --tables: robot 'no_such_robot'")
+
+
+def test_a_bars_value_label_stays_clear_of_the_papers_diamond_at_its_top(monkeypatch, tmp_path):
+    """Ours 96 %, the paper's 93 %: the diamond sits near the bar's top, the value at half height."""
+    from hlp_drake.experiments import plots
+
+    def stats(ours: float, paper: float) -> dict:
+        return {
+            "n": 100,
+            "success_pct": ours,
+            "success_ci95": [ours - 6, ours + 2],
+            "paper": {"success_pct": paper},
+        }
+
+    summary = {
+        "table": "Table III: Generalization II",
+        "robot": "iiwa14",
+        "conditions": [{"condition": "7 objects", "planners": {"hlp": stats(96, 93), "sto": stats(91, 96)}}],
+    }
+    figures = []
+    monkeypatch.setattr(plots, "save_png", lambda figure, path: figures.append(figure))
+    plots.plot_success(summary, tmp_path / "success.png")
+    (axes,) = figures[0].axes
+    plots.plt.close(figures[0])
+    labels = {text.get_text(): text.xy[1] for text in axes.texts}
+    assert labels == {"96": 48.0, "91": 45.5}
+    for value in (93, 96):  # the paper's diamonds, 45 or more points above either label
+        assert all(abs(value - y) > 40 for y in labels.values())

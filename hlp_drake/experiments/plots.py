@@ -18,7 +18,8 @@ BAR_WIDTH = 0.36
 
 
 def _label_bars(axes: plt.Axes, bars, values: list[float | None], label: Callable[[float], str]) -> None:
-    """Write each value inside its bar's top (white), or above a bar too short to hold it."""
+    """Write each value at its bar's half height (white), clear of the paper's diamond and the error
+    bar near the top, or above a bar too short to hold it."""
     top = axes.get_ylim()[1]
     for bar, value in zip(bars, values):
         if value is None:
@@ -26,11 +27,11 @@ def _label_bars(axes: plt.Axes, bars, values: list[float | None], label: Callabl
         inside = bar.get_height() > 0.12 * top
         axes.annotate(
             label(value),
-            (bar.get_x() + bar.get_width() / 2, bar.get_height()),
-            xytext=(0, -4 if inside else 3),
+            (bar.get_x() + bar.get_width() / 2, bar.get_height() / 2 if inside else bar.get_height()),
+            xytext=(0, 0 if inside else 3),
             textcoords="offset points",
             ha="center",
-            va="top" if inside else "bottom",
+            va="center" if inside else "bottom",
             fontsize=8,
             color="white" if inside else "black",
             fontweight="bold" if inside else "normal",

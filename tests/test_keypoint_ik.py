@@ -15,7 +15,7 @@ from hlp_drake.scene.model import Scene, SceneObject, Table
 from hlp_drake.systems.planning.ik import KeypointIk
 from hlp_drake.systems.planning.keyframes import Keyframes
 from hlp_drake.systems.scenario import Scenario
-from hlp_drake.systems.world.robot_description import MOBILE_UR5
+from hlp_drake.systems.world.robot_description import MOBILE_UR5, load_robot
 from hlp_drake.systems.world.start_pose import start_configuration
 from hlp_drake.systems.world.world import make_world_diagram, world_plant
 from hlp_drake.taskspace import TaskSpace
@@ -432,3 +432,50 @@ def test_the_default_iteration_cap_gives_the_keyframes_of_a_five_times_larger_on
     assert CONFIG.ik.max_iterations == 100
     assert capped.ok and longer.ok and len(capped.keypoints) >= 6
     np.testing.assert_allclose(capped.positions, longer.positions, atol=1e-4)
+
+
+def approach_angles(system: KeypointIk, keyframes: Keyframes, tcp_frame: str) -> np.ndarray:
+    """Per keyframe, the angle between the approach axis (tcp +z) and world +x, degrees."""
+    model = system.solver.planning_model
+    context = model.plant.GetMyMutableContextFromRoot(model.diagram.CreateDefaultContext())
+    tcp = model.plant.GetFrameByName(tcp_frame, model.robot)
+    angles = []
+    for q in keyframes.positions:
+        model.plant.SetPositions(context, model.robot, q)
+        axis = tcp.CalcPoseInWorld(context).rotation().matrix()[:, 2]
+        angles.append(math.degrees(math.acos(np.clip(axis[0], -1.0, 1.0))))
+    return np.array(angles)
+
+
+def test_a_fixed_arms_approach_weight_keeps_its_hand_square_to_the_table():
+    """The Panda's way through a gap, along a push and on to the target (gen1-5's): with no weight
+    its step cost turns the hand to the tolerance's edge (20 degrees); its description's weight
+    keeps it nearer +x at every keyframe."""
+    panda = load_robot("panda")
+    scene = generate_scene("gen1", 5, workspace=panda.workspace)
+    plan = HighLevelPlan(
+        scene=scene.name,
+        keypoints=(
+            PlanKeypoint("start", scene.start),
+            *(
+                PlanKeypoint("gap", p, row=1, element="0")
+                for p in ((0.228, 0.0), (0.274, 0.01), (0.383, -0.1))
+            ),
+            PlanKeypoint("target", scene.target.position, element=scene.target.name),
+        ),
+    )
+    assert panda.approach_weight > 0.0
+    turned, square = (
+        ik_for(scene, replace(CONFIG, robot=replace(panda, approach_weight=weight)))
+        for weight in (0.0, panda.approach_weight)
+    )
+    loose, held = (solve(system, plan) for system in (turned, square))
+    assert all(loose.success) and all(held.success)
+    np.testing.assert_allclose(held.tcp_positions, loose.tcp_positions, atol=0.003)  # the same waypoints
+    loose_angles, held_angles = (
+        approach_angles(system, keyframes, panda.tcp_frame)
+        for system, keyframes in ((turned, loose), (square, held))
+    )
+    assert loose_angles.max() > 19.0  # turned to the 20 degree tolerance (at the push's end)
+    assert np.all(held_angles <= loose_angles + 0.5)
+    assert held_angles.max() < loose_angles.max() - 4.0 and held_angles.mean() < 0.7 * loose_angles.mean()

@@ -12,7 +12,8 @@ scene's objects play no part: pushing them is allowed). Constraints:
   ``ik.base_lateral_margin``);
 * at least ``ik.table_clearance`` between the robot and the table top and between the robot's own links.
 
-The cost keeps each keyframe near the previous one. A keypoint is solved from up to ``ik.attempts``
+The cost keeps each keyframe near the previous one (and, with the robot's ``approach_weight``, the
+approach axis near +x). A keypoint is solved from up to ``ik.attempts``
 seeds (the previous keyframe; it with the base moved along with the tcp; the start posture moved
 to the keypoint; a continuation along the tcp's straight line) and checked by forward kinematics;
 a keypoint that fails is reported in ``Keyframes`` and skipped by the trajectory (the next keypoint
@@ -258,6 +259,10 @@ class KeypointSolver:
             math.pi / 2 - ik_config.roll_tolerance,
             math.pi / 2 + ik_config.roll_tolerance,
         )
+        if self._robot_description.approach_weight > 0.0:
+            ik.AddAngleBetweenVectorsCost(
+                world, [1.0, 0.0, 0.0], self._tcp, [0.0, 0.0, 1.0], self._robot_description.approach_weight
+            )
         if clearance:
             ik.AddMinimumDistanceLowerBoundConstraint(
                 ik_config.table_clearance, ik_config.table_clearance + 0.05

@@ -85,6 +85,11 @@ class RobotDescription:
         reach: how far from the base's ``pose`` the tcp reaches over the table, held horizontal at
             ``ik.height`` (a fixed base; the scene generators keep their tables within it), m; 0 for a
             mobile base.
+        approach_weight: the keypoint IK's pull of the approach axis towards world +x, the way the
+            push transfer assumes the gripper points: a cost of this times (1 - cos) of their angle,
+            beside the keyframe's step (1 per rad^2 or m^2). 0: none, the axis anywhere within
+            ``ik.approach_tolerance`` (a mobile base squares the hand by turning itself; a fixed arm's
+            step cost lets its hand turn to the cone's edge, where a wide hand sweeps its neighbours).
     """
 
     name: str = "mobile_ur5"
@@ -109,6 +114,7 @@ class RobotDescription:
     gripper_open: float = 0.0425
     gripper_closed: float = 0.0
     reach: NonNegativeFloat = 0.0
+    approach_weight: NonNegativeFloat = 0.0
 
     @property
     def mobile(self) -> bool:

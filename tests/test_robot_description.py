@@ -219,7 +219,7 @@ def test_a_users_own_arm_runs_a_scene_end_to_end(own_robot, tmp_path):
     assert "Traceback" not in result.stderr, result.stderr
     assert "run: robot arm6, planner hlp" in result.stdout
     record = json.loads(out.read_text())
-    assert record["robot"] == "arm6"
+    assert record["robot"] == "arm6" and record["robot_actuated_dofs"] == 7  # 6 joints and a gripper
     assert result.returncode == 0, result.stdout + result.stderr
 
 

@@ -38,7 +38,8 @@ class ExecutionResult:
     """Outcome of planning and executing one scene (``reach_reused``: the execution started where
     the optimiser's accepted rollout on the execution model ended, rather than simulating the reach
     again; see ``verified_reach``; ``true_names``: planned on a perceived scene, per perceived
-    object's name the true object's it was matched to, None if none).
+    object's name the true object's it was matched to, None if none; ``actuated_dofs``: the robot's
+    actuated joints, base, arm and gripper).
 
     ``success`` is the paper's reach success (see ``plan_and_execute``); ``grasp_held`` is reported
     beside it and is not part of it (``grasp_failure``: why the grasp's simulation stopped, if it
@@ -67,6 +68,7 @@ class ExecutionResult:
     closed_loop: dict[str, Any] = field(default_factory=dict)
     reach_reused: bool = False
     true_names: dict[str, str | None] | None = None
+    actuated_dofs: int = 0
 
     @property
     def rollout_passed_execution_failed(self) -> bool:
@@ -85,7 +87,7 @@ class ExecutionResult:
                 "failures": self.keyframes.failures,
                 "skipped": self.keyframes.skipped,
             },
-            "robot_actuated_dofs": 10,
+            "robot_actuated_dofs": self.actuated_dofs,
             "timings": self.timings,
             "objects_moved": self.objects_moved,
             "objects_dropped": self.objects_dropped,

@@ -194,7 +194,13 @@ def _plan(handles, scenario, simulator, listener, started, perception, perceive_
     listener.solved(keyframes, trajectory, solved - planned)
     robot_plan = planning.GetOutputPort("robot_plan").Eval(context)
     result = ExecutionResult(
-        scenario.planner.kind, scenario.scene, plan, keyframes, robot_plan, execution=handles.execution
+        scenario.planner.kind,
+        scenario.scene,
+        plan,
+        keyframes,
+        robot_plan,
+        execution=handles.execution,
+        actuated_dofs=len(scenario.robot.actuated_joints),
     )
     result.timings = {"plan_s": plan_s, "ik_s": solved - planned, "optimise_s": 0.0}
     result.true_names = names

@@ -97,6 +97,11 @@ class ProgressListener:
         failed = "" if keyframes.ok else f"; failed: {'; '.join(keyframes.failures)}"
         if keyframes.skipped:
             failed += f"; left out: {'; '.join(keyframes.skipped)}"
+        if keyframes.candidate:
+            failed += (
+                f"; the plan's alternative {keyframes.candidate} in its place, the plan's IK failed: "
+                f"{'; '.join(keyframes.replaced)}"
+            )
         self._line(
             f"IK: {solved} of {len(keyframes.success)} keyframes, a {trajectory.end_time():.1f} s "
             f"trajectory ({seconds:.2f} s){failed}"

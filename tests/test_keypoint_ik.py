@@ -208,6 +208,45 @@ def test_unreachable_waypoint_is_reported_for_that_keypoint(system, scene):
     )
 
 
+def test_a_plan_with_an_unreachable_keypoint_gives_way_to_its_first_reachable_alternative(system, scene):
+    """A keypoint the robot cannot reach fails the plan's IK; the first of the alternatives whose
+    IK succeeds takes its place (the rest stay the optimiser's), and the failures it replaced are
+    kept. With no reachable alternative, or a plan-level problem, the plan's own keyframes stand."""
+    good = through_gaps(scene, to_target=True)
+    far = PlanKeypoint("gap", (scene.table.length + 3.0, 0.0), row=0, element="0")
+    unreachable = replace(good, keypoints=(*good.keypoints[:2], far, *good.keypoints[2:]))
+    other = through_gaps(scene, to_target=False)
+    context = system.CreateDefaultContext()
+    system.GetInputPort("plan").FixValue(context, unreachable)
+    system.GetInputPort("alternatives").FixValue(context, (unreachable, good, other))
+    keyframes = system.GetOutputPort("keyframes").Eval(context)
+    trajectory = system.GetOutputPort("trajectory").Eval(context)
+    alone, alone_trajectory = evaluate(system, good)
+    assert keyframes.ok and keyframes.candidate == 2
+    assert keyframes.keypoints == good.keypoints
+    assert len(keyframes.replaced) == 1 and "keypoint 2 (gap 0)" in keyframes.replaced[0]
+    np.testing.assert_allclose(keyframes.positions, alone.positions, atol=1e-9)
+    np.testing.assert_allclose(
+        trajectory.vector_values(trajectory.get_segment_times()),
+        alone_trajectory.vector_values(alone_trajectory.get_segment_times()),
+        atol=1e-9,
+    )
+    rest = system.GetOutputPort("alternative_trajectories").Eval(context)
+    _, other_trajectory = evaluate(system, other)
+    assert len(rest) == 1  # the unreachable one has none, the one taken is not offered again
+    np.testing.assert_allclose(rest[0].get_segment_times(), other_trajectory.get_segment_times())
+
+    system.GetInputPort("alternatives").FixValue(context, (unreachable,))
+    failed = system.GetOutputPort("keyframes").Eval(context)
+    assert not failed.ok and failed.candidate == 0 and failed.replaced == ()
+    assert failed.failures == list(keyframes.replaced)
+    wrong = replace(unreachable, scene="another scene")
+    system.GetInputPort("plan").FixValue(context, wrong)
+    system.GetInputPort("alternatives").FixValue(context, (good,))
+    refused = system.GetOutputPort("keyframes").Eval(context)
+    assert not refused.ok and refused.candidate == 0 and "another scene" in refused.problems[0]
+
+
 def test_an_unreachable_lifted_transit_is_left_out_and_the_way_goes_straight_on(system, scene):
     """A transit waypoint the arm cannot reach (over the table close before a fixed arm's pedestal)
     is the robot's own addition: the trajectory goes without it; any other keypoint is needed."""

@@ -86,6 +86,8 @@ class ExecutionResult:
                 "ok": self.keyframes.ok,
                 "failures": self.keyframes.failures,
                 "skipped": self.keyframes.skipped,
+                "candidate": self.keyframes.candidate,
+                "replaced": list(self.keyframes.replaced),
             },
             "robot_actuated_dofs": self.actuated_dofs,
             "timings": self.timings,

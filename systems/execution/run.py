@@ -13,6 +13,7 @@ A ``RunListener`` hears of every stage as it happens.
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -193,6 +194,8 @@ def _plan(handles, scenario, simulator, listener, started, perception, perceive_
     solved = time.perf_counter()
     listener.solved(keyframes, trajectory, solved - planned)
     robot_plan = planning.GetOutputPort("robot_plan").Eval(context)
+    if keyframes.candidate:  # the plan's IK failed; an alternative's keypoints are run and drawn
+        robot_plan = replace(robot_plan, keypoints=keyframes.keypoints)
     result = ExecutionResult(
         scenario.planner.kind,
         scenario.scene,

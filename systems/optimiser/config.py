@@ -136,7 +136,8 @@ class StoConfig:
             fifth candidate held ended at half their rollouts, see docs/perception.md).
         alternatives: when the initial sequence's rollout fails, roll out the planner's next this
             many distinct candidate plans once (the HLP's, by expected arm collision; the straight
-            line has none) and go on from the best of them all (0: never).
+            line has none) and go on from the best of them all (0: never); when the initial plan's IK
+            fails, the first of them whose IK succeeds takes its place (``KeypointIk``).
         displaced_checks: a sequence that passes its verification counts only if it also passes
             on the execution model in this many worlds with every object displaced (seeded
             Gaussian offsets of ``displaced_sigma`` per axis and ``displaced_yaw_sigma``): a push

@@ -6,13 +6,15 @@ Input ports:
 
 Output ports (in Drake's cache, computed again only when their input changes):
     ``keyframes`` (abstract, ``Keyframes``): per keypoint the robot's 11 positions, a success flag and
-        a message naming the keypoint when its IK failed.
+        a message naming the keypoint when its IK failed. When a keypoint of the plan fails, the first
+        of ``alternatives`` whose IK succeeds takes its place (``Keyframes.candidate``).
     ``trajectory`` (abstract, ``PiecewisePolynomial``): a first-order hold of the robot's 11 positions
         from the start configuration through the successful keyframes (straight lines in joint space),
         timed by the scenario's ``motion``; the gripper closed among the obstacles if
         ``motion.closed_among_obstacles``.
     ``alternative_trajectories`` (abstract, tuple of ``PiecewisePolynomial``): the same for each of
-        ``alternatives`` whose every keypoint's IK succeeds, in order; computed only when evaluated.
+        ``alternatives`` whose every keypoint's IK succeeds, in order, but the one ``keyframes`` took;
+        computed only when evaluated.
 
 The positions are in the robot model instance's order (``robot_position_names()``: base x, y, yaw,
 the six UR5 joints, left finger, right (mimic) finger), the same in the world diagram's plant, so
@@ -134,24 +136,27 @@ class KeypointIk(LeafSystem):
             ),
             prerequisites_of_calc={self.nothing_ticket()},
         )
-        plan_ticket = {self.input_port_ticket(self._plan_port.get_index())}
+        plans_ticket = {
+            self.input_port_ticket(self._plan_port.get_index()),
+            self.input_port_ticket(self._alternatives_port.get_index()),
+        }
         self._keyframes_port = self.DeclareAbstractOutputPort(
             name="keyframes",
             alloc=lambda: AbstractValue.Make(Keyframes.empty(solver.start)),
             calc=self._calc_keyframes,
-            prerequisites_of_calc=plan_ticket,
+            prerequisites_of_calc=plans_ticket,
         )
         self._trajectory_port = self.DeclareAbstractOutputPort(
             name="trajectory",
             alloc=lambda: AbstractValue.Make(PiecewisePolynomial()),
             calc=self._calc_trajectory,
-            prerequisites_of_calc=plan_ticket,
+            prerequisites_of_calc=plans_ticket,
         )
         self._alternative_trajectories_port = self.DeclareAbstractOutputPort(
             name="alternative_trajectories",
             alloc=lambda: AbstractValue.Make(()),
             calc=self._calc_alternative_trajectories,
-            prerequisites_of_calc={self.input_port_ticket(self._alternatives_port.get_index())},
+            prerequisites_of_calc=plans_ticket,
         )
 
     @property
@@ -183,15 +188,20 @@ class KeypointIk(LeafSystem):
                 Keyframes.empty(self._solver.start, "no plan: the plan input port is not connected")
             )
             return
-        output.set_value(self._solver.solve(self._plant_context(context), self._plan_port.Eval(context)))
+        plans = (self._plan_port.Eval(context), *self._alternatives(context))
+        output.set_value(self._solver.solve_first(self._plant_context(context), plans))
 
     def _calc_trajectory(self, context: Context, output: AbstractValue) -> None:
         output.set_value(
             self._solver.trajectory(self._plant_context(context), self._keyframes_port.Eval(context))
         )
 
+    def _alternatives(self, context: Context) -> tuple:
+        return self._alternatives_port.Eval(context) if self._alternatives_port.HasValue(context) else ()
+
     def _calc_alternative_trajectories(self, context: Context, output: AbstractValue) -> None:
-        plans = self._alternatives_port.Eval(context) if self._alternatives_port.HasValue(context) else ()
+        taken = self._keyframes_port.Eval(context).candidate if self._plan_port.HasValue(context) else 0
+        plans = [plan for index, plan in enumerate(self._alternatives(context), start=1) if index != taken]
         plant_context = self._plant_context(context)
         solved = (self._solver.solve(plant_context, plan) for plan in plans)
         output.set_value(tuple(self._solver.trajectory(plant_context, k) for k in solved if k.ok))

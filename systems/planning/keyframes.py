@@ -37,6 +37,9 @@ class Keyframes:
         start: the robot's 11 start positions.
         problems: plan-level problems (no plan, wrong scene); empty normally.
         solve_time_s: wall-clock time of all the solves.
+        candidate: 0 for the plan's own keyframes; k when a keypoint of the plan failed and these are
+            its k-th alternative's, the first whose IK succeeds (``KeypointSolver.solve_first``).
+        replaced: with a candidate, the failures of the plan it replaced.
     """
 
     keypoints: tuple[PlanKeypoint, ...]
@@ -47,6 +50,8 @@ class Keyframes:
     start: np.ndarray
     problems: tuple[str, ...] = ()
     solve_time_s: float = 0.0
+    candidate: int = 0
+    replaced: tuple[str, ...] = ()
     details: dict = field(default_factory=dict, compare=False)
 
     @property

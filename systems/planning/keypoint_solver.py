@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -190,6 +192,22 @@ class KeypointSolver:
             start=first.copy(),
             solve_time_s=time.perf_counter() - started,
         )
+
+    def solve_first(
+        self, plant_context: Context, plans: Sequence[HighLevelPlan], start: np.ndarray | None = None
+    ) -> Keyframes:
+        """The keyframes of the first of ``plans`` (a plan, then its alternatives) whose IK succeeds
+        (``Keyframes.candidate``: its index, ``replaced``: the first plan's failures); else the first
+        plan's. A plan with a keypoint the robot cannot reach (a push start close before a fixed arm's
+        pedestal) so gives way to the next candidate; a plan-level problem does not."""
+        first = self.solve(plant_context, plans[0], start)
+        if first.ok or first.problems:
+            return first
+        for index, plan in enumerate(plans[1:], start=1):
+            keyframes = self.solve(plant_context, plan, start)
+            if keyframes.ok:
+                return replace(keyframes, candidate=index, replaced=tuple(first.failures))
+        return first
 
     def _target(self, keypoint: PlanKeypoint) -> np.ndarray:
         height = self._height if keypoint.height is None else self._scene.table.height + keypoint.height

@@ -99,8 +99,8 @@ class ProgressListener:
             failed += f"; left out: {'; '.join(keyframes.skipped)}"
         if keyframes.candidate:
             failed += (
-                f"; the plan's alternative {keyframes.candidate} in its place, the plan's IK failed: "
-                f"{'; '.join(keyframes.replaced)}"
+                f"; the plan's alternative {keyframes.candidate} runs in its place, the plan's IK "
+                f"failed: {'; '.join(keyframes.replaced)}"
             )
         self._line(
             f"IK: {solved} of {len(keyframes.success)} keyframes, a {trajectory.end_time():.1f} s "

@@ -246,9 +246,10 @@ def test_a_start_out_of_a_fixed_arms_reach_is_that_jobs_failure():
     assert "out of its reach" in row["failure_reason"] and not row["failure_reason"].startswith("crashed")
 
 
-def test_a_push_start_out_of_a_fixed_arms_reach_gives_way_to_the_plans_next_candidate():
+def test_a_push_start_out_of_a_fixed_arms_reach_gives_way_to_the_plans_next_candidate(capsys):
     """The iiwa's Gen II seed 38 (7 objects): the plan's push start 0.06 m past the front edge is too
     close before the pedestal; its second alternative's IK succeeds and is run in its place."""
+    from hlp_drake.run_progress import ProgressListener
     from hlp_drake.systems.execution.result import ExecutionResult
     from hlp_drake.systems.planning.diagram import make_planning_diagram
     from hlp_drake.systems.world.scene_source import SCENE_PORT
@@ -270,6 +271,10 @@ def test_a_push_start_out_of_a_fixed_arms_reach_gives_way_to_the_plans_next_cand
     assert trajectory.end_time() > 0.0
     record = ExecutionResult("hlp", scene, plan, keyframes, robot_plan).to_dict()["ik"]
     assert record["ok"] and record["candidate"] == 2 and record["replaced"] == list(keyframes.replaced)
+    ProgressListener(quiet=True).solved(keyframes, trajectory, 0.5)
+    line = capsys.readouterr().out
+    assert line.startswith("IK: ") and "the plan's alternative 2 runs in its place" in line
+    assert keyframes.replaced[0] in line
 
     alone = make_planning_diagram(replace(scenario, optimiser=replace(scenario.optimiser, alternatives=0)))
     alone_context = alone.CreateDefaultContext()

@@ -247,6 +247,23 @@ def test_a_plan_with_an_unreachable_keypoint_gives_way_to_its_first_reachable_al
     assert not refused.ok and refused.candidate == 0 and "another scene" in refused.problems[0]
 
 
+def test_a_reachable_plan_leaves_the_alternatives_unplanned():
+    """In the planning diagram the transfer's alternatives are made only when asked for: a plan
+    whose IK succeeds does not ask (nor does its trajectory)."""
+    from hlp_drake.systems.planning.diagram import make_planning_diagram
+    from hlp_drake.systems.world.scene_source import SCENE_PORT
+
+    diagram = make_planning_diagram(CONFIG)
+    context = diagram.CreateDefaultContext()
+    diagram.GetInputPort(SCENE_PORT).FixValue(context, CONFIG.scene)
+    keyframes = diagram.GetOutputPort("keyframes").Eval(context)
+    diagram.GetOutputPort("trajectory").Eval(context)
+    transfer = diagram.GetSubsystemByName("robot_plan_transfer")
+    alternatives = transfer.get_robot_alternatives_output_port()
+    assert keyframes.ok and keyframes.candidate == 0
+    assert alternatives.cache_entry().is_out_of_date(transfer.GetMyContextFromRoot(context))
+
+
 def test_an_unreachable_lifted_transit_is_left_out_and_the_way_goes_straight_on(system, scene):
     """A transit waypoint the arm cannot reach (over the table close before a fixed arm's pedestal)
     is the robot's own addition: the trajectory goes without it; any other keypoint is needed."""

@@ -28,6 +28,7 @@ Its settings are a ``Scenario``'s ``ik`` (``IkConfig``, also the start pose's) a
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Annotated
 
@@ -188,8 +189,7 @@ class KeypointIk(LeafSystem):
                 Keyframes.empty(self._solver.start, "no plan: the plan input port is not connected")
             )
             return
-        plans = (self._plan_port.Eval(context), *self._alternatives(context))
-        output.set_value(self._solver.solve_first(self._plant_context(context), plans))
+        output.set_value(self._solver.solve_first(self._plant_context(context), self._plans(context)))
 
     def _calc_trajectory(self, context: Context, output: AbstractValue) -> None:
         output.set_value(
@@ -198,6 +198,11 @@ class KeypointIk(LeafSystem):
 
     def _alternatives(self, context: Context) -> tuple:
         return self._alternatives_port.Eval(context) if self._alternatives_port.HasValue(context) else ()
+
+    def _plans(self, context: Context) -> Iterator[HighLevelPlan]:
+        """The plan, then (evaluated only if asked for) its alternatives."""
+        yield self._plan_port.Eval(context)
+        yield from self._alternatives(context)
 
     def _calc_alternative_trajectories(self, context: Context, output: AbstractValue) -> None:
         taken = self._keyframes_port.Eval(context).candidate if self._plan_port.HasValue(context) else 0

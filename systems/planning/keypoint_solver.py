@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Iterable
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
@@ -194,16 +194,18 @@ class KeypointSolver:
         )
 
     def solve_first(
-        self, plant_context: Context, plans: Sequence[HighLevelPlan], start: np.ndarray | None = None
+        self, plant_context: Context, plans: Iterable[HighLevelPlan], start: np.ndarray | None = None
     ) -> Keyframes:
         """The keyframes of the first of ``plans`` (a plan, then its alternatives) whose IK succeeds
         (``Keyframes.candidate``: its index, ``replaced``: the first plan's failures); else the first
         plan's. A plan with a keypoint the robot cannot reach (a push start close before a fixed arm's
-        pedestal) so gives way to the next candidate; a plan-level problem does not."""
-        first = self.solve(plant_context, plans[0], start)
+        pedestal) so gives way to the next candidate; a plan-level problem does not. ``plans`` is
+        read past the first only when the first fails (a generator defers the alternatives)."""
+        remaining = iter(plans)
+        first = self.solve(plant_context, next(remaining), start)
         if first.ok or first.problems:
             return first
-        for index, plan in enumerate(plans[1:], start=1):
+        for index, plan in enumerate(remaining, start=1):
             keyframes = self.solve(plant_context, plan, start)
             if keyframes.ok:
                 return replace(keyframes, candidate=index, replaced=tuple(first.failures))

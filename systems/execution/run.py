@@ -197,14 +197,9 @@ def _plan(handles, scenario, simulator, listener, started, perception, perceive_
     if keyframes.candidate:  # the plan's IK failed; an alternative's keypoints are run and drawn
         robot_plan = replace(robot_plan, keypoints=keyframes.keypoints)
     result = ExecutionResult(
-        scenario.planner.kind,
-        scenario.scene,
-        plan,
-        keyframes,
-        robot_plan,
-        execution=handles.execution,
-        actuated_dofs=len(scenario.robot.actuated_joints),
+        scenario.planner.kind, scenario.scene, plan, keyframes, robot_plan, execution=handles.execution
     )
+    result.actuated_dofs = len(scenario.robot.actuated_joints)
     result.timings = {"plan_s": plan_s, "ik_s": solved - planned, "optimise_s": 0.0}
     result.true_names = names
     if scenario.perception.source == "camera":

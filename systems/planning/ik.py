@@ -13,7 +13,7 @@ Output ports (in Drake's cache, computed again only when their input changes):
         timed by the scenario's ``motion``; the gripper closed among the obstacles if
         ``motion.closed_among_obstacles``.
     ``alternative_trajectories`` (abstract, tuple of ``PiecewisePolynomial``): the same for each of
-        ``alternatives`` whose every keypoint's IK succeeds, in order, but the one ``keyframes`` took;
+        ``alternatives`` whose every keypoint's IK succeeds, in order, after the one ``keyframes`` took;
         computed only when evaluated.
 
 The positions are in the robot model instance's order (``robot_position_names()``: base x, y, yaw,
@@ -205,8 +205,9 @@ class KeypointIk(LeafSystem):
         yield from self._alternatives(context)
 
     def _calc_alternative_trajectories(self, context: Context, output: AbstractValue) -> None:
+        # Those up to the one ``keyframes`` took failed their IK there, or were taken: not solved again.
         taken = self._keyframes_port.Eval(context).candidate if self._plan_port.HasValue(context) else 0
-        plans = [plan for index, plan in enumerate(self._alternatives(context), start=1) if index != taken]
+        plans = self._alternatives(context)[taken:]
         plant_context = self._plant_context(context)
         solved = (self._solver.solve(plant_context, plan) for plan in plans)
         output.set_value(tuple(self._solver.trajectory(plant_context, k) for k in solved if k.ok))

@@ -22,8 +22,8 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from hlp_drake.atomic import write_text_atomic
 from hlp_drake.errors import HlpError
+from hlp_drake.files.atomic import write_text_atomic
 from hlp_drake.scene.generators import generate_scene
 
 

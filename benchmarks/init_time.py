@@ -29,9 +29,9 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from hlp_drake.atomic import write_text_atomic
+from hlp_drake.files.atomic import write_text_atomic
+from hlp_drake.files.plotting import new_figure, save_png
 from hlp_drake.learners.bundled import default_models
-from hlp_drake.plotting import new_figure, save_png
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.planning.diagram import make_planning_diagram

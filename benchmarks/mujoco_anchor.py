@@ -65,8 +65,8 @@ from pydrake.multibody.tree import BodyIndex, JointActuatorIndex, JointIndex, Mo
 from sto import HORIZON, throughput_sequences
 from tqdm import tqdm
 
-from hlp_drake.systems.optimiser.control_sequence import ControlSequence
-from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
+from hlp_drake.systems.low_level.control_sequence import ControlSequence
+from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld
 from hlp_drake.systems.scenario import Scenario
 from hlp_drake.systems.world.robot_description import MOBILE_UR5, models_directory
 from hlp_drake.systems.world.world import make_world_diagram, world_plant

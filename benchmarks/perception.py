@@ -30,9 +30,9 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
+from hlp_drake.files.plotting import new_figure, save_png
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.planner import plan
-from hlp_drake.plotting import new_figure, save_png
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene, SceneObject
 from hlp_drake.systems.perception.accuracy import match_objects, perception_record, same_decisions

@@ -40,8 +40,8 @@ from sto import nudged, validation_sequences
 from tqdm import tqdm
 
 from hlp_drake.scene.generators import generate_scene
-from hlp_drake.systems.optimiser.control_sequence import ControlSequence
-from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
+from hlp_drake.systems.low_level.control_sequence import ControlSequence
+from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld
 from hlp_drake.systems.scenario import Scenario
 
 FULL = "contact: {top_spheres: true, rim_spheres: 8, robot_self_contact: true}"

@@ -36,7 +36,7 @@ from tqdm import tqdm
 from hlp_drake.dataset import STRUCTURED, UNSTRUCTURED, Dataset
 from hlp_drake.errors import HlpError
 from hlp_drake.evaluation import subject_splits
-from hlp_drake.plotting import new_figure, save_png
+from hlp_drake.files.plotting import new_figure, save_png
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene, SceneObject, Table
 from hlp_drake.segmentation import demonstration_records

@@ -21,7 +21,7 @@ import time
 import numpy as np
 
 from hlp_drake.scene.generators import generate_scene
-from hlp_drake.systems.optimiser.pool import SceneRollouts
+from hlp_drake.systems.low_level.sto.pool import SceneRollouts
 from hlp_drake.systems.perception.system import perceive_world
 from hlp_drake.systems.planning.diagram import initial_sequence
 from hlp_drake.systems.scenario import Scenario

@@ -33,10 +33,10 @@ from tqdm import tqdm
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import load_scene
 from hlp_drake.systems.execution.run import plan_and_execute
-from hlp_drake.systems.optimiser.control_sequence import ControlSequence
-from hlp_drake.systems.optimiser.optimiser import sample_base_noise
-from hlp_drake.systems.optimiser.pool import RolloutPool
-from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
+from hlp_drake.systems.low_level.control_sequence import ControlSequence
+from hlp_drake.systems.low_level.sto.optimiser import sample_base_noise
+from hlp_drake.systems.low_level.sto.pool import RolloutPool
+from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld
 from hlp_drake.systems.planning.diagram import initial_sequence
 from hlp_drake.systems.scenario import Scenario
 

@@ -10,7 +10,7 @@ import os as _os
 __version__ = "0.1.0"
 
 DRAKE_LOG = "HLP_DRAKE_LOG"
-"""The environment variable by which a command (``hlp_drake.cli.drake_logging``) tells its own process
+"""The environment variable by which a command (``hlp_drake.commands.parsing.drake_logging``) tells its own process
 and every process it starts (a process pool's or dask's workers, which inherit it) whether Drake's
 INFO lines are shown: ``warning`` keeps them out, anything else (or unset) lets them through."""
 

@@ -3,37 +3,27 @@
     hlp-drake COMMAND [ARGS ...]      (or: python -m hlp_drake COMMAND [ARGS ...])
 
 Commands (each takes --help; the same as python -m hlp_drake.MODULE):
-    run-scene     plan a scene, optimise it with the STO and run it in Drake (hlp_drake.run_scene)
-    scene         generate, validate and draw scene files (hlp_drake.scene)
-    experiments   the paper's Generalization I and II experiments, Tables II and III (hlp_drake.experiments)
-    train         train the decision models on the VR dataset (hlp_drake.train)
-    evaluate      the cross-subject evaluation, Table I (hlp_drake.evaluate)
-    segment       segment the VR demonstrations into per-row decisions (hlp_drake.segment)
-    dataset       summarise the VR dataset (hlp_drake.dataset)
+    run-scene     plan a scene, optimise it with the STO and run it in Drake (python -m hlp_drake.run_scene)
+    scene         generate, validate and draw scene files (python -m hlp_drake.scene)
+    experiments   the paper's Generalization I and II experiments, Tables II and III (python -m hlp_drake.experiments)
+    train         train the decision models on the VR dataset (python -m hlp_drake.train)
+    evaluate      the cross-subject evaluation, Table I (python -m hlp_drake.evaluate)
+    segment       segment the VR demonstrations into per-row decisions (python -m hlp_drake.segment)
+    dataset       summarise the VR dataset (python -m hlp_drake.dataset)
 """
 
 from __future__ import annotations
 
-import importlib
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 
 from hlp_drake import __version__
-from hlp_drake.cli import invoked_as, plain, run_cli
+from hlp_drake.commands import COMMANDS, command_main
+from hlp_drake.commands.parsing import invoked_as, plain, run_cli
 
 PROG, PYTHON_M = "hlp-drake", "python -m hlp_drake"
 """The console script's name, and how ``python -m`` runs the same (named as the user typed)."""
-
-COMMANDS = {
-    "run-scene": "hlp_drake.run_scene",
-    "scene": "hlp_drake.scene.__main__",
-    "experiments": "hlp_drake.experiments.cli",
-    "train": "hlp_drake.learners.cli",
-    "evaluate": "hlp_drake.evaluation.cli",
-    "segment": "hlp_drake.segmentation.cli",
-    "dataset": "hlp_drake.dataset.__main__",
-}
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -46,15 +36,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args[0] == "--version":
         print(f"{name} {__version__}")
         return 0
-    module = COMMANDS.get(args[0])
-    if module is None:
+    if args[0] not in COMMANDS:
         print(
             f"error: unknown command {args[0]!r}; choose one of {', '.join(COMMANDS)} (see {name} --help)",
             file=sys.stderr,
         )
         return 2
     with invoked_as(f"{name} {args[0]}"):
-        return run_cli(importlib.import_module(module).main, args[1:])
+        return run_cli(command_main(args[0]), args[1:])
 
 
 if __name__ == "__main__":

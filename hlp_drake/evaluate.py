@@ -1,7 +1,6 @@
-"""``python -m hlp_drake.evaluate``: see ``hlp_drake.evaluation.cli``."""
+"""``python -m hlp_drake.evaluate``: see ``hlp_drake.commands.evaluate``."""
 
-from hlp_drake.cli import run_cli
-from hlp_drake.evaluation.cli import main
+from hlp_drake.commands import run_command
 
 if __name__ == "__main__":
-    raise SystemExit(run_cli(main))
+    raise SystemExit(run_command("evaluate"))

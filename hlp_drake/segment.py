@@ -1,7 +1,6 @@
-"""``python -m hlp_drake.segment``: see ``hlp_drake.segmentation.cli``."""
+"""``python -m hlp_drake.segment``: see ``hlp_drake.commands.segment``."""
 
-from hlp_drake.cli import run_cli
-from hlp_drake.segmentation.cli import main
+from hlp_drake.commands import run_command
 
 if __name__ == "__main__":
-    raise SystemExit(run_cli(main))
+    raise SystemExit(run_command("segment"))

@@ -6,9 +6,9 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
-from hlp_drake.systems.optimiser.control_sequence import ControlSequence
-from hlp_drake.systems.optimiser.optimiser import StoResult
-from hlp_drake.systems.optimiser.pool import RolloutPool
+from hlp_drake.systems.low_level.control_sequence import ControlSequence
+from hlp_drake.systems.low_level.sto.optimiser import StoResult
+from hlp_drake.systems.low_level.sto.pool import RolloutPool
 from hlp_drake.systems.perception.system import add_scene_perception
 from hlp_drake.systems.scenario import Scenario
 from hlp_drake.systems.world.scene_source import SceneFromPlant

@@ -30,7 +30,7 @@ def die() -> None:
 
 def rollout_killing_its_worker_once(*args):
     """The rollout task, whose first call (in any worker) kills its worker process."""
-    from hlp_drake.systems.optimiser import pool
+    from hlp_drake.systems.low_level.sto import pool
 
     if first_time("rollout"):
         die()

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import collections
 import contextlib
+import functools
+import json
 import math
 import tempfile
 from collections.abc import Callable, Iterator
@@ -17,10 +19,14 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from hlp_drake.errors import MAX_LINE, MAX_PROBLEMS, HlpError
+from hlp_drake.scene.generators import KINDS, generate_scene
+from hlp_drake.scene.io import scene_to_dict
+from hlp_drake.scene.model import Scene
 
 PROFILES = [pytest.param("fast", id="fast"), pytest.param("long", id="long", marks=pytest.mark.slow)]
 STATS: collections.Counter[str] = collections.Counter()
@@ -116,3 +122,44 @@ def mutate(document: dict, draw: Callable, most: int = 3) -> dict:
         elif operation == "unknown" and isinstance(container, dict):
             container[draw(st.text(min_size=1, max_size=8))] = draw(junk)
     return document
+
+
+@functools.cache
+def generated(kind: str, seed: int) -> Scene:
+    return generate_scene(kind, seed)
+
+
+@st.composite
+def _mutated_document(draw) -> dict:
+    doc = scene_to_dict(generated(draw(st.sampled_from(KINDS)), draw(st.integers(0, 30))))
+    mutate(doc, draw)
+    if draw(st.integers(0, 5)) == 0 and isinstance(doc.get("obstacles"), list):
+        doc["obstacles"] = doc["obstacles"] * draw(
+            st.sampled_from([2, 10, 200])
+        )  # names repeat, objects overlap
+    return doc
+
+
+_DUMPER = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+_HOSTILE_TEXTS = [
+    "start: " + "[" * 5000 + "]" * 5000 + "\n",
+    "a: &a [x, x, x, x, x, x, x, x, x]\nb: &b [*a, *a, *a, *a, *a, *a, *a, *a, *a]\nstart: [*b, *b, *b, *b]\n",
+    "name: one\nname: two\n",
+    "table: {length: " + "9" * 400 + ", width: 0.7, height: 0.7}\n",
+    "!!python/object/apply:os.system ['echo owned']\n",
+    "--- {}\n--- {}\n",
+    "",
+    "\x00\xff",
+]
+
+
+@st.composite
+def scene_texts(draw) -> tuple[str, str]:
+    """(suffix, text) of a scene file: a generated scene mutated, or a hostile text."""
+    if draw(st.integers(0, 9)) == 0:
+        return draw(st.sampled_from([".yaml", ".json"])), draw(st.sampled_from(_HOSTILE_TEXTS))
+    doc = draw(_mutated_document())
+    suffix = draw(st.sampled_from([".yaml", ".json"]))
+    text = json.dumps(doc) if suffix == ".json" else yaml.dump(doc, Dumper=_DUMPER, sort_keys=False)
+    cut = draw(st.one_of(st.none(), st.integers(0, len(text))))
+    return suffix, text if cut is None else text[:cut]

@@ -94,8 +94,8 @@ GEN1_15 = [("move", "FailOnTouchObstacleLong", "BL"), ("move", "FailOnTouchObsta
 def chain_first_rollout(scenario, human: HighLevelPlan):
     """The optimiser's first rollout of the initial trajectory of ``human``'s robot plan."""
     from hlp_drake.systems import make_planning_diagram
-    from hlp_drake.systems.optimiser.control_sequence import ControlSequence
-    from hlp_drake.systems.optimiser.pool import SceneRollouts
+    from hlp_drake.systems.low_level.control_sequence import ControlSequence
+    from hlp_drake.systems.low_level.sto.pool import SceneRollouts
 
     diagram = make_planning_diagram(scenario, plan=human)
     context = diagram.CreateDefaultContext()

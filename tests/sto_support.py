@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hlp_drake.run_scene import DEFAULT_SCENE
+from hlp_drake.commands.run_scene import DEFAULT_SCENE
 from hlp_drake.scene.io import load_scene
-from hlp_drake.systems.optimiser.control_sequence import ControlSequence
-from hlp_drake.systems.optimiser.rollout_world import RolloutWorld
+from hlp_drake.systems.low_level.control_sequence import ControlSequence
+from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld
 from hlp_drake.systems.planning.diagram import make_planning_diagram
 from hlp_drake.systems.scenario import Scenario
 

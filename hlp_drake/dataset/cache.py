@@ -36,7 +36,7 @@ from hlp_drake.dataset.parse import (
 from hlp_drake.dataset.records import ARM_PARTS, TRACKERS, category_of, trial_key
 from hlp_drake.dataset.source import PARTICIPANTS_FILE, Source
 from hlp_drake.errors import HlpError, short
-from hlp_drake.terminal import bars_disabled
+from hlp_drake.runtime.terminal import bars_disabled
 
 CACHE_VERSION = 6  # 6: damaged interaction logs (cut short, naming an object the scene lacks) are left
 # out (5: values beyond parse.MAX_VALUE, files beyond source.MAX_FILE_BYTES and trials listed twice;

@@ -1,11 +1,11 @@
-"""VR layouts and tracks -> the project's Scene and Tracks (via ``hlp_drake.frames``)."""
+"""VR layouts and tracks -> the project's Scene and Tracks (via ``hlp_drake.dataset.frames``)."""
 
 from __future__ import annotations
 
 import numpy as np
 
+from hlp_drake.dataset.frames import unity_to_world, unity_yaw_to_world
 from hlp_drake.dataset.records import Track
-from hlp_drake.frames import unity_to_world, unity_yaw_to_world
 from hlp_drake.scene.model import Scene, SceneObject, Table
 from hlp_drake.scene.validation import validate_scene
 

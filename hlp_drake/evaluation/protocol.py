@@ -23,9 +23,9 @@ from hlp_drake.evaluation.metrics import TrialOutcome, score_trial
 from hlp_drake.features.training import LabelledSet, TrainingData
 from hlp_drake.learners.models import DecisionModels, LearnerSettings
 from hlp_drake.planner import PlannerConfig, plan
+from hlp_drake.runtime.terminal import bars_disabled
 from hlp_drake.segmentation.demonstration import GAP, OBJECT, Demonstration
 from hlp_drake.segmentation.modes import is_faithful
-from hlp_drake.terminal import bars_disabled
 
 PAPER_TABLE_I = {
     "gap_accuracy": 0.95,

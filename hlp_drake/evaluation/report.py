@@ -10,9 +10,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from hlp_drake.atomic import write_text_atomic
 from hlp_drake.evaluation.protocol import PAPER_TABLE_I, PLANNERS, SETTINGS, SplitResult, summarise
-from hlp_drake.plotting import new_figure, save_png
+from hlp_drake.files.atomic import write_text_atomic
+from hlp_drake.files.plotting import new_figure, save_png
 from hlp_drake.segmentation.demonstration import Demonstration
 
 COLUMNS = (

@@ -1,7 +1,6 @@
-"""``python -m hlp_drake.experiments``: see ``hlp_drake.experiments.cli``."""
+"""``python -m hlp_drake.experiments``: see ``hlp_drake.commands.experiments``."""
 
-from hlp_drake.cli import run_cli
-from hlp_drake.experiments.cli import main
+from hlp_drake.commands import run_command
 
 if __name__ == "__main__":
-    raise SystemExit(run_cli(main))
+    raise SystemExit(run_command("experiments"))

@@ -22,7 +22,7 @@ from types import ModuleType
 
 from hlp_drake.errors import HlpError
 from hlp_drake.experiments.runner import Job, JobFunction, Row, crash_row
-from hlp_drake.processes import (
+from hlp_drake.runtime.processes import (
     interrupts_held,
     shut_down_broken,
     terminate_workers,

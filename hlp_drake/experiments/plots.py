@@ -11,7 +11,7 @@ import numpy as np
 
 from hlp_drake.experiments.runner import PLANNERS
 from hlp_drake.experiments.summary import PLANNER_LABELS, TIME_LABELS, TIMES
-from hlp_drake.plotting import plt, save_png
+from hlp_drake.files.plotting import plt, save_png
 
 COLOURS = {"hlp": "#1f77b4", "sto": "#ff7f0e"}
 BAR_WIDTH = 0.36

@@ -21,10 +21,10 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from hlp_drake.atomic import atomic_path
-from hlp_drake.documents import read_bytes
 from hlp_drake.errors import HlpError
 from hlp_drake.experiments.runner import PLANNERS, Row
+from hlp_drake.files.atomic import atomic_path
+from hlp_drake.files.documents import read_bytes
 
 COLUMNS = (
     "scene",

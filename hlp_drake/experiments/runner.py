@@ -12,11 +12,11 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+from hlp_drake.config.what_ran import WhatRan
 from hlp_drake.errors import SceneError
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.workspace import Workspace
-from hlp_drake.what_ran import WhatRan
 
 PLANNERS = ("hlp", "sto")  # the planners of Tables II and III: human-like plan; STO's straight line
 KINDS = ("gen1", "gen2")  # Generalization I (Table II) and II (Table III)

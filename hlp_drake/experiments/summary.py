@@ -16,9 +16,9 @@ from pathlib import Path
 from statistics import fmean
 from typing import Any
 
-from hlp_drake.atomic import write_text_atomic
+from hlp_drake.config.what_ran import WhatRan
 from hlp_drake.experiments.runner import PLANNERS, Row
-from hlp_drake.what_ran import WhatRan
+from hlp_drake.files.atomic import write_text_atomic
 
 PLANNER_LABELS = {"hlp": "HLP", "sto": "STO (straight line)"}
 TIMES = ("init_s", "optimise_s", "total_s")

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from hlp_drake.features.plane import corner_origin
-from hlp_drake.lazy import LazyRows
+from hlp_drake.scene.lazy import LazyRows
 from hlp_drake.segmentation.modes import Mode, is_faithful
 from hlp_drake.taskspace import (
     DIRECTIONS,

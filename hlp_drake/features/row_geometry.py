@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hlp_drake.lazy import LazyRows
+from hlp_drake.scene.lazy import LazyRows
 from hlp_drake.taskspace import TaskSpace, free_fractions, rect_array
 from hlp_drake.taskspace.model import table_walls
 

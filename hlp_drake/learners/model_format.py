@@ -27,13 +27,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from hlp_drake.documents import brief
 from hlp_drake.errors import ModelError
 from hlp_drake.features.arm import ARM_FEATURES
 from hlp_drake.features.direction import DIRECTION_FEATURES
 from hlp_drake.features.row_choice import ROW_CHOICE_FEATURES
 from hlp_drake.features.scene_features import GAP_FEATURES, OBJECT_FEATURES
 from hlp_drake.features.segment import SEGMENT_FEATURES
+from hlp_drake.files.documents import brief
 from hlp_drake.learners.arm import CATEGORICAL as ARM_CATEGORICAL
 from hlp_drake.learners.direction import CATEGORICAL as DIRECTION_CATEGORICAL
 from hlp_drake.learners.encoding import N_DIRECTIONS

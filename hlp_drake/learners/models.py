@@ -19,11 +19,12 @@ from typing import Any
 
 import numpy as np
 
-from hlp_drake.atomic import atomic_path, write_text_atomic
+from hlp_drake.config.typed_yaml import document_problems
 from hlp_drake.dataset.records import STRUCTURED, UNSTRUCTURED, category_of
-from hlp_drake.documents import brief, parse_json, read_bytes
 from hlp_drake.errors import ModelError
 from hlp_drake.features.training import TrainingData
+from hlp_drake.files.atomic import atomic_path, write_text_atomic
+from hlp_drake.files.documents import brief, parse_json, read_bytes
 from hlp_drake.learners.arm import CATEGORICAL as ARM_CATEGORICAL
 from hlp_drake.learners.arm import ArmRegressor
 from hlp_drake.learners.choice import LEARNERS as ROW_LEARNERS
@@ -41,7 +42,6 @@ from hlp_drake.learners.model_format import (
 )
 from hlp_drake.learners.svm import RbfSvmClassifier
 from hlp_drake.segmentation.modes import Mode, is_faithful
-from hlp_drake.typed_yaml import document_problems
 
 FORMAT = "hlp_drake.decision_models"
 VERSION = 2

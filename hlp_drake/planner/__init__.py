@@ -1,8 +1,8 @@
 """The human-like planner (Algorithm 1 of the paper) and its output, ``HighLevelPlan``."""
 
-from hlp_drake.exports import lazy_exports
 from hlp_drake.planner.config import PlannerConfig
 from hlp_drake.planner.plan import ACTIONS, HighLevelPlan, PlanCandidate, PlanKeypoint
+from hlp_drake.runtime.exports import lazy_exports
 
 __all__ = ["ACTIONS", "HighLevelPlan", "PlanCandidate", "PlanKeypoint", "PlannerConfig", "plan"]
 

@@ -1,4 +1,4 @@
-"""Typed settings of the human-like planner, each with its range (``hlp_drake.ranges``)."""
+"""Typed settings of the human-like planner, each with its range (``hlp_drake.config.ranges``)."""
 
 from __future__ import annotations
 
@@ -6,8 +6,8 @@ import typing
 from dataclasses import dataclass
 from typing import Annotated
 
-from hlp_drake.documents import brief
-from hlp_drake.ranges import Rule
+from hlp_drake.config.ranges import Rule
+from hlp_drake.files.documents import brief
 from hlp_drake.segmentation.modes import Mode
 
 

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from hlp_drake.config.ranges import config_problems
 from hlp_drake.errors import SceneError, short
 from hlp_drake.features import table_diagonal
 from hlp_drake.features.row_choice import HUMAN_HAND_WIDTH
@@ -16,7 +17,6 @@ from hlp_drake.planner.config import PlannerConfig
 from hlp_drake.planner.plan import HighLevelPlan, PlanCandidate, PlanKeypoint
 from hlp_drake.planner.rollout import PrefixTree, arm_configurations, expected_collisions, path_keypoints
 from hlp_drake.planner.row_plan import plan_rows
-from hlp_drake.ranges import config_problems
 from hlp_drake.scene.generators import VR_TABLE
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.validation import scene_problems

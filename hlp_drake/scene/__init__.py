@@ -1,6 +1,6 @@
-"""The scene model: table, start, target and obstacles in the world frame (see ``hlp_drake.frames``)."""
+"""The scene model: table, start, target and obstacles in the world frame (see ``hlp_drake.dataset.frames``)."""
 
-from hlp_drake.exports import lazy_exports
+from hlp_drake.runtime.exports import lazy_exports
 
 __all__ = [
     "DEFAULT_SCENE_FILE",

@@ -1,7 +1,7 @@
 """Seeded scene generators: the VR two-row structure, Generalization I and II, unstructured layouts.
 
 Every generator is a pure function of its seed (``numpy.random.default_rng(seed)``). All scenes are in
-the world frame of ``hlp_drake.frames`` (front edge of the table at x = 0, y to the left).
+the world frame of ``hlp_drake.dataset.frames`` (front edge of the table at x = 0, y to the left).
 
 - ``vr``: the dataset's structured trials (T010-T099): the 0.74 x 0.60 m VR table, obstacle rows at
   0.245 and 0.405 m from the front edge, one short (0.05 m), medium (0.10) and long (0.15) obstacle per
@@ -26,8 +26,8 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
-from hlp_drake.documents import brief
 from hlp_drake.errors import SceneError
+from hlp_drake.files.documents import brief
 from hlp_drake.scene.constants import KINDS, MAX_GENERATED
 from hlp_drake.scene.geometry import footprint
 from hlp_drake.scene.model import Scene, SceneObject, Table

@@ -1,6 +1,6 @@
 """Scene files: YAML or JSON, chosen by the file extension. Loading validates; saving is atomic.
 
-The format is the ``Scene`` dataclass itself, read by ``hlp_drake.typed_yaml`` the same way a scenario
+The format is the ``Scene`` dataclass itself, read by ``hlp_drake.config.typed_yaml`` the same way a scenario
 file's ``scene:`` is read.
 """
 
@@ -14,13 +14,13 @@ from typing import Any
 
 import yaml
 
-from hlp_drake.atomic import write_text_atomic
-from hlp_drake.documents import parse_json, parse_yaml, read_document
+from hlp_drake.config.typed_yaml import load_typed
 from hlp_drake.errors import SceneError
+from hlp_drake.files.atomic import write_text_atomic
+from hlp_drake.files.documents import parse_json, parse_yaml, read_document
 from hlp_drake.scene.constants import DEFAULT_SCENE_FILE
 from hlp_drake.scene.model import Scene, SceneObject
 from hlp_drake.scene.validation import MAX_OBSTACLES, scene_problems, validate_scene
-from hlp_drake.typed_yaml import load_typed
 
 YAML_SUFFIXES = (".yaml", ".yml")
 JSON_SUFFIXES = (".json",)
@@ -55,7 +55,7 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
 
 def scene_from_dict(data: Any, *, where: str = "") -> Scene:
     """Read and validate a Scene from parsed YAML or JSON (``Scene`` is the schema; see
-    ``hlp_drake.typed_yaml``).
+    ``hlp_drake.config.typed_yaml``).
 
     Raises:
         SceneError: every problem on its own line, located (``obstacles[0].x: expected a number``)
@@ -91,7 +91,7 @@ def load_scene(path: str | os.PathLike[str]) -> Scene:
 
     Raises:
         SceneError: the file is missing, unreadable, too large, not YAML/JSON (or breaks the
-            limits of ``hlp_drake.documents``), or describes an invalid scene; every message starts
+            limits of ``hlp_drake.files.documents``), or describes an invalid scene; every message starts
             with the file's path.
     """
     path = Path(path)

@@ -1,6 +1,6 @@
 """Scene dataclasses: a table, a start point, a target cylinder and obstacles, in the world frame.
 
-See ``hlp_drake.frames`` for the frame: origin below the middle of the table's front edge, x into
+See ``hlp_drake.dataset.frames`` for the frame: origin below the middle of the table's front edge, x into
 the table (depth), y to the left, z up. Objects stand on the table top; a scene stores only their
 planar pose (x, y, yaw) and their size.
 """

@@ -9,7 +9,7 @@ from matplotlib.axes import Axes
 from matplotlib.patches import Circle, Rectangle
 from matplotlib.patches import Polygon as PolygonPatch
 
-from hlp_drake.plotting import new_figure, save_png
+from hlp_drake.files.plotting import new_figure, save_png
 from hlp_drake.scene.geometry import footprint
 from hlp_drake.scene.model import Scene, SceneObject
 from hlp_drake.scene.rows import find_rows

@@ -14,10 +14,10 @@ from numbers import Real
 import numpy as np
 import shapely
 
-from hlp_drake.documents import brief
 from hlp_drake.errors import MAX_PROBLEMS, SceneError
-from hlp_drake.lazy import LazyRows
+from hlp_drake.files.documents import brief
 from hlp_drake.scene.geometry import footprint_bounds, footprints
+from hlp_drake.scene.lazy import LazyRows
 from hlp_drake.scene.model import SHAPES, Scene, SceneObject, Table
 
 LENGTH_TOLERANCE = 1e-9  # m: how far a footprint may poke past the table edge (float noise)

@@ -1,6 +1,6 @@
 """Demonstration segmentation (reference notes section 3): per-row decisions, keypoints, arm angles."""
 
-from hlp_drake.exports import lazy_exports
+from hlp_drake.runtime.exports import lazy_exports
 
 __all__ = [
     "DEFAULT_MODE",

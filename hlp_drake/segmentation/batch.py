@@ -11,11 +11,11 @@ from tqdm import tqdm
 
 from hlp_drake.dataset.dataset import Dataset
 from hlp_drake.dataset.records import STRUCTURED, TrialRecord, category_of
+from hlp_drake.runtime.terminal import bars_disabled
 from hlp_drake.segmentation.demonstration import NONE, OBJECT, Demonstration, Rejection
 from hlp_drake.segmentation.modes import DEFAULT_MODE, Mode, check_mode
 from hlp_drake.segmentation.segment import Rejected, segment_trial
 from hlp_drake.taskspace import TaskSpace
-from hlp_drake.terminal import bars_disabled
 
 
 @dataclass

@@ -6,7 +6,7 @@ import os
 
 from matplotlib.patches import Rectangle
 
-from hlp_drake.plotting import new_figure, save_png
+from hlp_drake.files.plotting import new_figure, save_png
 from hlp_drake.scene.plot import draw_scene, page_xy
 from hlp_drake.segmentation.demonstration import OBJECT, Demonstration
 from hlp_drake.taskspace import DIRECTION_VECTORS, TaskSpace

@@ -13,7 +13,7 @@ import math
 from dataclasses import dataclass
 from typing import Annotated
 
-from hlp_drake.ranges import NonNegativeFloat, Positive, PositiveFloat
+from hlp_drake.config.ranges import NonNegativeFloat, Positive, PositiveFloat
 
 MIN_TRAVEL_STEP = 1e-4
 """m: the finest step pushes and ways are measured in (their samples grow as its inverse)."""

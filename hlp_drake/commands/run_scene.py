@@ -1,0 +1,276 @@
+"""Plan a scene with the human-like planner (or the straight line), optimise it with the STO and run it in Drake.
+
+    python -m hlp_drake.run_scene [--scene FILE | --kind vr|gen1|gen2|unstructured --seed N [--objects K]]
+        [--planner hlp|sto] [--perception truth|camera] [--config SCENARIO.yaml] [--workers N]
+        [--meshcat] [--html FILE] [--contact-forces] [--execution open|closed] [--uncertainty [SEED]]
+        [--json FILE] [--quiet | --verbose]
+
+With no arguments it runs the bundled default scene with the bundled models. With --perception camera
+the planner, IK and optimiser work on the scene the world's cameras see (ScenePerception) while the
+simulation runs the true one; the plan names each perceived object by the true one it was matched
+to, the perceived name beside, and the JSON's perception record compares the two scenes. A header
+says what runs (the scene; the robot, planner, execution mode, model error, perception source and
+scenario file), each stage is printed as it happens (plan, IK, the optimiser's rollouts, the
+execution's simulated time), then a summary ending in one verdict line: the paper's reach success
+(the target in the gripper's pre-grasp region, no object off the table), the grasp beside it.
+
+Exit status: 0 when the reach succeeded, whether or not the grasp then held (the grasp is reported,
+not part of success); 1 when it failed (the verdict line says why); 2 on bad input; 130 when
+interrupted.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import replace
+
+from hlp_drake.commands.parsing import (
+    MAX_SEED,
+    MAX_WORKERS,
+    add_conditions,
+    add_perception,
+    add_robot_option,
+    add_verbosity,
+    drake_logging,
+    integer,
+    make_parser,
+)
+from hlp_drake.config.what_ran import WhatRan
+from hlp_drake.errors import InstallError
+from hlp_drake.files.atomic import check_writable, write_text_atomic
+from hlp_drake.scene.constants import DEFAULT_SCENE_FILE, KINDS, MAX_GENERATED
+
+DEFAULT_SCENE = DEFAULT_SCENE_FILE
+PROG = "python -m hlp_drake.run_scene"
+PLANNER_NAMES = {"hlp": "human-like", "sto": "straight-line"}
+"""The planners as the recording's heading names them."""
+
+
+def verdict(result) -> str:
+    """The verdict line: whether the reach succeeded (the paper's success, which sets the exit status),
+    and beside it whether the grasp held."""
+    grasp = {None: "not attempted", True: "held", False: "did not hold"}[result.grasp_held]
+    if result.grasp_failure is not None:
+        grasp = f"did not hold ({result.grasp_failure})"
+    reach = (
+        "reach success (the paper's criterion, exit status 0)"
+        if result.success
+        else f"reach failure: {result.failure_reason} (exit status 1)"
+    )
+    return f"verdict: {reach}; grasp {grasp} (reported, not part of success)"
+
+
+def exit_status(result) -> int:
+    """0 when the reach succeeded (the paper's success), whatever the grasp; 1 when it failed."""
+    return 0 if result.success else 1
+
+
+def recording_title(result, ran: WhatRan) -> str:
+    """The recording's heading: the scene, the planner and perception, and the verdict in short."""
+    reach = "reach success" if result.success else f"reach failure: {result.failure_reason}"
+    held = {None: "", True: ", grasp held", False: ", grasp did not hold"}[result.grasp_held]
+    planners = " and ".join(PLANNER_NAMES.get(p, p) for p in ran.planners)
+    seen = "on the depth camera's view" if ran.perception_source == "camera" else "on the true scene"
+    return f"scene {result.scene.name}, {planners} planner {seen}: {reach}{held}"
+
+
+def summary(result, ran: WhatRan | None = None) -> str:
+    """The run's summary: what ran (``ran``), timings, the objects moved and dropped, the verdict."""
+    t = result.timings
+    start = (result.optimisation or {}).get("start", 0)
+    alternative = f", from the planner's alternative {start}" if start else ""
+    optimiser = (
+        f"optimise {t['optimise_s']:.1f} s ({result.iterations} iterations, "
+        f"{result.rollouts} rollouts{alternative})"
+        if result.rollouts
+        else "not optimised"
+    )
+    verified = (result.optimisation or {}).get("verifications", 0)
+    if verified:
+        displaced = result.optimisation.get("displaced_checks", 0)
+        optimiser += (
+            f", {verified} verified on the execution model"
+            + (f" and in {displaced} displaced worlds" if displaced else "")
+            + f" ({result.optimisation['rejected']} rejected, {result.optimisation.get('verify_s', 0.0):.1f} s of it)"
+        )
+    loop = result.closed_loop
+    if loop:
+        optimiser += (
+            f"; closed loop: {loop['replans']} re-optimisations, {loop['rollouts']} rollouts, "
+            f"{loop['on_track']} periods on track"
+        )
+    lines = [f"ran: {ran.line()}"] if ran is not None else []
+    lines += [
+        (
+            f"timings: plan {t['plan_s']:.3f} s, IK {t['ik_s']:.2f} s, {optimiser}, execute {t['execute_s']:.1f} s "
+            f"({result.simulated_s:.1f} s simulated), total {t['total_s']:.1f} s"
+        ),
+        f"objects moved: {', '.join(result.objects_moved) or 'none'}; dropped: {', '.join(result.objects_dropped) or 'none'}",
+        verdict(result),
+    ]
+    return "\n".join(lines)
+
+
+def _parser():
+    parser = make_parser(PROG, __doc__)
+    source = parser.add_mutually_exclusive_group()
+    source.add_argument(
+        "--scene", metavar="FILE", help="a scene file (YAML or JSON); default: the bundled default scene"
+    )
+    source.add_argument("--kind", choices=KINDS, help="generate a scene of this kind (with --seed)")
+    parser.add_argument(
+        "--seed", type=integer(0, MAX_SEED), help="seed of the generated scene (with --kind; default 0)"
+    )
+    parser.add_argument(
+        "--objects",
+        type=integer(1, MAX_GENERATED),
+        metavar="K",
+        help="number of obstacles of the generated scene (with --kind gen2 or unstructured)",
+    )
+    parser.add_argument(
+        "--planner",
+        choices=("hlp", "sto"),
+        help="initialise the optimiser with the human-like plan (hlp, the default) or the "
+        "baseline's straight line (sto)",
+    )
+    add_perception(parser)
+    add_robot_option(parser)
+    parser.add_argument(
+        "--config",
+        metavar="SCENARIO.yaml",
+        help="scenario settings (see hlp_drake.systems.Scenario); --scene or --kind replace its scene",
+    )
+    parser.add_argument(
+        "--workers",
+        type=integer(1, MAX_WORKERS),
+        metavar="N",
+        help="rollout processes (default: the scenario's, 2)",
+    )
+    parser.add_argument(
+        "--meshcat", action="store_true", help="show the run live in MeshCat (prints the URL)"
+    )
+    parser.add_argument("--html", metavar="FILE", help="write a self-contained MeshCat recording of the run")
+    parser.add_argument("--contact-forces", action="store_true", help="draw the contact forces in MeshCat")
+    add_conditions(parser)
+    parser.add_argument("--json", metavar="FILE", help="write the result as JSON")
+    add_verbosity(parser)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    started = time.perf_counter()
+    parser = _parser()
+    args = parser.parse_args(argv)
+    if args.kind is None and (args.seed is not None or args.objects is not None):
+        parser.error("--seed and --objects describe a generated scene: give its --kind too")
+    check_writable(args.json, args.html)
+    from hlp_drake.scene.generators import generate_scene  # numpy and shapely: once the arguments are good
+    from hlp_drake.scene.io import load_scene
+
+    scene = None
+    if args.kind is None and (args.scene is not None or args.config is None):
+        scene = load_scene(args.scene or DEFAULT_SCENE)
+        _print(f"scene {scene.name}: {len(scene.obstacles)} obstacles")
+
+    drake_logging(args.verbose)  # Drake is imported from here on
+    from hlp_drake.systems.scenario import load_scenario, with_conditions
+
+    scenario = with_conditions(load_scenario(args.config), robot=args.robot)
+    if args.kind is not None:  # generated for the robot: a fixed one's table within its reach
+        scene = generate_scene(args.kind, args.seed or 0, args.objects, scenario.robot.workspace)
+        _print(f"scene {scene.name}: {len(scene.obstacles)} obstacles")
+    scenario = replace(
+        scenario,
+        scene=scene or scenario.scene,
+        planner=replace(scenario.planner, kind=args.planner or scenario.planner.kind),
+        optimiser=replace(scenario.optimiser, workers=args.workers or scenario.optimiser.workers),
+    )
+    scenario = with_conditions(
+        scenario,
+        execution=args.execution,
+        uncertainty=args.uncertainty,
+        perception=args.perception,
+    )
+    if scene is None:
+        _print(f"scene {scenario.scene.name}: {len(scenario.scene.obstacles)} obstacles")
+    from hlp_drake.systems.execution.result import what_ran
+
+    ran = what_ran(scenario, args.config)
+    _print(f"run: {ran.line()}")
+    result, meshcat = _run(scenario, args, started)
+    print(summary(result, ran))
+    if args.html:
+        from hlp_drake.systems.execution.meshcat_view import with_legend
+
+        perceived = scenario.perception.source == "camera"
+        page = with_legend(meshcat.StaticHtml(), perceived=perceived, title=recording_title(result, ran))
+        write_text_atomic(args.html, page)
+        print(f"wrote {args.html}")
+    if args.json:
+        write_text_atomic(args.json, json.dumps({**ran.to_dict(), **result.to_dict()}, indent=2) + "\n")
+        print(f"wrote {args.json}")
+    if args.meshcat:
+        print(f"done in {time.perf_counter() - started:.1f} s; MeshCat keeps serving until you press Ctrl-C")
+        try:
+            while True:
+                time.sleep(1.0)
+        except KeyboardInterrupt:
+            pass
+    return exit_status(result)
+
+
+def _print(line: str) -> None:
+    print(line, flush=True)
+
+
+def _meshcat():
+    """A MeshCat server on localhost.
+
+    Raises:
+        InstallError: Drake's network policy (``DRAKE_ALLOW_NETWORK``) refuses MeshCat, or the
+            server cannot start.
+    """
+    from pydrake.geometry import Meshcat, MeshcatParams
+
+    try:
+        return Meshcat(MeshcatParams(host="localhost"))
+    except RuntimeError as error:
+        policy = os.environ.get("DRAKE_ALLOW_NETWORK")
+        if policy is not None and "meshcat" not in policy.split(":"):
+            raise InstallError(
+                f"--meshcat and --html need MeshCat, which DRAKE_ALLOW_NETWORK={policy} refuses; "
+                "allow it with DRAKE_ALLOW_NETWORK=meshcat (or unset the variable)"
+            ) from None
+        raise InstallError(f"cannot start MeshCat: {' '.join(str(error).split())}") from None
+
+
+def _run(scenario, args, started: float):
+    """Plan and execute ``scenario`` on a rollout pool of its own, the stages printed as they come."""
+    from hlp_drake.commands.progress import ProgressListener
+    from hlp_drake.systems.execution.run import plan_and_execute
+    from hlp_drake.systems.low_level.sto.pool import RolloutPool
+
+    meshcat = _meshcat() if args.meshcat or args.html else None
+    if args.meshcat:
+        _print(f"MeshCat: {meshcat.web_url()}")
+    listener = ProgressListener(quiet=args.quiet, stream=sys.stderr)
+    workers = scenario.optimiser.workers
+    if workers > 1:
+        _print(f"rollout workers: {workers}, started when a batch of rollouts needs them")
+    with (
+        contextlib.closing(listener),
+        RolloutPool(workers, on_rollout=listener.rollout, on_warning=listener.warning) as pool,
+    ):
+        result = plan_and_execute(
+            scenario,
+            pool=pool,
+            meshcat=meshcat,
+            contact_forces=args.contact_forces,
+            listener=listener,
+        )
+    return result, meshcat

@@ -1,0 +1,2 @@
+"""Files: atomic writes and output checks (``atomic``), bounded reading of documents (``documents``),
+PNG figures (``plotting``)."""

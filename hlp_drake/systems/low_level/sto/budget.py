@@ -1,0 +1,152 @@
+"""What one optimisation may spend (``Budget``) and what it spent (``BudgetedRun``: its rollouts,
+and the checks of a passing rollout: on the execution model after a reduced model's rollout, and in
+the displaced worlds)."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
+
+from hlp_drake.systems.low_level.control_sequence import ControlSequence
+from hlp_drake.systems.low_level.sto.config import PERCEIVED_CHECKS
+from hlp_drake.systems.low_level.sto.cost import RolloutOutcome
+from hlp_drake.systems.low_level.sto.pool import RolloutPool
+from hlp_drake.systems.world.uncertainty import displaced_scenes
+
+if TYPE_CHECKING:
+    from hlp_drake.systems.low_level.sto.rollout_world import RolloutStart
+    from hlp_drake.systems.scenario import Scenario
+
+
+def displaced_checks(scenario: Scenario) -> int:
+    """``optimiser.displaced_checks``, or when it is None ``PERCEIVED_CHECKS`` on a perceived scene
+    (``perception.source: camera``) and 0 on the true one."""
+    checks = scenario.optimiser.displaced_checks
+    if checks is not None:
+        return checks
+    return PERCEIVED_CHECKS if scenario.perception.source == "camera" else 0
+
+
+@dataclass(frozen=True)
+class Budget:
+    """How much one optimisation may do (``Budget.of(scenario)`` by default; the
+    receding-horizon controller gives its replans smaller ones).
+
+    Attributes:
+        samples: noisy rollouts per iteration.
+        max_iterations, max_rollouts: the iteration and rollout budgets (no iteration starts that
+            would pass ``max_rollouts``).
+        time_budget_s: the optional wall-clock cap, s (0: none).
+        alternatives: the planner's alternatives tried when the initial rollout fails (0: none).
+        verify: verify a passing rollout on the execution model before declaring success.
+        max_verifications: verifications at most.
+        seed: seed of the noise.
+        displaced_checks: worlds with displaced objects a verified sequence must pass in too
+            (``displaced_checks(scenario)``; 0: none).
+    """
+
+    samples: int
+    max_iterations: int
+    max_rollouts: int
+    time_budget_s: float = 0.0
+    alternatives: int = 0
+    verify: bool = False
+    max_verifications: int = 0
+    seed: int = 0
+    displaced_checks: int = 0
+
+    @classmethod
+    def of(cls, scenario: Scenario) -> Budget:
+        """The budget ``scenario.optimiser`` sets."""
+        sto = scenario.optimiser
+        return cls(
+            sto.samples,
+            sto.max_iterations,
+            sto.max_rollouts,
+            sto.time_budget_s,
+            sto.alternatives,
+            sto.verify,
+            sto.max_verifications,
+            sto.seed,
+            displaced_checks(scenario),
+        )
+
+
+class BudgetedRun:
+    """One optimisation's rollouts and verifications, counted into its ``StoResult``."""
+
+    def __init__(
+        self, scenario: Scenario, pool: RolloutPool, budget: Budget, start: RolloutStart | None
+    ) -> None:
+        self.scenario, self.pool, self.budget, self.start = scenario, pool, budget, start
+        self.rollouts = self.verifications = self.rejected = 0
+        self.verify_s = 0.0
+        self._displaced: list[Scenario] | None = None
+
+    def displaced_scenarios(self) -> list[Scenario]:
+        """The scenario with its objects displaced, ``budget.displaced_checks`` times (none from a
+        measured start: the closed loop's re-optimisations see where the objects are)."""
+        if self._displaced is None:
+            sto = self.scenario.optimiser
+            count = self.budget.displaced_checks if self.start is None else 0
+            scenes = displaced_scenes(
+                self.scenario.scene, count, sto.displaced_sigma, sto.displaced_yaw_sigma
+            )
+            self._displaced = [replace(self.scenario, scene=scene) for scene in scenes]
+        return self._displaced
+
+    def roll(self, sequences: list[ControlSequence]) -> list[RolloutOutcome]:
+        """The rollouts of ``sequences`` (from the run's start)."""
+        outcomes = self.pool.rollouts(self.scenario, sequences, start=self.start)
+        self.rollouts += len(sequences)
+        return outcomes
+
+    def settle(self, sequences: list[ControlSequence], outcomes: list[RolloutOutcome], order) -> None:
+        """Check the passing outcomes in ``order`` (indices) until one holds (or the verifications
+        run out): with the reduced model on the execution model, and in the displaced worlds. Each
+        one that fails is replaced by the failing check's outcome, and once the verifications run
+        out no passing rollout is trusted. A rollout on the execution model is its own verification."""
+        if not self.budget.verify:
+            return
+        on_model = not self.scenario.optimiser.reduced_model
+        displaced = self.displaced_scenarios()
+        for i in order:
+            if not outcomes[i].success:
+                continue
+            if on_model and not displaced:
+                outcomes[i] = replace(outcomes[i], verification=outcomes[i])
+                return
+            if self.verifications >= self.budget.max_verifications:
+                outcomes[i] = replace(
+                    outcomes[i],
+                    success=False,
+                    failure_reason="passed its rollout, but the verifications ran out",
+                )
+                continue
+            started = time.perf_counter()
+            checked = self.pool.verifications(
+                displaced if on_model else [self.scenario, *displaced], sequences[i], start=self.start
+            )
+            verified, moved = (outcomes[i], checked) if on_model else (checked[0], checked[1:])
+            self.verify_s += time.perf_counter() - started
+            self.verifications += 1
+            failed = next((k for k, o in enumerate(moved) if not o.success), None)
+            if verified.success and failed is None:
+                outcomes[i] = replace(outcomes[i], verification=verified)
+                return
+            self.rejected += 1
+            outcomes[i] = (
+                replace(
+                    verified,
+                    failure_reason=f"passed its rollout, failed its verification: {verified.failure_reason}",
+                )
+                if not verified.success
+                else replace(
+                    moved[failed],
+                    failure_reason=(
+                        f"passed its verification, failed with the objects displaced ({failed + 1} of "
+                        f"{len(moved)}): {moved[failed].failure_reason}"
+                    ),
+                )
+            )

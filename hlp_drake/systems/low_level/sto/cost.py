@@ -1,0 +1,190 @@
+"""The cost of an STO rollout, a pure function of the states read every sample period.
+
+``rollout_cost`` charges (``StoCost``): the goal distance at the end, objects off the table, robot-table
+contact, high contact forces on objects, disturbance of the obstacles and of the target, ending next to
+an obstacle, and the control effort. The paper's success test is part of it (``RolloutOutcome``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from hlp_drake.scene.model import Scene
+from hlp_drake.systems.low_level.sto.config import StoConfig
+from hlp_drake.systems.world.scene_models import off_table_mask
+
+BLOWN_UP_COST = 1.0e9
+
+
+@dataclass(frozen=True)
+class RolloutSamples:
+    """A rollout's state read every sample period (T samples, m objects; object 0 is the target).
+
+    Attributes:
+        times: (T,) sample times, s.
+        positions: (T, m, 3) object centres.
+        tcp: (T, 3) tcp positions.
+        max_force: (T,) largest contact force magnitude on any object, N.
+        table_contact: (T,) whether the robot touched the table.
+        blew_up: why the simulation is not to be trusted (None if it is sane).
+        asleep: the objects asleep at the end (``rollout_sampler``).
+        switches: how often the set of sleeping objects changed.
+    """
+
+    times: np.ndarray
+    positions: np.ndarray
+    tcp: np.ndarray
+    max_force: np.ndarray
+    table_contact: np.ndarray
+    blew_up: str | None = None
+    asleep: tuple[str, ...] = ()
+    switches: int = 0
+
+
+@dataclass(frozen=True)
+class Prediction:
+    """Where a rollout had the objects and the tcp at its samples (for comparing with the world later).
+
+    Attributes:
+        times: (T,) sample times from the rollout's start, s.
+        positions: (T, m, 3) object centres (the target first).
+        tcp: (T, 3) tcp positions.
+    """
+
+    times: np.ndarray
+    positions: np.ndarray
+    tcp: np.ndarray
+
+    def at(self, t: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """(object centres, tcp) at the last sample at or before ``t`` (None before the first)."""
+        k = int(np.searchsorted(self.times, t + 1e-9, side="right")) - 1
+        return None if k < 0 else (self.positions[k], self.tcp[k])
+
+
+@dataclass(frozen=True)
+class FinalState:
+    """Where a rollout on the execution model ended: the plant's model instances' positions and
+    velocities (by name, ``RolloutWorld.states()``' form) at simulated time ``time``, in the world
+    of the scenario with key ``scenario_key``. Its execution model is deterministic, so an execution
+    of the same sequence from the same start in that world ends there too and may start from here.
+    """
+
+    scenario_key: str
+    time: float
+    states: dict[str, np.ndarray]
+
+
+@dataclass(frozen=True)
+class RolloutOutcome:
+    """A rollout's cost and final state.
+
+    Attributes:
+        cost: total cost (``BLOWN_UP_COST`` if the simulation blew up).
+        terms: the cost's terms by name.
+        success: the paper's test at the end: target inside the pre-grasp region, nothing fell, sane.
+        failure_reason: why not, one line (None on success).
+        target_distance: final horizontal tcp-to-target distance, m.
+        fallen: names of the objects off the table at the end.
+        simulated_s, wall_s: simulated and wall-clock time of the rollout.
+        asleep: the objects asleep at the end (empty: the full model).
+        switches: how often the set of sleeping objects changed.
+        prediction: the samples' object centres and tcp positions.
+        verification: the same sequence's outcome on the execution model, when it was verified there
+            and passed (its prediction is then the execution's own).
+        final: the end state, for a rollout from the scene's start with every object awake (None otherwise).
+    """
+
+    cost: float
+    terms: dict[str, float]
+    success: bool
+    failure_reason: str | None
+    target_distance: float
+    fallen: tuple[str, ...] = ()
+    simulated_s: float = 0.0
+    wall_s: float = 0.0
+    asleep: tuple[str, ...] = ()
+    switches: int = 0
+    prediction: Prediction | None = None
+    verification: RolloutOutcome | None = None
+    final: FinalState | None = None
+
+
+def _half_extent(size: tuple[float, float, float]) -> float:
+    return 0.5 * max(size[0], size[1])
+
+
+def pregrasp_check(
+    tcp: np.ndarray, target_position: np.ndarray, scene: Scene, *, tcp_height: float, margin: float
+) -> tuple[bool, float]:
+    """Whether the target (centre at ``target_position``) is inside the gripper's pre-grasp region at
+    tcp position ``tcp``: horizontally within the target's radius + ``margin``, and the tcp within
+    ``margin`` of the grasp height. Also returns the horizontal distance."""
+    distance = float(np.hypot(*(np.asarray(tcp)[:2] - np.asarray(target_position)[:2])))
+    inside = distance <= _half_extent(scene.target.size) + margin and abs(tcp[2] - tcp_height) <= margin
+    return inside, distance
+
+
+def reach_problem(fallen, inside: bool, distance: float) -> str | None:
+    """Why a reach failed the success test (None if it passed)."""
+    if fallen:
+        return f"objects fell off the table: {', '.join(fallen)}"
+    if not inside:
+        return f"the target is not in the gripper's pre-grasp region (tcp {distance:.3f} m away)"
+    return None
+
+
+def rollout_cost(
+    samples: RolloutSamples,
+    scene: Scene,
+    sto: StoConfig,
+    *,
+    tcp_height: float,
+    effort: float,
+    step_duration: float,
+) -> RolloutOutcome:
+    """The cost of a rollout from its samples (see ``StoCost`` for the terms)."""
+    weights = sto.cost
+    names = [obj.name for obj in scene.objects]
+    simulated = float(samples.times[-1]) if len(samples.times) else 0.0
+    if samples.blew_up is not None:
+        return RolloutOutcome(
+            BLOWN_UP_COST,
+            {"blew_up": BLOWN_UP_COST},
+            False,
+            f"the simulation blew up: {samples.blew_up}",
+            math.inf,
+            simulated_s=simulated,
+        )
+    positions, tcp = samples.positions, samples.tcp
+    per_step = (samples.times[1] - samples.times[0]) / step_duration if len(samples.times) > 1 else 1.0
+    off = np.array([off_table_mask(p, scene.table) for p in positions])  # (T, m)
+    final = positions[-1]
+    start = positions[0]
+    inside, distance = pregrasp_check(
+        tcp[-1], final[0], scene, tcp_height=tcp_height, margin=weights.pregrasp_margin
+    )
+    moved = np.sum((final[:, :2] - start[:, :2]) ** 2, axis=1)
+    near = [
+        name
+        for name, obj, p, gone in zip(names[1:], scene.obstacles, final[1:], off[-1, 1:])
+        if not gone and np.hypot(*(tcp[-1, :2] - p[:2])) <= _half_extent(obj.size) + weights.near_distance
+    ]
+    excess = np.clip(samples.max_force - weights.force_limit, 0.0, None)
+    terms = {
+        "goal": distance if inside else weights.goal_weight * distance,
+        "off_table": weights.off_table * float(np.sum(off)) * per_step,
+        "table_contact": weights.table_contact * float(np.sum(samples.table_contact)) * per_step,
+        "force": weights.force_weight * float(np.sum(excess)) * per_step,
+        "disturbance": weights.disturbance_weight * float(np.sum(moved[1:])),
+        "target_disturbance": weights.target_disturbance_weight * float(moved[0]),
+        "near_obstacle": weights.near_obstacle * len(near),
+        "effort": weights.effort_weight * effort,
+    }
+    fallen = tuple(name for name, f in zip(names, off[-1]) if f)
+    reason = reach_problem(fallen, inside, distance)
+    return RolloutOutcome(
+        float(sum(terms.values())), terms, reason is None, reason, distance, fallen, simulated
+    )

@@ -33,8 +33,8 @@ the footprint):
   left finger's opening direction.
 
 Geometry is primitives only (boxes and cylinders). Wheels, caps, rings and stripes are visual only.
-The URDF helpers (primitives, links, joints, inertias) are in ``urdf_writer.py``, shared with
-``make_arms.py``.
+The UR5's numbers, links and joints are in ``ur5_arm.py``; the URDF helpers (primitives, links,
+joints, inertias) in ``urdf_writer.py``, shared with ``make_arms.py``.
 """
 
 from __future__ import annotations
@@ -43,58 +43,25 @@ import argparse
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))  # urdf_writer.py beside this script
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # ur5_arm.py and urdf_writer.py beside it
 
+from ur5_arm import UR5_JOINTS, arm_joints, arm_links
 from urdf_writer import (
-    IDENTITY,
     PI,
     Link,
-    Pose,
-    Vec,
-    add,
-    apply,
     box,
     box_inertia,
     collision_group,
     combined_inertia,
-    compose,
     cyl,
     cyl_span,
     cylinder_inertia,
     joint_xml,
     nums,
-    rot,
-    rpy_matrix,
-    sub,
     transmission_xml,
-    transpose,
 )
 
 OUTPUT = Path(__file__).resolve().parents[2] / "hlp_drake" / "models" / "robot" / "mobile_ur5.urdf"
-
-# --- UR5 (official DH parameters, link masses, centres of mass in the DH link frames) -----------
-UR5_DH = (  # (d, a, alpha) of links 1..6
-    (0.089159, 0.0, PI / 2),
-    (0.0, -0.425, 0.0),
-    (0.0, -0.39225, 0.0),
-    (0.10915, 0.0, PI / 2),
-    (0.09465, 0.0, -PI / 2),
-    (0.0823, 0.0, 0.0),
-)
-UR5_MASSES = (4.0, 3.7, 8.393, 2.275, 1.219, 1.219, 0.1879)  # base, shoulder ... wrist 3
-UR5_COMS_DH = (  # centre of mass of links 1..6 in DH frame i
-    (0.0, -0.02561, 0.00193),
-    (0.2125, 0.0, 0.11336),
-    (0.15, 0.0, 0.0265),
-    (0.0, -0.0018, 0.01634),
-    (0.0, 0.0018, 0.01634),
-    (0.0, 0.0, -0.001159),
-)
-SHOULDER_OFFSET = 0.13585  # lateral offsets of UR's layout; they add up to d4:
-ELBOW_OFFSET = -0.1197  # 0.13585 - 0.1197 + 0.093 = 0.10915
-WRIST_1_OFFSET = 0.093
-
-BIG_EFFORT, SMALL_EFFORT = 150.0, 28.0
 
 # --- Base (Clearpath Ridgeback sized) ----------------------------------------------------------
 BASE_LENGTH, BASE_WIDTH, DECK_HEIGHT = 0.96, 0.79, 0.30
@@ -130,38 +97,6 @@ MATERIALS = {
     "base_black": (0.06, 0.06, 0.06, 1.0),
     "base_yellow": (0.96, 0.76, 0.10, 1.0),
 }
-
-
-# UR layout of the arm: (joint, parent, child, origin xyz, origin rpy, axis) in the parent link.
-UR5_JOINTS = (
-    ("shoulder_pan_joint", "ur5_base_link", "shoulder_link", (0, 0, UR5_DH[0][0]), (0, 0, 0), (0, 0, 1)),
-    (
-        "shoulder_lift_joint",
-        "shoulder_link",
-        "upper_arm_link",
-        (0, SHOULDER_OFFSET, 0),
-        (0, PI / 2, 0),
-        (0, 1, 0),
-    ),
-    ("elbow_joint", "upper_arm_link", "forearm_link", (0, ELBOW_OFFSET, -UR5_DH[1][1]), (0, 0, 0), (0, 1, 0)),
-    ("wrist_1_joint", "forearm_link", "wrist_1_link", (0, 0, -UR5_DH[2][1]), (0, PI / 2, 0), (0, 1, 0)),
-    ("wrist_2_joint", "wrist_1_link", "wrist_2_link", (0, WRIST_1_OFFSET, 0), (0, 0, 0), (0, 0, 1)),
-    ("wrist_3_joint", "wrist_2_link", "wrist_3_link", (0, 0, UR5_DH[4][0]), (0, 0, 0), (0, 1, 0)),
-)
-FLANGE_ORIGIN = ((0, UR5_DH[5][0], 0), (-PI / 2, 0, 0))  # ur5_flange in wrist_3_link
-
-
-def ur5_coms() -> list[Vec]:
-    """Centres of mass of links 1..6 expressed in this model's link frames (at q = 0 both agree)."""
-    dh_pose: Pose = (rot("z", PI), (0.0, 0.0, 0.0))  # DH base in ur5_base_link
-    link_pose: Pose = (IDENTITY, (0.0, 0.0, 0.0))
-    coms = []
-    for (d, a, alpha), com, joint in zip(UR5_DH, UR5_COMS_DH, UR5_JOINTS):
-        dh_pose = compose(dh_pose, (rot("x", alpha), (a, 0.0, d)))
-        link_pose = compose(link_pose, (rpy_matrix(*joint[4]), tuple(float(v) for v in joint[3])))
-        p_world = add(dh_pose[1], apply(dh_pose[0], com))
-        coms.append(apply(transpose(link_pose[0]), sub(p_world, link_pose[1])))
-    return coms
 
 
 # --- The model -----------------------------------------------------------------------------------
@@ -230,74 +165,6 @@ def base_links() -> list[Link]:
     return [x_link, y_link, base]
 
 
-def arm_links() -> list[Link]:
-    _, m1, m2, m3, m4, m5, m6 = UR5_MASSES
-    c1, c2, c3, c4, c5, c6 = ur5_coms()
-    d1, d5, d6 = UR5_DH[0][0], UR5_DH[4][0], UR5_DH[5][0]
-    upper, fore = -UR5_DH[1][1], -UR5_DH[2][1]
-    r_big, r_mid, r_small = 0.06, 0.05, 0.045
-
-    base = Link(
-        "ur5_base_link", "UR5: arm mount on the riser, x forward; the arm stretches along +x at q = 0"
-    )
-    base.mass(UR5_MASSES[0], (0, 0, 0.019), cylinder_inertia(UR5_MASSES[0], 0.075, 0.038, "z"))
-    base.add(cyl_span("z", 0.0, 0.038, 0.075), "ur_grey")
-    base.add(cyl_span("z", 0.038, 0.044, 0.062), "ur_dark", collide=False)
-
-    # Shoulder: vertical J1 housing, z from 0.04 above the mount (frame at d1 above it).
-    shoulder = Link("shoulder_link").mass(m1, c1, cylinder_inertia(m1, r_big, 0.15, "z"))
-    shoulder.add(cyl_span("z", 0.044 - d1, 0.07, r_big), "ur_grey")
-    shoulder.add(cyl_span("z", 0.07, 0.076, 0.045), "ur_blue", collide=False)
-    shoulder.add(cyl_span("y", 0.0, SHOULDER_OFFSET - 0.045, r_big), "ur_grey")
-    shoulder.add(
-        cyl_span("y", SHOULDER_OFFSET - 0.045, SHOULDER_OFFSET - 0.039, 0.052), "ur_dark", collide=False
-    )
-
-    # Upper arm: frame on the J2 axis, z along the arm, y along the joint axes.
-    upper_arm = Link("upper_arm_link").mass(m2, c2, cylinder_inertia(m2, r_big, upper, "z"))
-    upper_arm.add(cyl_span("y", -0.039, 0.06, r_big), "ur_grey")
-    upper_arm.add(cyl_span("y", 0.06, 0.066, 0.045), "ur_blue", collide=False)
-    upper_arm.add(cyl_span("z", 0.0, upper, 0.045), "ur_grey")
-    elbow_y = ELBOW_OFFSET
-    upper_arm.add(cyl_span("y", -0.06, 0.05, r_mid, at=(0, 0, upper)), "ur_grey")
-    upper_arm.add(cyl_span("y", 0.05, 0.056, 0.038, at=(0, 0, upper)), "ur_blue", collide=False)
-    upper_arm.add(cyl_span("y", -0.066, -0.06, 0.044, at=(0, 0, upper)), "ur_dark", collide=False)
-
-    # Forearm: frame on the J3 axis, in the plane 0.1197 m nearer the pan axis than the upper arm.
-    forearm = Link("forearm_link").mass(m3, c3, cylinder_inertia(m3, 0.04, fore, "z"))
-    forearm.add(cyl_span("y", -0.045, -elbow_y - 0.066, r_mid), "ur_grey")
-    forearm.add(cyl_span("y", -0.051, -0.045, 0.038), "ur_blue", collide=False)
-    forearm.add(cyl_span("z", 0.0, fore - 0.04, 0.038), "ur_grey")
-
-    # Wrist 1: frame on the J4 axis (y), the J5 axis 0.093 m further along y.
-    wrist_1 = Link("wrist_1_link").mass(m4, c4, cylinder_inertia(m4, r_small, 0.12, "y"))
-    wrist_1.add(cyl_span("y", -0.045, WRIST_1_OFFSET - r_small, r_small), "ur_grey")
-    wrist_1.add(cyl_span("y", -0.051, -0.045, 0.035), "ur_blue", collide=False)
-    wrist_1.add(
-        cyl_span("y", WRIST_1_OFFSET - r_small, WRIST_1_OFFSET - r_small + 0.006, 0.04),
-        "ur_dark",
-        collide=False,
-    )
-
-    # Wrist 2: frame on the J5 axis (z), the J6 axis d5 further along z.
-    wrist_2 = Link("wrist_2_link").mass(m5, c5, cylinder_inertia(m5, r_small, 0.12, "z"))
-    wrist_2.add(cyl_span("z", -r_small, d5 - r_small, r_small), "ur_grey")
-    wrist_2.add(cyl_span("z", -r_small - 0.006, -r_small, 0.035), "ur_blue", collide=False)
-    wrist_2.add(cyl_span("z", d5 - r_small, d5 - r_small + 0.006, 0.04), "ur_dark", collide=False)
-
-    # Wrist 3: frame on the J6 axis (y); the tool flange d6 along y.
-    wrist_3 = Link("wrist_3_link").mass(m6, c6, cylinder_inertia(m6, 0.0375, 0.03, "y"))
-    wrist_3.add(cyl_span("y", -r_small + 0.006, d6 - 0.012, r_small), "ur_grey")
-    wrist_3.add(cyl_span("y", -r_small, -r_small + 0.006, 0.035), "ur_blue", collide=False)
-    wrist_3.add(cyl_span("y", d6 - 0.012, d6, 0.0315), "ur_dark")
-
-    dh_base = Link(
-        "ur5_base", "the UR5's DH base frame (as UR's controller reports it): the mount turned by pi"
-    )
-    flange = Link("ur5_flange", "the UR5's DH tool flange frame (ROS tool0): z out of the flange")
-    return [base, shoulder, upper_arm, forearm, wrist_1, wrist_2, wrist_3, dh_base, flange]
-
-
 def gripper_links() -> list[Link]:
     gripper = Link("gripper_base_link", "two-finger gripper (Robotiq 2F-85 sized); frame = ur5_flange")
     px, py, pz = PALM_SIZE
@@ -331,14 +198,6 @@ def gripper_links() -> list[Link]:
     return [gripper, *fingers, tcp]
 
 
-ARM_LIMITS = (  # (lower, upper, effort) per UR5 joint; velocity pi rad/s for all
-    (-2 * PI, 2 * PI, BIG_EFFORT),
-    (-2 * PI, 2 * PI, BIG_EFFORT),
-    (-PI, PI, BIG_EFFORT),
-    (-2 * PI, 2 * PI, SMALL_EFFORT),
-    (-2 * PI, 2 * PI, SMALL_EFFORT),
-    (-2 * PI, 2 * PI, SMALL_EFFORT),
-)
 ACTUATED = (
     ("base_x_joint", "base_y_joint", "base_yaw_joint")
     + tuple(j[0] for j in UR5_JOINTS)
@@ -373,12 +232,7 @@ def joints() -> list[str]:
         limit=(-2 * PI, 2 * PI, BASE_TORQUE, BASE_YAW_RATE),
     )
     lines += joint_xml("arm_mount_joint", "fixed", "base_link", "ur5_base_link", ARM_MOUNT_XYZ)
-    lines += joint_xml("ur5_base_joint", "fixed", "ur5_base_link", "ur5_base", rpy=(0, 0, PI))
-    for (name, parent, child, xyz, rpy, axis), (lower, upper, effort) in zip(UR5_JOINTS, ARM_LIMITS):
-        lines += joint_xml(
-            name, "revolute", parent, child, xyz, rpy, axis=axis, limit=(lower, upper, effort, PI)
-        )
-    lines += joint_xml("ur5_flange_joint", "fixed", "wrist_3_link", "ur5_flange", *FLANGE_ORIGIN)
+    lines += arm_joints()
     lines += joint_xml("gripper_mount_joint", "fixed", "ur5_flange", "gripper_base_link")
     finger_limit = (0.0, FINGER_STROKE, FINGER_FORCE, FINGER_SPEED)
     lines += joint_xml(

@@ -43,207 +43,37 @@ step (0.05 m) with the seeds' luck.
 ``--home`` looks for a ready configuration instead: the tcp 0.40 m (``--home-x``) in front of the
 axis, horizontal along +x (within ``--home-tolerance`` rad), 0.06 m above a 0.75 m table, clear of
 itself and of the table, as near as IK finds to the middle of the joint ranges.
+
+The robot on its plant, its IK program and the collision grades are ``Arm`` in ``reach_arm.py``
+beside this script; this script walks the grid, scores the maps and prints them.
 """
 
 from __future__ import annotations
 
 import argparse
-import itertools
 import math
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
-from pydrake.geometry import Box
-from pydrake.math import RigidTransform
-from pydrake.multibody.inverse_kinematics import InverseKinematics
-from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, CoulombFriction
-from pydrake.solvers import SnoptSolver
-from pydrake.systems.framework import DiagramBuilder
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))  # make_arms.py beside this script
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # make_arms.py and reach_arm.py beside it
 
 import make_arms
+from reach_arm import TABLE_EDGE, Arm
 
 TABLES = (0.70, 0.80)
 CLEARANCE = 0.06  # tcp above the table top
-ANGLE_TOLERANCE = 0.2  # rad: tcp z from world +x, tcp y from the horizontal
-POSITION_TOLERANCE = 1e-4  # m
 XS = np.round(np.arange(0.10, 1.2001, 0.05), 3)
 YS = np.round(np.arange(-0.70, 0.7001, 0.05), 3)
 HALF_DISC_X = 0.25
 SEEDS = 24  # attempts per point: neighbours' solutions, hand-picked postures, random ones
 SEEDS_NEAR, NEAR = 64, 0.45  # more attempts within NEAR of the axis, where the wrist folds over the base
-TABLE_EDGE = 0.20  # the table's front edge in front of the pedestal's axis, m
 TALL = 1.5  # the mount of the model the maps are computed on
 
-# Hand-picked postures of the arm (7 or 6 joints) near "gripper forward and horizontal".
-NOMINAL = {
-    "panda": [
-        (0.0, 0.3, 0.0, -2.0, 0.0, 2.3, 0.785),
-        (0.0, -0.3, 0.0, -2.6, 0.0, 3.5, 0.785),
-        (0.0, 0.9, 0.0, -1.0, 0.0, 1.9, 0.785),
-        (0.0, -0.6, 0.0, -2.8, 0.0, 2.2, -0.785),
-    ],
-    "iiwa14": [
-        (0.0, 0.6, 0.0, -1.4, 0.0, -0.8, 0.0),
-        (0.0, 1.2, 0.0, -0.6, 0.0, -0.8, 0.0),
-        (0.0, 0.0, 0.0, -2.0, 0.0, -0.5, 0.0),
-        (0.0, -0.4, 0.0, -1.9, 0.0, 0.9, 0.0),
-    ],
-    "ur5": [
-        (0.0, -0.9, 1.9, -1.0, 1.57, -1.57),
-        (0.0, -0.3, 0.6, -0.3, 1.57, -1.57),
-        (0.0, -1.6, 2.6, -1.0, 1.57, -1.57),
-        (0.0, -2.0, 2.4, -0.4, 1.57, -1.57),
-    ],
-}
-FLANGES = {"panda": "panda_flange", "iiwa14": "iiwa_flange", "ur5": "ur5_flange"}
 HOME_TARGET = (0.40, 0.0)  # tcp in front of the pedestal's axis for the ready configuration
 HOME_TABLE = 0.75
-
-
-class Arm:
-    """One robot on a continuous plant with its scene graph, for IK and collision checks."""
-
-    def __init__(
-        self,
-        name: str,
-        mount: float,
-        table_top: float | None = None,
-        angle_tolerance: float = ANGLE_TOLERANCE,
-    ) -> None:
-        """``name`` on a pedestal ``mount`` high (the mobile UR5 has its own riser); with
-        ``table_top``, a table top in front of the pedestal: its front edge ``TABLE_EDGE`` from the
-        pedestal's axis, its top ``table_top`` above the floor."""
-        self.name, self.angle_tolerance = name, angle_tolerance
-        builder = DiagramBuilder()
-        plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-        if name == "ur5":
-            from hlp_drake.systems.world.robot import ARM_JOINTS, ARM_MOUNT, add_robot
-
-            add_robot(plant)
-            self.axis = np.array(ARM_MOUNT[:2])
-            self.mount = ARM_MOUNT[2]
-            arm_joints = ARM_JOINTS
-        else:
-            from pydrake.multibody.parsing import Parser
-
-            text = make_arms.panda_urdf(mount) if name == "panda" else make_arms.iiwa14_urdf(mount)
-            Parser(plant).AddModelsFromString(text, "urdf")
-            plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(f"{name}_pedestal"))
-            self.axis = np.zeros(2)
-            self.mount = mount
-            spec = make_arms.PANDA_JOINTS if name == "panda" else make_arms.IIWA_JOINTS
-            arm_joints = tuple(joint[0] for joint in spec)
-        self.table = None
-        if table_top is not None:
-            size = (2.0, 4.0, 0.05)
-            centre = (self.axis[0] + TABLE_EDGE + size[0] / 2, self.axis[1], table_top - size[2] / 2)
-            self.table = plant.RegisterCollisionGeometry(
-                plant.world_body(), RigidTransform(centre), Box(*size), "table", CoulombFriction(0.5, 0.5)
-            )
-        plant.Finalize()
-        self.plant, self.scene_graph = plant, scene_graph
-        self.diagram = builder.Build()
-        self.context = self.diagram.CreateDefaultContext()
-        self.plant_context = plant.GetMyContextFromRoot(self.context)
-        self.sg_context = scene_graph.GetMyContextFromRoot(self.context)
-        joints = [plant.GetJointByName(n) for n in arm_joints]
-        self.arm_index = np.array([j.position_start() for j in joints])
-        self.lower = plant.GetPositionLowerLimits()
-        self.upper = plant.GetPositionUpperLimits()
-        # Everything but the arm is held: fingers open, the mobile base at the origin.
-        self.fixed = np.zeros(plant.num_positions())
-        for joint_index in plant.GetJointIndices():
-            joint = plant.get_joint(joint_index)
-            if joint.num_positions() == 1 and "finger" in joint.name():
-                self.fixed[joint.position_start()] = joint.position_upper_limits()[0]
-        self.tcp = plant.GetFrameByName("tcp")
-        self.ik = InverseKinematics(plant, self.plant_context, with_joint_limits=True)
-        q = self.ik.q()
-        free = np.zeros(plant.num_positions(), dtype=bool)
-        free[self.arm_index] = True
-        for i in np.flatnonzero(~free):
-            self.ik.prog().AddBoundingBoxConstraint(self.fixed[i], self.fixed[i], q[i])
-        world = plant.world_frame()
-        self.position = self.ik.AddPositionConstraint(
-            self.tcp, [0, 0, 0], world, [0, 0, 0], [0, 0, 0]
-        ).evaluator()
-        self.approach = self.ik.AddAngleBetweenVectorsConstraint(
-            self.tcp, [0, 0, 1], world, [1, 0, 0], 0.0, angle_tolerance
-        ).evaluator()
-        self.level = self.ik.AddAngleBetweenVectorsConstraint(
-            self.tcp,
-            [0, 1, 0],
-            world,
-            [0, 0, 1],
-            math.pi / 2 - angle_tolerance,
-            math.pi / 2 + angle_tolerance,
-        ).evaluator()
-        self.solver = SnoptSolver()
-        # A sure bound: the flange is at most the sum of the joint-to-joint distances from joint 1's
-        # origin (fixed to the base), and the tcp ``tool`` along its z from the flange.
-        plant.SetPositions(self.plant_context, self.fixed)
-        origins = [j.frame_on_child().CalcPoseInWorld(self.plant_context).translation() for j in joints]
-        flange = plant.GetFrameByName(FLANGES[name]).CalcPoseInWorld(self.plant_context).translation()
-        origins.append(flange)
-        self.start = origins[0]
-        self.stretch = sum(np.linalg.norm(b - a) for a, b in itertools.pairwise(origins))
-        self.tool = float(np.linalg.norm(self.tcp.CalcPoseInWorld(self.plant_context).translation() - flange))
-        self.rng = np.random.default_rng(0)
-        self.nominal = [np.array(n) for n in NOMINAL[name]]
-
-    def may_reach(self, p: np.ndarray) -> bool:
-        """False if ``p`` is surely out of reach with the tcp within ANGLE_TOLERANCE of +x."""
-        wrist = p - self.tool * np.array([1.0, 0.0, 0.0])
-        slack = 2.0 * self.tool * math.sin(ANGLE_TOLERANCE / 2.0) + 1e-3
-        return bool(np.linalg.norm(wrist - self.start) <= self.stretch + slack)
-
-    def full(self, q_arm: np.ndarray) -> np.ndarray:
-        q = self.fixed.copy()
-        q[self.arm_index] = q_arm
-        return q
-
-    def solve(self, p: np.ndarray, seed: np.ndarray) -> np.ndarray | None:
-        """Arm joints putting the tcp at world point ``p`` (horizontal, along +x), or None."""
-        self.position.set_bounds(p - POSITION_TOLERANCE, p + POSITION_TOLERANCE)
-        result = self.solver.Solve(self.ik.prog(), self.full(seed), None)
-        if not result.is_success():
-            return None
-        q = result.GetSolution(self.ik.q())
-        if not self.satisfied(q, p):
-            return None
-        return q[self.arm_index]
-
-    def satisfied(self, q: np.ndarray, p: np.ndarray) -> bool:
-        if np.any(q < self.lower - 1e-6) or np.any(q > self.upper + 1e-6):
-            return False
-        self.plant.SetPositions(self.plant_context, q)
-        X = self.tcp.CalcPoseInWorld(self.plant_context)
-        R = X.rotation().matrix()
-        tol = self.angle_tolerance
-        ok_pose = np.all(np.abs(X.translation() - p) <= POSITION_TOLERANCE + 1e-6)
-        # Cosines, as the constraints hold them (to the solver's feasibility tolerance).
-        ok_approach = R[0, 2] >= math.cos(tol) - 1e-6  # tcp z . world x
-        ok_level = abs(R[2, 1]) <= math.sin(tol) + 1e-6  # tcp y . world z
-        return bool(ok_pose and ok_approach and ok_level)
-
-    def grade(self, q_arm: np.ndarray) -> int:
-        """2 if the robot at ``q_arm`` touches neither itself (arm, gripper, pedestal) nor the table,
-        1 if it touches the table only, 0 if it collides with itself."""
-        self.plant.SetPositions(self.plant_context, self.full(q_arm))
-        query = self.scene_graph.get_query_output_port().Eval(self.sg_context)
-        pairs = query.ComputePointPairPenetration()
-        if any(self.table not in (pair.id_A, pair.id_B) for pair in pairs):
-            return 0
-        return 1 if pairs else 2
-
-    def random_seed(self) -> np.ndarray:
-        lo, hi = self.lower[self.arm_index], self.upper[self.arm_index]
-        lo, hi = np.maximum(lo, -math.pi), np.minimum(hi, math.pi)
-        return self.rng.uniform(lo, hi)
 
 
 Grades = dict[tuple[int, int], int]

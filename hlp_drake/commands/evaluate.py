@@ -23,7 +23,7 @@ from functools import partial
 
 from tqdm import tqdm
 
-from hlp_drake.commands.parsing import MAX_SEED, MAX_WORKERS, add_quiet, integer, make_parser
+from hlp_drake.commands.parsing import MAX_SEED, MAX_WORKERS, Parser, add_quiet, integer, make_parser
 from hlp_drake.dataset.dataset import Dataset
 from hlp_drake.dataset.records import STRUCTURED, UNSTRUCTURED, category_of
 from hlp_drake.errors import HlpError
@@ -81,7 +81,8 @@ def _jobs(
     ]
 
 
-def main(argv: Sequence[str] | None = None) -> int:
+def _parser() -> Parser:
+    """The command line of ``python -m hlp_drake.evaluate``."""
     parser = make_parser("python -m hlp_drake.evaluate", __doc__)
     parser.add_argument("--dataset", help="the dataset: archives or folders (default: $HLP_DATASET)")
     parser.add_argument("--protocol", choices=PROTOCOLS, default="80_20")
@@ -119,6 +120,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         "--workers", type=integer(1, MAX_WORKERS), help="parallel splits (default: one per core)"
     )
     add_quiet(parser)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = _parser()
     args = parser.parse_args(argv)
     if args.splits < 1 or args.folds < 2:
         parser.error("--splits must be at least 1 and --folds at least 2")

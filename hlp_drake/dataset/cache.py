@@ -195,46 +195,7 @@ def _trial_entry(
     if files is None:
         collector.problem(folder, f"listed in {RESULTS_FILE} but its folder is missing")
         return None
-    missing = [
-        f"{folder}/scene/{name}_T{number:03d}.csv"
-        for field, name in (("scene_layout", "scene_layout"), ("objects_layout", "grid_objects_layout"))
-        if field not in files
-    ]
-    if "interactions" not in files:
-        missing.append(f"{folder}/movement/interaction_log_T{number:03d}.csv")
-    if "objects_layout" in files:
-        tracks = files.get("tracks", {})
-        missing += [
-            f"{folder}/movement/{name}_movement_T{number:03d}.csv"
-            for name in [*TRACKERS, *(r[0] for r in files["objects_layout"])]
-            if name not in tracks
-        ]
-    if missing:
-        for path in missing:
-            collector.problem(path, "missing: trial skipped")
-        return None
-    start_time, end_time = times[0], times[1]
-    short_tracks = [
-        (name, first, last)
-        for name, (first, last) in files["track_times"].items()
-        if (start_time is not None and first > start_time + COVERAGE_TOLERANCE)
-        or (end_time is not None and last < end_time - COVERAGE_TOLERANCE)
-    ]
-    for name, first, last in short_tracks:
-        collector.problem(
-            f"{folder}/movement/{name}_movement_T{number:03d}.csv",
-            f"truncated: the track spans {first:.3f}-{last:.3f} s, the trial "
-            f"{start_time}-{end_time} s ({RESULTS_FILE}): trial skipped",
-        )
-    if short_tracks:
-        return None
-    strangers = _strangers(files["interactions"], files["objects_layout"])
-    if strangers:
-        line, name = strangers[0]
-        collector.problem(
-            f"{folder}/movement/interaction_log_T{number:03d}.csv",
-            f"line {line}: names {short(name, 40)!r}, which the scene does not have: trial skipped",
-        )
+    if not _complete(collector, folder, number, files, times):
         return None
     try:
         start_x = optional_float(row.get("start_pos_x"))
@@ -263,6 +224,56 @@ def _trial_entry(
         "tracks": files["tracks"],
         "interactions": files["interactions"],
     }
+
+
+def _complete(
+    collector: _Collector, folder: str, number: int, files: dict[str, Any], times: list[float | None]
+) -> bool:
+    """Whether a trial's files are all there, its tracks span the trial and its interaction log names
+    only the scene's objects; if not, the problems say what is wrong (every missing file or short
+    track, the first stranger)."""
+    missing = [
+        f"{folder}/scene/{name}_T{number:03d}.csv"
+        for field, name in (("scene_layout", "scene_layout"), ("objects_layout", "grid_objects_layout"))
+        if field not in files
+    ]
+    if "interactions" not in files:
+        missing.append(f"{folder}/movement/interaction_log_T{number:03d}.csv")
+    if "objects_layout" in files:
+        tracks = files.get("tracks", {})
+        missing += [
+            f"{folder}/movement/{name}_movement_T{number:03d}.csv"
+            for name in [*TRACKERS, *(r[0] for r in files["objects_layout"])]
+            if name not in tracks
+        ]
+    if missing:
+        for path in missing:
+            collector.problem(path, "missing: trial skipped")
+        return False
+    start_time, end_time = times[0], times[1]
+    short_tracks = [
+        (name, first, last)
+        for name, (first, last) in files["track_times"].items()
+        if (start_time is not None and first > start_time + COVERAGE_TOLERANCE)
+        or (end_time is not None and last < end_time - COVERAGE_TOLERANCE)
+    ]
+    for name, first, last in short_tracks:
+        collector.problem(
+            f"{folder}/movement/{name}_movement_T{number:03d}.csv",
+            f"truncated: the track spans {first:.3f}-{last:.3f} s, the trial "
+            f"{start_time}-{end_time} s ({RESULTS_FILE}): trial skipped",
+        )
+    if short_tracks:
+        return False
+    strangers = _strangers(files["interactions"], files["objects_layout"])
+    if strangers:
+        line, name = strangers[0]
+        collector.problem(
+            f"{folder}/movement/interaction_log_T{number:03d}.csv",
+            f"line {line}: names {short(name, 40)!r}, which the scene does not have: trial skipped",
+        )
+        return False
+    return True
 
 
 def _strangers(interactions: list[list], objects_layout: list[list]) -> list[tuple[int, str]]:

@@ -20,6 +20,7 @@ from typing import NoReturn
 
 from hlp_drake import DRAKE_LOG, __version__
 from hlp_drake.errors import HlpError
+from hlp_drake.models import SHIPPED_ROBOTS
 from hlp_drake.runtime.processes import Terminated, terminations_raised
 
 EXIT_USER_ERROR = 2
@@ -131,8 +132,31 @@ def drake_logging(verbose: bool) -> None:
     logging.getLogger("drake").setLevel(logging.INFO if verbose else logging.WARNING)
 
 
-SHIPPED_ROBOTS = ("mobile_ur5", "panda", "iiwa14")
-"""The robots the project ships (``hlp_drake/models/robot/NAME.yaml``; ``hlp_drake.systems.load_robot``)."""
+def add_planner_options(parser: argparse.ArgumentParser, *, several: bool = False) -> None:
+    """``--planner`` (the initialiser; ``sto`` is accepted for ``line``) and ``--low-level`` (the
+    low-level planner), from their registries; ``several``: each takes a list (an experiment's grid)."""
+    from hlp_drake.systems.low_level.registry import LOW_LEVEL_PLANNERS
+    from hlp_drake.systems.planning.initialisers import ALIASES, INITIALISERS
+
+    many = {"nargs": "+"} if several else {}
+    aliases = ", ".join(f"{alias}: {name}" for alias, name in ALIASES.items())
+    parser.add_argument(
+        "--planner",
+        choices=(*INITIALISERS, *ALIASES),
+        metavar="|".join((*INITIALISERS, *ALIASES)),
+        help="the initialiser: the human-like plan (hlp, the default) or the baseline's straight line "
+        f"(line; {aliases}, the paper's name of the baseline)",
+        **many,
+    )
+    parser.add_argument(
+        "--low-level",
+        choices=tuple(LOW_LEVEL_PLANNERS),
+        metavar="|".join(LOW_LEVEL_PLANNERS),
+        help="the low-level planner that turns the initialiser's plan into the robot's motion: "
+        + "; ".join(f"{name}, {entry.about}" for name, entry in LOW_LEVEL_PLANNERS.items())
+        + " (default: the scenario's, sto)",
+        **many,
+    )
 
 
 def add_robot_option(parser: argparse.ArgumentParser) -> None:

@@ -1,18 +1,21 @@
-"""Plan a scene with the human-like planner (or the straight line), optimise it with the STO and run it in Drake.
+"""Plan a scene with the human-like planner (or the straight line), turn the plan into a motion with the STO and run it in Drake.
 
     python -m hlp_drake.run_scene [--scene FILE | --kind vr|gen1|gen2|unstructured --seed N [--objects K]]
-        [--planner hlp|sto] [--perception truth|camera] [--config SCENARIO.yaml] [--workers N]
-        [--meshcat] [--html FILE] [--contact-forces] [--execution open|closed] [--uncertainty [SEED]]
-        [--json FILE] [--quiet | --verbose]
+        [--planner hlp|line] [--low-level sto] [--perception truth|camera] [--config SCENARIO.yaml]
+        [--workers N] [--meshcat] [--html FILE] [--contact-forces] [--execution open|closed]
+        [--uncertainty [SEED]] [--json FILE] [--quiet | --verbose]
 
-With no arguments it runs the bundled default scene with the bundled models. With --perception camera
-the planner, IK and optimiser work on the scene the world's cameras see (ScenePerception) while the
-simulation runs the true one; the plan names each perceived object by the true one it was matched
-to, the perceived name beside, and the JSON's perception record compares the two scenes. A header
-says what runs (the scene; the robot, planner, execution mode, model error, perception source and
-scenario file), each stage is printed as it happens (plan, IK, the optimiser's rollouts, the
-execution's simulated time), then a summary ending in one verdict line: the paper's reach success
-(the target in the gripper's pre-grasp region, no object off the table), the grasp beside it.
+With no arguments it runs the bundled default scene with the bundled models. --planner picks the
+initialiser (hlp: the human-like plan; line, also accepted as sto: the straight line of the paper's
+baseline) and --low-level the planner that turns it into the robot's motion. With --perception camera
+the initialiser, IK and low-level planner work on the scene the world's cameras see
+(ScenePerception) while the simulation runs the true one; the plan names each perceived object by
+the true one it was matched to, the perceived name beside, and the JSON's perception record compares
+the two scenes. A header says what runs (the scene; the robot, initialiser, low-level planner,
+execution mode, model error, perception source and scenario file), each stage is printed as it
+happens (plan, IK, the optimiser's rollouts, the execution's simulated time), then a summary ending
+in one verdict line: the paper's reach success (the target in the gripper's pre-grasp region, no
+object off the table), the grasp beside it.
 
 Exit status: 0 when the reach succeeded, whether or not the grasp then held (the grasp is reported,
 not part of success); 1 when it failed (the verdict line says why); 2 on bad input; 130 when
@@ -27,13 +30,13 @@ import os
 import sys
 import time
 from collections.abc import Sequence
-from dataclasses import replace
 
 from hlp_drake.commands.parsing import (
     MAX_SEED,
     MAX_WORKERS,
     add_conditions,
     add_perception,
+    add_planner_options,
     add_robot_option,
     add_verbosity,
     drake_logging,
@@ -132,12 +135,7 @@ def _parser():
         metavar="K",
         help="number of obstacles of the generated scene (with --kind gen2 or unstructured)",
     )
-    parser.add_argument(
-        "--planner",
-        choices=("hlp", "sto"),
-        help="initialise the optimiser with the human-like plan (hlp, the default) or the "
-        "baseline's straight line (sto)",
-    )
+    add_planner_options(parser)
     add_perception(parser)
     add_robot_option(parser)
     parser.add_argument(
@@ -149,7 +147,7 @@ def _parser():
         "--workers",
         type=integer(1, MAX_WORKERS),
         metavar="N",
-        help="rollout processes (default: the scenario's, 2)",
+        help="rollout processes of a low-level planner that rolls out (default: the scenario's, 2)",
     )
     parser.add_argument(
         "--meshcat", action="store_true", help="show the run live in MeshCat (prints the URL)"
@@ -169,6 +167,28 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.kind is None and (args.seed is not None or args.objects is not None):
         parser.error("--seed and --objects describe a generated scene: give its --kind too")
     check_writable(args.json, args.html)
+    scenario = _scenario(args)
+    from hlp_drake.systems.execution.result import what_ran
+
+    ran = what_ran(scenario, args.config)
+    _print(f"run: {ran.line()}")
+    result, meshcat = _run(scenario, args, started)
+    print(summary(result, ran))
+    _write(args, scenario, result, ran, meshcat)
+    if args.meshcat:
+        print(f"done in {time.perf_counter() - started:.1f} s; MeshCat keeps serving until you press Ctrl-C")
+        try:
+            while True:
+                time.sleep(1.0)
+        except KeyboardInterrupt:
+            pass
+    return exit_status(result)
+
+
+def _scenario(args):
+    """The run's scenario: ``--config`` (the defaults without it) under the flags' ``Conditions``, on
+    ``--scene``, a scene generated for the robot (``--kind``), the bundled default scene or the
+    scenario's own; the scene is named as soon as it is known."""
     from hlp_drake.scene.generators import generate_scene  # numpy and shapely: once the arguments are good
     from hlp_drake.scene.io import load_scene
 
@@ -176,34 +196,33 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.kind is None and (args.scene is not None or args.config is None):
         scene = load_scene(args.scene or DEFAULT_SCENE)
         _print(f"scene {scene.name}: {len(scene.obstacles)} obstacles")
-
     drake_logging(args.verbose)  # Drake is imported from here on
-    from hlp_drake.systems.scenario import load_scenario, with_conditions
+    from hlp_drake.systems.conditions import Conditions
+    from hlp_drake.systems.scenario import load_scenario
+    from hlp_drake.systems.world.robot_description import load_robot
 
-    scenario = with_conditions(load_scenario(args.config), robot=args.robot)
+    base = load_scenario(args.config)
     if args.kind is not None:  # generated for the robot: a fixed one's table within its reach
-        scene = generate_scene(args.kind, args.seed or 0, args.objects, scenario.robot.workspace)
+        robot = base.robot if args.robot is None else load_robot(args.robot)
+        scene = generate_scene(args.kind, args.seed or 0, args.objects, robot.workspace)
         _print(f"scene {scene.name}: {len(scene.obstacles)} obstacles")
-    scenario = replace(
-        scenario,
-        scene=scene or scenario.scene,
-        planner=replace(scenario.planner, kind=args.planner or scenario.planner.kind),
-        optimiser=replace(scenario.optimiser, workers=args.workers or scenario.optimiser.workers),
-    )
-    scenario = with_conditions(
-        scenario,
+    conditions = Conditions(
+        robot=args.robot,
+        initial=args.planner,
+        low_level=args.low_level,
         execution=args.execution,
         uncertainty=args.uncertainty,
         perception=args.perception,
+        workers=args.workers,
     )
+    scenario = conditions.applied(base, scene=scene)
     if scene is None:
         _print(f"scene {scenario.scene.name}: {len(scenario.scene.obstacles)} obstacles")
-    from hlp_drake.systems.execution.result import what_ran
+    return scenario
 
-    ran = what_ran(scenario, args.config)
-    _print(f"run: {ran.line()}")
-    result, meshcat = _run(scenario, args, started)
-    print(summary(result, ran))
+
+def _write(args, scenario, result, ran, meshcat) -> None:
+    """Write the recording (``--html``) and the result (``--json``)."""
     if args.html:
         from hlp_drake.systems.execution.meshcat_view import with_legend
 
@@ -214,14 +233,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.json:
         write_text_atomic(args.json, json.dumps({**ran.to_dict(), **result.to_dict()}, indent=2) + "\n")
         print(f"wrote {args.json}")
-    if args.meshcat:
-        print(f"done in {time.perf_counter() - started:.1f} s; MeshCat keeps serving until you press Ctrl-C")
-        try:
-            while True:
-                time.sleep(1.0)
-        except KeyboardInterrupt:
-            pass
-    return exit_status(result)
 
 
 def _print(line: str) -> None:
@@ -250,8 +261,10 @@ def _meshcat():
 
 
 def _run(scenario, args, started: float):
-    """Plan and execute ``scenario`` on a rollout pool of its own, the stages printed as they come."""
+    """Plan and execute ``scenario`` (on a rollout pool of its own if its low-level planner rolls
+    out), the stages printed as they come."""
     from hlp_drake.commands.progress import ProgressListener
+    from hlp_drake.systems.conditions import rollout_workers
     from hlp_drake.systems.execution.run import plan_and_execute
     from hlp_drake.systems.low_level.sto.pool import RolloutPool
 
@@ -259,16 +272,18 @@ def _run(scenario, args, started: float):
     if args.meshcat:
         _print(f"MeshCat: {meshcat.web_url()}")
     listener = ProgressListener(quiet=args.quiet, stream=sys.stderr)
-    workers = scenario.optimiser.workers
-    if workers > 1:
+    workers = rollout_workers(scenario)
+    if workers is not None and workers > 1:
         _print(f"rollout workers: {workers}, started when a batch of rollouts needs them")
-    with (
-        contextlib.closing(listener),
-        RolloutPool(workers, on_rollout=listener.rollout, on_warning=listener.warning) as pool,
-    ):
+    pool = (
+        contextlib.nullcontext()
+        if workers is None
+        else RolloutPool(workers, on_rollout=listener.rollout, on_warning=listener.warning)
+    )
+    with contextlib.closing(listener), pool:
         result = plan_and_execute(
             scenario,
-            pool=pool,
+            pool=pool if workers is not None else None,
             meshcat=meshcat,
             contact_forces=args.contact_forces,
             listener=listener,

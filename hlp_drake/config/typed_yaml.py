@@ -1,8 +1,10 @@
 """Typed YAML documents: frozen dataclass schemas, every problem located on its own line.
 
 A schema is a frozen dataclass whose fields are floats, ints, bools, strings, ``Literal`` strings,
-tuples (``tuple[float, float]`` of a fixed length or ``tuple[X, ...]``), ``X | None``, other schemas
-or Drake's bound config structs (e.g. ``MultibodyPlantConfig``).
+tuples (``tuple[float, float]`` of a fixed length or ``tuple[X, ...]``), ``X | None``, other schemas,
+tagged unions (a schema with a class method ``variants()``: its subclasses by the name its ``TAG``
+field holds, e.g. ``planner.low_level: {kind: sto, ...}``) or Drake's bound config structs (e.g.
+``MultibodyPlantConfig``).
 
 A document (``hlp_drake.files.documents.parse_yaml``: limits on size, depth, aliases, duplicate keys) is
 checked against the schema first, every problem reported at its place, one line each
@@ -51,7 +53,8 @@ def _is_drake_struct(kind: Any) -> bool:
 def _fields(kind: type) -> dict[str, Any]:
     """The field types of a schema (string annotations resolved) or of a Drake struct."""
     if _is_schema(kind):
-        return typing.get_type_hints(kind)
+        hints = typing.get_type_hints(kind)
+        return {f.name: hints[f.name] for f in dataclasses.fields(kind)}  # no ClassVar
     return {f.name: f.type for f in kind.__fields__}
 
 
@@ -65,6 +68,13 @@ def _required(kind: type) -> list[str]:
         for f in dataclasses.fields(kind)
         if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
     ]
+
+
+def _variants(kind: Any) -> dict[str, type] | None:
+    """The variants of a tagged union (a schema that defines a ``variants()`` class method: its
+    subclasses, which inherit it, by the name its ``TAG`` field holds), else None."""
+    variants = getattr(kind, "variants", None) if _is_schema(kind) and "variants" in vars(kind) else None
+    return dict(variants()) if callable(variants) else None
 
 
 @functools.cache
@@ -122,16 +132,53 @@ def join_path(where: str, name: str) -> str:
     return f"{where}.{name}" if where else name
 
 
-def document_problems(schema: Any, value: Any, where: str = "", *, top: str = "document") -> list[str]:
+def _variant_problems(
+    base: type, variants: dict[str, type], value: Any, default: Any, label: str
+) -> tuple[type | None, list[str]]:
+    """(the variant of the tagged union ``base`` that ``value`` names, or its ``default``'s; the
+    problems of the tag and of fields that belong to other variants)."""
+    if not isinstance(value, dict):
+        return None, [f"{label}: expected a mapping, got {type(value).__name__}"]
+    tag = base.TAG
+    name = value.get(tag, getattr(default, tag, None))
+    known = ", ".join(variants)
+    if name not in variants:
+        given = f"unknown {base.NOUN} {name!r}" if name is not None else f"missing field {tag!r}"
+        return None, [f"{label}.{tag}: {given} (known: {known})"]
+    kind, problems = variants[name], []
+    own = _fields(kind)
+    for key in value:
+        owners = [other for other, cls in variants.items() if key in _fields(cls)]
+        if key not in own and owners:
+            settings = ", ".join(n for n in own if n != tag)
+            problems.append(
+                f"{label}: {key!r} is a setting of {' and '.join(owners)}, not of {name} "
+                f"({name}'s settings: {settings}; {base.NOUN}s: {known})"
+            )
+    return kind, problems
+
+
+def document_problems(
+    schema: Any, value: Any, where: str = "", *, top: str = "document", default: Any = None
+) -> list[str]:
     """Every place where the parsed YAML ``value`` does not fit ``schema``, one message each.
 
     Args:
         where: the path of ``value`` in the document ("" at the top, where ``top`` names it).
+        default: what ``value`` is read over (None: the class defaults); a tagged union's variant is
+            the one ``value`` names, else its default's.
     """
     label = where or top
     inner = _optional(schema)
     if inner is not None:
         return [] if value is None else document_problems(inner, value, where, top=top)
+    variants = _variants(schema)
+    if variants is not None:
+        kind, problems = _variant_problems(schema, variants, value, default, label)
+        if kind is None or problems:
+            return problems
+        same = default if type(default) is kind else None
+        return document_problems(kind, value, where, top=top, default=same)
     items = _tuple_items(schema)
     if items is not None:
         item, length = items
@@ -148,9 +195,11 @@ def document_problems(schema: Any, value: Any, where: str = "", *, top: str = "d
         hints = _fields(schema)
         problems = [f"{label}: unknown field {key!r}" for key in value if key not in hints]
         problems += [f"{label}: missing field {name!r}" for name in _required(schema) if name not in value]
+        merged = default is not None and not _required(schema)
         for name, sub in value.items():
             if name in hints:
-                problems += document_problems(hints[name], sub, join_path(where, name), top=top)
+                below = getattr(default, name, None) if merged else None
+                problems += document_problems(hints[name], sub, join_path(where, name), top=top, default=below)
         return problems
     problem = _scalar_problem(schema, value)
     return [] if problem is None else [f"{label}: {problem}"]
@@ -173,6 +222,10 @@ def _read(kind: Any, default: Any, value: Any) -> Any:
         return yaml_load_typed(schema=kind, data=yaml.safe_dump(value), defaults=default)
     if not _is_schema(kind):
         return float(value) if kind is float else value
+    variants = _variants(kind)
+    if variants is not None:
+        chosen = variants[value.get(kind.TAG, getattr(default, kind.TAG, None))]
+        return _read(chosen, default if type(default) is chosen else None, value)
     hints = _fields(kind)
     if default is None or _required(kind):
         return kind(**{name: _read(hints[name], None, v) for name, v in value.items()})
@@ -205,7 +258,7 @@ def load_typed(
     if document is None and defaults is not None:
         return defaults
     prefix = f"{where}: " if where else ""
-    problems = document_problems(schema, document, top=top)
+    problems = document_problems(schema, document, top=top, default=defaults)
     if problems:
         raise error(*(prefix + p for p in problems))
     return _read(schema, defaults, document)
@@ -220,6 +273,8 @@ def _plain(kind: Any, value: Any) -> Any:
     items = _tuple_items(kind)
     if items is not None:
         return [_plain(items[0], v) for v in value]
+    if _variants(kind) is not None:
+        kind = type(value)  # a tagged union's variant
     if _is_schema(kind) or _is_drake_struct(kind):
         data = {}
         for name, hint in _fields(kind).items():

@@ -1,8 +1,10 @@
 """``Scenario``: one typed description of a run, the argument of every builder in ``hlp_drake.systems``.
 
-A frozen dataclass tree (the pattern of manipulation's ``Scenario``): the scene, the planner, the
-plant and contact settings, how the scene becomes bodies, the robot's controller, keypoint IK,
-motion timing, the push transfer's margins, the optimiser and the grasp. Each section is a config
+A frozen dataclass tree (the pattern of manipulation's ``Scenario``): the scene, the planner (the
+initialiser and the low-level planner), the plant and contact settings, how the scene becomes
+bodies, the robot's controller, keypoint IK, motion timing, the push transfer's margins and the
+grasp. Only the top-level builders read it whole (``make_world_diagram``, ``make_planning_diagram``,
+``make_execution_diagram``, the experiments' job); each block takes its own sections. Each section is a config
 dataclass beside the code that uses it, each field with its range (``hlp_drake.config.ranges``). Loaded
 by ``load_scenario`` (``hlp_drake.config.typed_yaml``; problems are located one-line errors), it is passed to
 the builders at construction. A ``Scenario`` is checked once, when it is made (in Python too, and by
@@ -15,11 +17,16 @@ whole)::
     scene: {name: mine, table: {length: 0.9, width: 0.8, height: 0.75}, start: [0.1, 0.0],
             target: {name: Target, shape: cylinder, x: 0.7, y: 0.0, size: [0.06, 0.06, 0.12]},
             obstacles: []}
-    planner: {kind: hlp}            # hlp (human-like) or sto (the straight line of the STO baseline)
+    planner:                        # the initialiser and the low-level planner
+      initial: hlp                  # hlp (human-like) or line (the straight line; sto: its alias)
+      low_level: {kind: sto, samples: 8, max_iterations: 20}   # the STO's settings
     robot: {name: panda, ...}       # the robot (RobotDescription; --robot NAME reads a shipped one)
     plant: {time_step: 0.01}        # Drake's MultibodyPlantConfig
     controller: {arm: {kp: 2000.0, kd: 150.0}}
-    optimiser: {samples: 8, max_iterations: 20}
+
+The former spellings ``planner: {kind: ...}`` and ``optimiser: {...}`` are read as
+``planner.initial`` and ``planner.low_level`` (its ``alternatives``: ``planner.alternatives``; its
+``settle_s`` and ``cost.pregrasp_margin``: ``success``): ``legacy``.
 """
 
 from __future__ import annotations
@@ -29,11 +36,11 @@ import hashlib
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Any
 
 from pydrake.multibody.plant import MultibodyPlantConfig
 
-from hlp_drake.config.ranges import config_problems
+from hlp_drake.config.ranges import Count, Rule, config_problems
 from hlp_drake.config.typed_yaml import dump_typed, load_typed
 from hlp_drake.errors import HlpError
 from hlp_drake.files.documents import parse_yaml, read_document
@@ -42,21 +49,23 @@ from hlp_drake.scene.io import default_scene
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.validation import scene_problems
 from hlp_drake.systems.execution.command import GraspConfig
+from hlp_drake.systems.low_level.protocol import LowLevelConfig
 from hlp_drake.systems.low_level.sto.config import ClosedLoopConfig, StoConfig
 from hlp_drake.systems.perception.cameras import MAX_CAMERAS, PerceptionConfig, camera_pose
-from hlp_drake.systems.planning.ik import IkConfig, MotionConfig
+from hlp_drake.systems.planning.config import DEFAULT_ALTERNATIVES, IkConfig, MotionConfig
+from hlp_drake.systems.planning.initialisers import ALIASES, INITIALISERS
+from hlp_drake.systems.world.model import WorldModel
 from hlp_drake.systems.world.robot_description import (
     MOBILE_UR5,
     RobotDescription,
-    load_robot,
     with_model_beside,
 )
 from hlp_drake.systems.world.scene_models import BodiesConfig, ContactConfig
+from hlp_drake.systems.world.success import SuccessConfig
 from hlp_drake.systems.world.uncertainty import UncertaintyConfig
-from hlp_drake.systems.world.world import PLANT_RANGES, ControlConfig, default_plant_config
+from hlp_drake.systems.world.world_config import PLANT_RANGES, ControlConfig, default_plant_config
 from hlp_drake.transfer.rules import TransferConfig
 
-PLANNERS = ("hlp", "sto")
 MAX_WORLD_OBSTACLES = 100
 """Most obstacles in a simulated world (the planner alone, ``hlp_drake.planner.plan``, takes a scene's
 10,000): 100 on a 2 m table took 0.6 GB and 2 min to plan, verify and execute here; 400, 2.7 GB and
@@ -65,13 +74,25 @@ _LOADING = contextvars.ContextVar("loading", default=False)
 """True while ``load_scenario`` lays sources over each other: it checks the result once, naming them."""
 
 
+INITIAL = Rule(
+    lambda v: v in INITIALISERS, f"{{where}} must be one of {', '.join(INITIALISERS)}, got {{value!r}}"
+)
+
+
 @dataclass(frozen=True)
 class PlannerChoiceConfig:
-    """Which plan initialises the optimiser.
+    """The initialiser and the low-level planner.
 
     Attributes:
-        kind: "hlp" (the human-like planner) or "sto" (the straight line of the baseline STO); the
-            optimiser and its settings are the same for both.
+        initial: the initialiser, the low-level planner's start (``INITIALISERS``): "hlp" (the
+            human-like planner) or "line" (the straight line of the paper's STO baseline).
+        low_level: the low-level planner's settings, its name in ``kind`` (``LOW_LEVEL_PLANNERS``;
+            default: the STO's).
+        alternatives: when the plan's first motion fails (its IK, or the low-level planner's first
+            rollout), its next this many distinct candidate plans may take its place (the HLP's, by
+            expected arm collision; the straight line has none): the first whose IK succeeds
+            replaces a plan whose IK failed (``KeypointIk``), and the STO rolls each out once and
+            goes on from the best (0: never).
         models: a directory of trained decision models (``python -m hlp_drake.train --out DIR``);
             "" for the bundled ones.
         models_sha256: the SHA-256 of the trusted ``models.json`` in ``models``
@@ -80,7 +101,9 @@ class PlannerChoiceConfig:
         hlp: the human-like planner's settings.
     """
 
-    kind: Literal["hlp", "sto"] = "hlp"
+    initial: Annotated[str, INITIAL] = "hlp"
+    low_level: LowLevelConfig = field(default_factory=StoConfig)
+    alternatives: Annotated[int, Count(0, 100)] = DEFAULT_ALTERNATIVES
     models: str = ""
     models_sha256: str = ""
     hlp: PlannerConfig = field(default_factory=PlannerConfig)
@@ -94,7 +117,7 @@ class Scenario:
 
     Attributes:
         scene: the table, start, target and obstacles (default: the bundled default scene).
-        planner: the planner and its settings.
+        planner: the initialiser, the low-level planner and their settings.
         robot: the robot (``RobotDescription``; default the mobile UR5).
         plant: Drake's plant settings; ``time_step`` > 0 and a SAP contact approximation ("sap",
             "lagged", "similar"), which the robot's mimic finger needs.
@@ -104,11 +127,13 @@ class Scenario:
         ik: keypoint inverse kinematics and the start pose.
         motion: the timing of the joint trajectory through the keyframes.
         transfer: the push transfer's margins (the robot's sizes come from its model).
-        optimiser: the stochastic trajectory optimiser.
+        success: the paper's success test of a reach (the planners' that simulate, and the
+            execution's).
         grasp: the grasp and lift after the reach.
         perception: where the planning blocks' scene comes from (the plant, or the cameras through
             ``ScenePerception``), the world's cameras and the perception block's settings.
-        closed_loop: the receding-horizon controller of ``--execution closed``.
+        closed_loop: the receding-horizon controller of ``--execution closed`` (a low-level planner
+            that re-plans, the STO).
         uncertainty: the seeded model error of ``--uncertainty`` (``model_error``).
     """
 
@@ -122,7 +147,7 @@ class Scenario:
     ik: IkConfig = field(default_factory=IkConfig)
     motion: MotionConfig = field(default_factory=MotionConfig)
     transfer: TransferConfig = field(default_factory=TransferConfig)
-    optimiser: StoConfig = field(default_factory=StoConfig)
+    success: SuccessConfig = field(default_factory=SuccessConfig)
     grasp: GraspConfig = field(default_factory=GraspConfig)
     perception: PerceptionConfig = field(default_factory=PerceptionConfig)
     closed_loop: ClosedLoopConfig = field(default_factory=ClosedLoopConfig)
@@ -165,6 +190,17 @@ class Scenario:
         return problems
 
     @cached_property
+    def world_model(self) -> WorldModel:
+        """What its world is made of besides the scene: the robot, plant, contact, bodies, controller
+        and start pose (``ik``) sections (computed once)."""
+        return WorldModel(self.robot, self.plant, self.contact, self.bodies, self.controller, self.ik)
+
+    @property
+    def low_level(self) -> LowLevelConfig:
+        """The low-level planner's settings (``planner.low_level``)."""
+        return self.planner.low_level
+
+    @cached_property
     def yaml(self) -> str:
         """The scenario as YAML text that ``load_scenario(data=...)`` reads back (computed once)."""
         return dump_typed(self)
@@ -177,6 +213,60 @@ class Scenario:
     def updated(self, data: str, *, where: str = "overrides") -> Scenario:
         """This scenario with the YAML text ``data`` laid over it (see ``load_scenario``)."""
         return load_scenario(data=data, defaults=self, where=where)
+
+
+def legacy(document: Any, where: str) -> Any:
+    """``document`` (a parsed scenario) with its former spellings in their places: ``optimiser: {...}``
+    is ``planner.low_level: {kind: sto, ...}`` (its ``alternatives``: ``planner.alternatives``),
+    ``planner.kind`` is ``planner.initial``, and the initialiser ``sto`` is ``line`` (``ALIASES``).
+
+    Raises:
+        HlpError: a setting given in both spellings (one line, naming ``where``).
+    """
+    if not isinstance(document, dict) or not isinstance(document.get("planner", {}), dict):
+        return document  # the typed check says what is wrong
+    document, planner = dict(document), dict(document.get("planner") or {})
+
+    def move(section: dict, old: str, new: str, value: Any) -> None:
+        if new in section:
+            raise HlpError(f"{where}: planner.{new} is given twice (once by its former name, {old})")
+        section[new] = value
+
+    if "kind" in planner:
+        move(planner, "planner.kind", "initial", planner.pop("kind"))
+    if isinstance(planner.get("initial"), str):
+        planner["initial"] = ALIASES.get(planner["initial"], planner["initial"])
+    if "optimiser" in document:
+        optimiser = document.pop("optimiser")
+        if isinstance(optimiser, dict):
+            optimiser = dict(optimiser)
+            if "alternatives" in optimiser:
+                move(planner, "optimiser.alternatives", "alternatives", optimiser.pop("alternatives"))
+            document = _moved_success(document, optimiser, where)
+            optimiser = {"kind": "sto", **optimiser}
+        move(planner, "optimiser", "low_level", optimiser)
+    if planner or "planner" in document:
+        document["planner"] = planner
+    return document
+
+
+def _moved_success(document: dict, optimiser: dict, where: str) -> dict:
+    """``document`` with the success test's settings of the former ``optimiser`` section
+    (``settle_s``, ``cost.pregrasp_margin``, taken out of ``optimiser``) in ``success``."""
+    moved = {}
+    if "settle_s" in optimiser:
+        moved["settle_s"] = optimiser.pop("settle_s")
+    cost = optimiser.get("cost")
+    if isinstance(cost, dict) and "pregrasp_margin" in cost:
+        cost = dict(cost)
+        moved["pregrasp_margin"] = cost.pop("pregrasp_margin")
+        optimiser["cost"] = cost
+    if not moved:
+        return document
+    success = document.get("success") or {}
+    if not isinstance(success, dict) or set(moved) & set(success):
+        raise HlpError(f"{where}: success.{next(iter(moved))} is given twice (once in the former optimiser)")
+    return {**document, "success": {**success, **moved}}
 
 
 def load_scenario(
@@ -205,7 +295,7 @@ def load_scenario(
     try:
         scenario = Scenario() if defaults is None else defaults
         for name, text in sources:
-            document = parse_yaml(text, name)
+            document = legacy(parse_yaml(text, name), name)
             scenario = load_typed(Scenario, document, defaults=scenario, where=name, top="scenario")
             if filename is not None and name == str(filename):  # a relative model path: the file's neighbour
                 scenario = replace(scenario, robot=with_model_beside(scenario.robot, Path(filename).parent))
@@ -218,40 +308,10 @@ def load_scenario(
     return scenario
 
 
-def with_conditions(
-    scenario: Scenario,
-    *,
-    execution: str | None = None,
-    uncertainty: int | None = None,
-    perception: str | None = None,
-    robot: str | None = None,
-) -> Scenario:
-    """``scenario`` run by ``robot`` (a shipped robot's name or a description file: ``load_robot``;
-    None: as it says), executed ``execution`` ("open" or "closed"; None: as it says), with seeded
-    model error of seed ``uncertainty`` (None: as it says), its scene from ``perception`` ("truth" or
-    "camera"; None: as it says): the ``--robot``, ``--execution``, ``--uncertainty`` and
-    ``--perception`` options of ``run_scene`` and the experiments.
-
-    Raises:
-        HlpError: the settings do not fit together so (e.g. a camera source without a camera).
-    """
-    changes = {}
-    if robot is not None:
-        changes["robot"] = load_robot(robot)
-    if execution is not None:
-        changes["closed_loop"] = replace(scenario.closed_loop, enabled=execution == "closed")
-    if uncertainty is not None:
-        changes["uncertainty"] = replace(scenario.uncertainty, enabled=True, seed=int(uncertainty))
-    if perception is not None:
-        changes["perception"] = replace(scenario.perception, source=perception)
-    return replace(scenario, **changes) if changes else scenario  # checked as it is made
-
-
 __all__ = [
     "MAX_WORLD_OBSTACLES",
-    "PLANNERS",
     "PlannerChoiceConfig",
     "Scenario",
+    "legacy",
     "load_scenario",
-    "with_conditions",
 ]

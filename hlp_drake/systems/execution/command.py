@@ -19,6 +19,7 @@ from hlp_drake.systems.world.scene_models import object_body
 from hlp_drake.systems.world.start_pose import ik_solver_options, kinematic_robot
 
 if TYPE_CHECKING:
+    from pydrake.multibody.plant import MultibodyPlant
     from pydrake.systems.analysis import Simulator
     from pydrake.systems.framework import Context
     from pydrake.systems.primitives import TrajectorySource
@@ -135,8 +136,8 @@ def grasp_knots(
 def advance_through_reach(
     simulator: Simulator, command: OpenLoopCommand | ClosedLoopCommand, *, settle_s: float
 ) -> float:
-    """Simulate to the end of the commanded reach, then ``settle_s`` more (``optimiser.settle_s``, as
-    a rollout settles); return that time. A closed
+    """Simulate to the end of the commanded reach, then ``settle_s`` more (``success.settle_s``, as a
+    rollout settles); return that time. A closed
     loop's re-plan may move the end while the simulation goes there: later (it goes on), or earlier
     than the time already simulated (the robot has held the reach's last pose since; the settling
     ends no earlier than now: going back would be Drake's "boundary_time >= context time" failure)."""
@@ -150,16 +151,26 @@ def advance_through_reach(
     return settled
 
 
-def grasp_and_lift(simulator, command, t0, scenario, plant, plant_context, scene) -> bool:
-    """Close the fingers at the reach's end pose (from ``t0``) and lift; whether the target rose
-    with the gripper."""
+def grasp_and_lift(
+    simulator: Simulator,
+    command: OpenLoopCommand | ClosedLoopCommand,
+    t0: float,
+    *,
+    plant: MultibodyPlant,
+    target: str,
+    grasp: GraspConfig,
+    robot: RobotDescription = MOBILE_UR5,
+) -> bool:
+    """Close the fingers at the reach's end pose (from ``t0``) and lift (``grasp``); whether the object
+    ``target`` of ``plant`` rose with the gripper."""
     root = simulator.get_mutable_context()
-    grasp = grasp_knots(command.final(root), scenario.grasp, scenario.robot)
-    if grasp is None:
+    knots = grasp_knots(command.final(root), grasp, robot)
+    if knots is None:
         return False
-    times, knots = grasp
+    times, knots = knots
     command.then(root, t0, times, knots)
-    target = object_body(plant, scene.target.name)
-    z0 = target.EvalPoseInWorld(plant_context).translation()[2]
+    body = object_body(plant, target)
+    plant_context = plant.GetMyContextFromRoot(root)
+    z0 = body.EvalPoseInWorld(plant_context).translation()[2]
     simulator.AdvanceTo(t0 + times[-1])
-    return bool(target.EvalPoseInWorld(plant_context).translation()[2] - z0 >= scenario.grasp.held_height)
+    return bool(body.EvalPoseInWorld(plant_context).translation()[2] - z0 >= grasp.held_height)

@@ -7,8 +7,8 @@ Open loop with cameras, the planners plan on one frame perceived before the buil
 (``perceive_world``: the executed world renders nothing), given as ``planned_scene``; so they do under
 model error without cameras (the scenario's scene, not the plant's). What drives the robot: open
 loop a trajectory source (holding the start until the run gives it the optimised sequence), closed
-loop (``scenario.closed_loop.enabled``) a ``RecedingHorizonController`` re-optimising on the measured
-state and the source's scene.
+loop (``scenario.closed_loop.enabled``) a ``RecedingHorizonController`` re-planning with the
+low-level planner (one that ``replans``: the STO) on the measured state and the source's scene.
 """
 
 from __future__ import annotations
@@ -20,12 +20,14 @@ import numpy as np
 from pydrake.geometry import Meshcat
 from pydrake.systems.framework import Diagram, DiagramBuilder
 
+from hlp_drake.errors import HlpError
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
+from hlp_drake.systems.low_level.registry import LOW_LEVEL_PLANNERS, low_level_entry
 from hlp_drake.systems.low_level.sto.pool import RolloutPool
 from hlp_drake.systems.perception.system import ScenePerception, add_scene_perception
-from hlp_drake.systems.planning.diagram import ObservedScenePlanner, make_planning_diagram
+from hlp_drake.systems.planning.diagram import ObservedScenePlanner, low_level_planner, make_planning_diagram
 from hlp_drake.systems.world.scene_source import SCENE_PORT, SceneFromPlant
 from hlp_drake.systems.world.uncertainty import sample_perturbation
 from hlp_drake.systems.world.world import (
@@ -80,16 +82,28 @@ def execution_model_error(scenario: Scenario) -> WorldPerturbation | None:
 def make_execution_diagram(
     scenario: Scenario,
     *,
-    pool: RolloutPool,
+    pool: RolloutPool | None = None,
     models: DecisionModels | None = None,
     meshcat: Meshcat | None = None,
     contact_forces: bool = False,
     planned_scene: Scene | None = None,
 ) -> ExecutionDiagram:
-    """The execution diagram of ``scenario`` (see the module's docstring); ``planned_scene``: the scene
-    the planners plan on instead of the source's (a frame perceived before; under model error without
-    cameras the scenario's scene is used anyway)."""
+    """The execution diagram of ``scenario`` (see the module's docstring); ``pool``: the rollout workers
+    of a low-level planner that rolls out (the caller's); ``planned_scene``: the scene the planners
+    plan on instead of the source's (a frame perceived before; under model error without cameras the
+    scenario's scene is used anyway).
+
+    Raises:
+        HlpError: closed loop with a low-level planner that cannot re-plan.
+    """
     closed = scenario.closed_loop.enabled
+    entry = low_level_entry(scenario.low_level.kind)
+    if closed and not entry.replans:
+        replanners = ", ".join(n for n, e in LOW_LEVEL_PLANNERS.items() if e.replans)
+        raise HlpError(
+            f"closed-loop execution re-plans from the measured state, which the low-level planner "
+            f"{entry.name} cannot (one that can: {replanners})"
+        )
     camera = scenario.perception.source == "camera"
     watching = camera and closed  # cameras in the executed world, re-perceived at re-plans
     error = execution_model_error(scenario)
@@ -104,7 +118,7 @@ def make_execution_diagram(
     plant, robot = world_plant(world)
     planning = builder.AddNamedSystem("planning", make_planning_diagram(scenario, pool=pool, models=models))
     if watching:  # the planners see what the cameras see of the (true) world
-        source = add_scene_perception(builder, world, scenario)
+        source = add_scene_perception(builder, world, template=scenario.scene, config=scenario.perception)
     else:  # the plant's poses (of the believed objects, under model error)
         source = builder.AddNamedSystem("scene_from_plant", SceneFromPlant(plant, scenario.scene))
         builder.Connect(world.GetOutputPort("body_poses"), source.get_body_poses_input_port())
@@ -112,7 +126,7 @@ def make_execution_diagram(
         builder.Connect(source.get_scene_output_port(), planning.GetInputPort(SCENE_PORT))
     controller = trajectory_source = None
     if closed:
-        controller = _add_controller(builder, scenario, world, planning, source, pool, models, camera=camera)
+        controller = _add_controller(builder, scenario, world, planning, source, models, camera=camera)
     else:  # holds the start until the run gives it the optimised sequence
         start = plant.GetPositions(plant.CreateDefaultContext(), robot)
         hold = ControlSequence(np.array([0.0, 1.0]), np.vstack([start, start]))
@@ -130,14 +144,21 @@ def make_execution_diagram(
     )
 
 
-def _add_controller(builder, scenario, world, planning, source, pool, models, *, camera: bool):
-    """A receding-horizon controller driving the robot from the planning diagram's optimisation on,
-    observing the scene through ``source`` at every re-plan."""
+def _add_controller(builder, scenario, world, planning, source, models, *, camera: bool):
+    """A receding-horizon controller driving the robot from the planning diagram's low-level plan on,
+    re-planning with its planner, observing the scene through ``source`` at every re-plan."""
     plant, _ = world_plant(world)
-    replanner = ObservedScenePlanner(scenario, models=models)  # when objects have moved far
-    controller = builder.AddNamedSystem(
-        "controller", RecedingHorizonController(scenario, plant, pool, initialiser=replanner)
+    planner = low_level_planner(planning)
+    observed = make_planning_diagram(scenario, models=models)  # when objects have moved far
+    controller = RecedingHorizonController(
+        plant,
+        planner=planner,
+        closed_loop=scenario.closed_loop,
+        robot=scenario.robot.name,
+        objects=() if camera else tuple(o.name for o in scenario.scene.objects),
+        initialiser=ObservedScenePlanner(observed, planner.as_commanded),
     )
+    controller = builder.AddNamedSystem("controller", controller)
     builder.Connect(world.GetOutputPort("state"), controller.GetInputPort("state"))
     builder.Connect(source.get_scene_output_port(), controller.GetInputPort(SCENE_PORT))
     if camera:

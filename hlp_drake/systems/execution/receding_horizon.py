@@ -1,25 +1,26 @@
-"""``RecedingHorizonController``: closed-loop execution, the STO re-run on the measured state.
+"""``RecedingHorizonController``: closed-loop execution, the low-level planner (the STO) re-run on the
+measured state.
 
 Input ports:
-    ``state``: the plant's whole state (the world's ``state`` output): the robot's state, and with
-        ``perception.source: plant`` the free objects' too.
+    ``state``: the plant's whole state (the world's ``state`` output): the robot's state, and the
+        measured objects' (``objects``; none when the scene is perceived by cameras).
     ``scene`` (abstract ``Scene``): the observed scene, from the diagram's scene source (``SceneFromPlant``
         on the plant's poses, or ``ScenePerception`` on the cameras: then the objects are known only
         from it), read at the start and at every re-plan.
     ``perception`` (abstract ``Perception``, optional): the scene source's frame, for why a scene
         without a target was observed (``ScenePerception``'s ``perception`` output).
-    ``initial`` (abstract ``StoResult``, e.g. the planning diagram's ``optimisation``): the open-loop
-        optimisation, read once when the simulation is initialised.
+    ``initial`` (abstract ``LowLevelResult``, e.g. the planning diagram's ``optimisation``): the
+        open-loop plan, read once when the simulation is initialised.
 
 Output port:
-    ``desired_trajectory_state`` (22): the robot's 11 commanded positions then their velocities now (zero
+    ``desired_trajectory_state``: the robot's commanded positions then their velocities now (zero
         velocities once the sequence has ended); ``connect_robot_command`` feeds it to the world.
 
 Every ``closed_loop.replan_period`` s of simulated time while its sequence lasts (a periodic
 unrestricted update: the simulation waits for it), the controller reads the measured state and the
 observed scene, cuts its commanded sequence there (the warm start: its remainder, starting where the
-robot is commanded now) and runs ``optimise`` from the measured state (``RolloutStart``; objects
-not measured start at rest where the observed scene has them) with the budget of
+robot is commanded now) and re-plans from the measured state (``StoPlanner.replan``, ``RolloutStart``;
+objects not measured start at rest where the observed scene has them) with the budget of
 ``closed_loop.iterations`` and ``closed_loop.rollouts`` (and within ``closed_loop.max_rollouts`` in
 all: once those are spent, no more re-optimisation); the result's sequence is commanded from then
 on (the optimiser's acceptance is monotone: the remainder unless a candidate is cheaper or passes;
@@ -47,24 +48,23 @@ from pydrake.systems.framework import Context, LeafSystem, State
 
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
-from hlp_drake.systems.low_level.sto.budget import Budget
+from hlp_drake.systems.low_level.result import EMPTY_RESULT, LowLevelResult
 from hlp_drake.systems.low_level.sto.cost import Prediction
-from hlp_drake.systems.low_level.sto.optimiser import EMPTY_RESULT, StoResult, optimise
 from hlp_drake.systems.low_level.sto.rollout_world import RolloutStart
 from hlp_drake.systems.perception.accuracy import largest_displacement
 from hlp_drake.systems.perception.perception import Perception
-from hlp_drake.systems.world.scene_source import declare_scene_input_port, scene_input, with_scene
+from hlp_drake.systems.world.scene_source import declare_scene_input_port, scene_input
 
 if TYPE_CHECKING:
     from pydrake.multibody.plant import MultibodyPlant
 
-    from hlp_drake.systems.low_level.sto.pool import RolloutPool
-    from hlp_drake.systems.scenario import Scenario
+    from hlp_drake.systems.low_level.sto.config import ClosedLoopConfig
+    from hlp_drake.systems.low_level.sto.planner import StoPlanner
 
 MIN_REMAINDER = 1.0e-3
 """A sequence with less than this left (s) is not re-optimised."""
 Initialiser = Callable[[Scene, np.ndarray], "ControlSequence | None"]
-"""A fresh initial sequence for an observed scene from the robot's measured state (11 + 11)."""
+"""A fresh initial sequence for an observed scene from the robot's measured state (positions, velocities)."""
 
 
 @dataclass(frozen=True)
@@ -123,27 +123,30 @@ class RecedingHorizonController(LeafSystem):
     """The receding-horizon controller (see the module's docstring for the ports and the behaviour).
 
     Args:
-        scenario: the optimiser's settings; with ``perception.source: camera`` only the robot is
-            measured on ``state`` (the objects are what the ``scene`` input shows).
         plant: the world's plant (to split its state by model instance; not simulated here).
-        pool: the rollout workers (the caller's).
+        planner: the low-level planner that re-plans (``StoPlanner``: its pool is the caller's).
+        closed_loop: the controller's settings (a ``Scenario``'s ``closed_loop``).
+        robot: the robot's model instance name.
+        objects: the objects measured on ``state`` (none when the scene is perceived by cameras:
+            the objects are then what the ``scene`` input shows).
         initialiser: a fresh initial sequence for the observed scene (``Initialiser``; None: none).
     """
 
     def __init__(
         self,
-        scenario: Scenario,
         plant: MultibodyPlant,
-        pool: RolloutPool,
         *,
+        planner: StoPlanner,
+        closed_loop: ClosedLoopConfig,
+        robot: str,
+        objects: tuple[str, ...] = (),
         initialiser: Initialiser | None = None,
     ) -> None:
         super().__init__()
-        self._scenario, self._pool, self._initialiser = scenario, pool, initialiser
+        self._planner, self._closed, self._initialiser = planner, closed_loop, initialiser
         self._plant = plant
-        objects = () if scenario.perception.source == "camera" else scenario.scene.objects
-        self._robot_name = robot_name = scenario.robot.name
-        names = [robot_name] + [o.name for o in objects if plant.HasModelInstanceNamed(o.name)]
+        self._robot_name = robot_name = robot
+        names = [robot_name] + [name for name in objects if plant.HasModelInstanceNamed(name)]
         self._instances = {n: plant.GetModelInstanceByName(n) for n in names}
         self._state = self.DeclareVectorInputPort("state", plant.num_multibody_states())
         self._scene = declare_scene_input_port(self)
@@ -160,9 +163,7 @@ class RecedingHorizonController(LeafSystem):
             {self.time_ticket(), self.abstract_state_ticket(self._record), self._state.ticket()},
         )
         self.DeclareInitializationUnrestrictedUpdateEvent(self._initialise)
-        self.DeclarePeriodicUnrestrictedUpdateEvent(
-            scenario.closed_loop.replan_period, scenario.closed_loop.replan_period, self._replan
-        )
+        self.DeclarePeriodicUnrestrictedUpdateEvent(closed_loop.replan_period, closed_loop.replan_period, self._replan)
 
     def record(self, root_context: Context) -> ControllerRecord:
         """The controller's state in the diagram's ``root_context``."""
@@ -201,7 +202,7 @@ class RecedingHorizonController(LeafSystem):
         )
 
     def _initialise(self, context: Context, state: State) -> None:
-        result: StoResult = self._initial.Eval(context)
+        result: LowLevelResult = self._initial.Eval(context)
         prediction = None if result.outcome is None else result.outcome.prediction
         verified = None if result.outcome is None else result.outcome.verification
         track = verified.prediction if verified is not None and verified.success else None
@@ -221,7 +222,7 @@ class RecedingHorizonController(LeafSystem):
         record: ControllerRecord = context.get_abstract_state(int(self._record)).get_value()
         if record.sequence is None or record.reason == "commanded" or record.budget_spent:
             return
-        left = self._scenario.closed_loop.max_rollouts - record.rollouts
+        left = self._closed.max_rollouts - record.rollouts
         if left <= 0:  # the closed loop's budget is spent: the sequence plays to its end, unobserved
             state.get_mutable_abstract_state(int(self._record)).set_value(replace(record, budget_spent=True))
             return
@@ -241,27 +242,19 @@ class RecedingHorizonController(LeafSystem):
         states = self._states(context)
         measured = all(o.name in states for o in record.observed.objects)
         scene = record.scene if measured and record.scene is not None else record.observed
-        closed = self._scenario.closed_loop
-        sto = self._scenario.optimiser
         initial, alternatives, initialised = rest, None, False
         if self._initialiser is not None and self._moved_far(record, t):
             fresh = self._initialiser(record.observed, states[self._robot_name])
             if fresh is not None:
                 initial, alternatives, initialised = fresh, (lambda: [rest]), True
-        budget = Budget(
-            sto.samples,
-            closed.iterations,
-            min(closed.rollouts, left),
-            alternatives=1 if initialised and left > 1 else 0,
-            seed=sto.seed + 1 + record.replans,
-        )
-        result = optimise(
-            with_scene(self._scenario, scene),
+        result = self._planner.replan(
+            scene,
             initial,
-            self._pool,
-            budget=budget,
             start=RolloutStart(states),
-            alternatives=alternatives,
+            iterations=self._closed.iterations,
+            rollouts=min(self._closed.rollouts, left),
+            attempt=record.replans,
+            alternatives=alternatives if initialised and left > 1 else None,
         )
         prediction = None if result.outcome is None else result.outcome.prediction
         state.get_mutable_abstract_state(int(self._record)).set_value(
@@ -295,7 +288,7 @@ class RecedingHorizonController(LeafSystem):
     def _on_track(self, record: ControllerRecord, t: float) -> bool:
         """Whether every observed object is within ``closed_loop.track_distance`` of where the
         verified initial sequence's run on the execution model had it at ``t``."""
-        distance = self._scenario.closed_loop.track_distance
+        distance = self._closed.track_distance
         off = self._off_by(record.track, record, t) if distance > 0 else None
         return off is not None and off <= distance
 
@@ -303,7 +296,7 @@ class RecedingHorizonController(LeafSystem):
         """Whether an observed object is farther than ``closed_loop.replan_distance`` from where the
         commanded sequence's rollout put it at ``t``, or one appeared or went."""
         off = None if record.scene is None else self._off_by(record.prediction, record, t)
-        return off is not None and off > self._scenario.closed_loop.replan_distance
+        return off is not None and off > self._closed.replan_distance
 
     def _calc_desired(self, context: Context, output) -> None:
         record: ControllerRecord = context.get_abstract_state(int(self._record)).get_value()

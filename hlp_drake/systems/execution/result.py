@@ -10,6 +10,7 @@ from hlp_drake.config.what_ran import WhatRan
 from hlp_drake.planner import HighLevelPlan
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.perception.accuracy import match_objects
+from hlp_drake.systems.planning.initialisers import planner_label
 from hlp_drake.systems.planning.keyframes import Keyframes
 
 if TYPE_CHECKING:
@@ -18,25 +19,34 @@ if TYPE_CHECKING:
 
 
 def what_ran(
-    scenario: Scenario, scenario_file: str | None = None, *, planners: tuple[str, ...] | None = None
+    scenario: Scenario,
+    scenario_file: str | None = None,
+    *,
+    pairs: tuple[tuple[str, str], ...] | None = None,
 ) -> WhatRan:
     """What a run of ``scenario`` (read from ``scenario_file``; None: the built-in default) runs: its
-    robot, planner (or ``planners``), execution mode, model error's seed, perception source."""
+    robot, initialiser and low-level planner (or the (initialiser, low-level planner) ``pairs`` of an
+    experiment), execution mode, model error's seed, perception source."""
     uncertainty = scenario.uncertainty
+    pairs = pairs or ((scenario.planner.initial, scenario.low_level.kind),)
     return WhatRan(
         robot=scenario.robot.name,
-        planners=planners or (scenario.planner.kind,),
+        planners=tuple(planner_label(*pair) for pair in pairs),
         execution="closed" if scenario.closed_loop.enabled else "open",
         model_error_seed=uncertainty.seed if uncertainty.enabled else None,
         perception_source=scenario.perception.source,
         scenario_file=scenario_file,
+        initials=tuple(dict.fromkeys(i for i, _ in pairs)),
+        low_levels=tuple(dict.fromkeys(k for _, k in pairs)),
     )
 
 
 @dataclass
 class ExecutionResult:
-    """Outcome of planning and executing one scene (``reach_reused``: the execution started where
-    the optimiser's accepted rollout on the execution model ended, rather than simulating the reach
+    """Outcome of planning and executing one scene (``planner``: the pair's name, ``planner_label``
+    of the ``initial`` initialiser and the ``low_level`` planner; ``reach_reused``: the execution
+    started where the low-level planner's accepted rollout on the execution model ended, rather than
+    simulating the reach
     again; see ``verified_reach``; ``true_names``: planned on a perceived scene, per perceived
     object's name the true object's it was matched to, None if none; ``actuated_dofs``: the robot's
     actuated joints, base, arm and gripper).
@@ -69,6 +79,8 @@ class ExecutionResult:
     reach_reused: bool = False
     true_names: dict[str, str | None] | None = None
     actuated_dofs: int = 0
+    initial: str = "hlp"
+    low_level: str = "sto"
 
     @property
     def rollout_passed_execution_failed(self) -> bool:
@@ -78,6 +90,8 @@ class ExecutionResult:
     def to_dict(self) -> dict[str, Any]:
         return {
             "planner": self.planner,
+            "initial": self.initial,
+            "low_level": self.low_level,
             "scene": self.scene.name,
             "success": self.success,
             "failure_reason": self.failure_reason,

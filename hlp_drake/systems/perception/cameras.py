@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Annotated, Literal
+from typing import Annotated, Literal
 
 import numpy as np
 from pydrake.common.value import AbstractValue
@@ -48,10 +48,6 @@ from hlp_drake.scene.generators import MAX_SEED
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.validation import name_problem
 from hlp_drake.systems.world.scene_models import SceneModels
-
-if TYPE_CHECKING:
-    from hlp_drake.systems.scenario import Scenario
-
 
 RENDERER = "vtk"
 TABLE_LABEL, TARGET_LABEL, OBSTACLE_LABEL, ROBOT_LABEL = 1, 2, 3, 4
@@ -155,10 +151,12 @@ def label_classes(
                 _relabel(scene_graph, plant.get_source_id(), geometry, label)
 
 
-def add_cameras(builder: DiagramBuilder, scene_graph: SceneGraph, scenario: Scenario) -> None:
-    """Add ``scenario.perception.cameras`` to a world being built (its plant already finalized, the
-    geometry labelled by ``label_classes``) and export their ports (see the module's docstring)."""
-    cameras = scenario.perception.cameras
+def add_cameras(
+    builder: DiagramBuilder, scene_graph: SceneGraph, cameras: tuple[CameraConfig, ...], scene: Scene
+) -> None:
+    """Add ``cameras`` (placed over ``scene``'s table) to a world being built (its plant already
+    finalized, the geometry labelled by ``label_classes``) and export their ports (see the module's
+    docstring)."""
     if not cameras:
         return
     if not scene_graph.HasRenderer(RENDERER):
@@ -168,7 +166,7 @@ def add_cameras(builder: DiagramBuilder, scene_graph: SceneGraph, scenario: Scen
         color, depth = render_cameras(camera)
         sensor = builder.AddNamedSystem(
             f"{camera.name}_sensor",
-            RgbdSensor(world, camera_pose(camera, scenario.scene), color_camera=color, depth_camera=depth),
+            RgbdSensor(world, camera_pose(camera, scene), color_camera=color, depth_camera=depth),
         )
         builder.Connect(scene_graph.get_query_output_port(), sensor.query_object_input_port())
         noise = builder.AddNamedSystem(f"{camera.name}_noise", DepthNoise(camera))

@@ -17,7 +17,8 @@ from pydrake.perception import BaseField, Fields, PointCloud
 from pydrake.systems.framework import Context, Diagram, DiagramBuilder, LeafSystem, OutputPort
 from pydrake.systems.sensors import ImageDepth32F, ImageLabel16I
 
-from hlp_drake.systems.perception.cameras import camera_info
+from hlp_drake.scene.model import Scene
+from hlp_drake.systems.perception.cameras import PerceptionConfig, camera_info
 from hlp_drake.systems.perception.depth_points import CameraView
 from hlp_drake.systems.perception.perception import Perception, perceive, unperceived_scene
 from hlp_drake.systems.world.scene_source import MODEL_SCENE, SCENE_PORT
@@ -41,22 +42,25 @@ def perception_cloud(perception: Perception) -> PointCloud:
 
 
 class ScenePerception(LeafSystem):
-    """The scene from the scenario's cameras (see ``hlp_drake.systems.perception.perception``).
+    """The scene from the cameras of ``config`` (see ``hlp_drake.systems.perception.perception``).
 
-    Input ports, per camera N of ``scenario.perception.cameras`` (the world's ports of the same
-    names): ``N.depth_image`` (``ImageDepth32F``), ``N.label_image`` (``ImageLabel16I``),
-    ``N.camera_pose`` (``RigidTransform``). Output ports: ``scene`` (abstract ``Scene``, for the
-    planning blocks), ``perception`` (abstract ``Perception``: the objects, the reason of a
-    failure, the time) and ``point_cloud`` (a Drake ``PointCloud`` of the frame, coloured by class).
-    Evaluated on demand and cached until an input changes. The scenario's scene is the template:
-    only its start, start heading and name are used (the robot's own); its target's name names the
-    perceived target.
+    Input ports, per camera N of ``config.cameras`` (the world's ports of the same names):
+    ``N.depth_image`` (``ImageDepth32F``), ``N.label_image`` (``ImageLabel16I``), ``N.camera_pose``
+    (``RigidTransform``). Output ports: ``scene`` (abstract ``Scene``, for the planning blocks),
+    ``perception`` (abstract ``Perception``: the objects, the reason of a failure, the time) and
+    ``point_cloud`` (a Drake ``PointCloud`` of the frame, coloured by class). Evaluated on demand
+    and cached until an input changes.
+
+    Args:
+        template: of this scene only the start, start heading and name are used (the robot's own);
+            its target's name names the perceived target.
+        config: the cameras and the perception's settings (a ``Scenario``'s ``perception``).
     """
 
-    def __init__(self, scenario: Scenario) -> None:
+    def __init__(self, *, template: Scene, config: PerceptionConfig | None = None) -> None:
         super().__init__()
-        self._config = scenario.perception
-        self._template = scenario.scene
+        self._config = config or PerceptionConfig()
+        self._template = template
         self._cameras = self._config.cameras
         self._info = [camera_info(c) for c in self._cameras]
         self._inputs = []
@@ -137,11 +141,14 @@ class ScenePerception(LeafSystem):
         output.set_value(perceive(views, self._config, self._template))
 
 
-def add_scene_perception(builder: DiagramBuilder, world: Diagram, scenario: Scenario) -> ScenePerception:
-    """Add a ``ScenePerception`` named ``scene_perception`` fed by ``world``'s cameras (the world
-    must have them: ``make_world_diagram(..., cameras=True)``, already in ``builder``)."""
-    block = builder.AddNamedSystem("scene_perception", ScenePerception(scenario))
-    for camera in scenario.perception.cameras:
+def add_scene_perception(
+    builder: DiagramBuilder, world: Diagram, *, template: Scene, config: PerceptionConfig
+) -> ScenePerception:
+    """Add a ``ScenePerception(template=template, config=config)`` named ``scene_perception`` fed by
+    ``world``'s cameras (the world must have ``config.cameras``, e.g. ``make_world_diagram(...,
+    cameras=True)``, and be in ``builder`` already)."""
+    block = builder.AddNamedSystem("scene_perception", ScenePerception(template=template, config=config))
+    for camera in config.cameras:
         for port in CAMERA_PORTS:
             name = f"{camera.name}.{port}"
             builder.Connect(world.GetOutputPort(name), block.GetInputPort(name))
@@ -156,7 +163,7 @@ def perceive_world(
     world is built for this frame only, so a world executed open loop need not carry the cameras."""
     builder = DiagramBuilder()
     world = builder.AddSystem(make_world_diagram(scenario, cameras=True, model_error=model_error))
-    block = add_scene_perception(builder, world, scenario)
+    block = add_scene_perception(builder, world, template=scenario.scene, config=scenario.perception)
     context = builder.Build().CreateDefaultContext()
     started = time.perf_counter()
     perception = block.get_perception_output_port().Eval(block.GetMyContextFromRoot(context))

@@ -12,10 +12,11 @@ from pydrake.systems.framework import DiagramBuilder
 
 from hlp_drake.planner.plan import PlanKeypoint
 from hlp_drake.systems.world.robot import add_robot
-from hlp_drake.systems.world.scene_models import SceneModels, add_scene
+from hlp_drake.systems.world.robot_description import MOBILE_UR5, RobotDescription
+from hlp_drake.systems.world.scene_models import BodiesConfig, ContactConfig, SceneModels, add_scene
 
 if TYPE_CHECKING:
-    from hlp_drake.systems.scenario import Scenario
+    from hlp_drake.scene.model import Scene
 
 
 SKIPPABLE_ACTIONS = ("transit",)
@@ -98,7 +99,8 @@ def describe_keypoint(index: int, keypoint: PlanKeypoint) -> str:
 
 # ``PlanningModel``: the robot and the table (and the scene's objects, welded), for kinematics.
 class PlanningModel:
-    """Robot + table (+ the objects welded at their scene poses), for kinematics (IK, distance queries).
+    """``robot`` + ``scene``'s table (+ its objects welded at their poses), for kinematics (IK, distance
+    queries).
 
     A continuous plant (no dynamics) with its SceneGraph in a Diagram; it holds no context (make one
     with ``diagram.CreateDefaultContext()``).
@@ -109,15 +111,23 @@ class PlanningModel:
         scene_models: the table's and objects' model instances.
     """
 
-    def __init__(self, scenario: Scenario, *, with_objects: bool = True) -> None:
+    def __init__(
+        self,
+        scene: Scene,
+        *,
+        robot: RobotDescription = MOBILE_UR5,
+        contact: ContactConfig | None = None,
+        bodies: BodiesConfig | None = None,
+        with_objects: bool = True,
+    ) -> None:
         builder = DiagramBuilder()
         plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-        self.robot = add_robot(plant, scenario.robot)
+        self.robot = add_robot(plant, robot)
         self.scene_models: SceneModels = add_scene(
             plant,
-            scenario.scene,
-            contact=scenario.contact,
-            bodies=scenario.bodies,
+            scene,
+            contact=contact or ContactConfig(),
+            bodies=bodies or BodiesConfig(),
             weld_objects=True,
             with_objects=with_objects,
         )

@@ -36,13 +36,15 @@ from pydrake.systems.framework import Context
 from pydrake.trajectories import PiecewisePolynomial
 
 from hlp_drake.planner.plan import HighLevelPlan, PlanKeypoint
+from hlp_drake.systems.planning.config import IkConfig, MotionConfig
 from hlp_drake.systems.planning.keyframes import Keyframes, PlanningModel, describe_keypoint
+from hlp_drake.systems.world.robot_description import MOBILE_UR5, RobotDescription
+from hlp_drake.systems.world.scene_models import BodiesConfig, ContactConfig
 from hlp_drake.systems.world.start_pose import ik_solver_options, start_configuration, tcp_keypoint_height
 from hlp_drake.transfer.push import TRANSFERRED
 
 if TYPE_CHECKING:
     from hlp_drake.scene.model import Scene
-    from hlp_drake.systems.scenario import Scenario
 
 START_MATCH_TOLERANCE = 1e-3
 """A "start" keypoint this close (m) to ``scene.start`` uses the start configuration without IK."""
@@ -66,31 +68,47 @@ def _grandparents(plant, robot) -> list[tuple]:
 
 
 class KeypointSolver:
-    """Solves a plan's keypoints on ``scenario``'s table from its start (see the module's docstring)."""
+    """Solves a plan's keypoints on ``scene``'s table from its start (see the module's docstring).
 
-    def __init__(self, scenario: Scenario) -> None:
-        scene = scenario.scene
+    Args:
+        scene: the table and the start (its objects play no part).
+        robot: the robot.
+        ik: the IK's settings (and the start pose's).
+        motion: the trajectory's timing.
+        contact, bodies: how the table becomes a body (default: a ``Scenario``'s).
+    """
+
+    def __init__(
+        self,
+        scene: Scene,
+        *,
+        robot: RobotDescription = MOBILE_UR5,
+        ik: IkConfig | None = None,
+        motion: MotionConfig | None = None,
+        contact: ContactConfig | None = None,
+        bodies: BodiesConfig | None = None,
+    ) -> None:
         self._scene = scene
-        self._config = scenario
-        self._model = PlanningModel(scenario, with_objects=False)
-        plant, robot = self._model.plant, self._model.robot
+        self._ik = ik = ik or IkConfig()
+        self._motion = motion or MotionConfig()
+        self._model = PlanningModel(scene, robot=robot, contact=contact, bodies=bodies, with_objects=False)
+        plant, instance = self._model.plant, self._model.robot
         self._plant = plant
-        self._robot = robot
-        self._robot_description = description = scenario.robot
-        self._tcp = plant.GetFrameByName(description.tcp_frame, robot)
-        if plant.num_positions() != plant.num_positions(robot):
+        self._robot = instance
+        self._robot_description = description = robot
+        self._tcp = plant.GetFrameByName(description.tcp_frame, instance)
+        if plant.num_positions() != plant.num_positions(instance):
             raise RuntimeError("the planning model must have no positions besides the robot's")
-        self._start = start_configuration(scene, scenario.ik, plant, robot, description)
+        self._start = start_configuration(scene, ik, plant, instance, description)
         self._names = description.position_names
-        self._index = {name: plant.GetJointByName(name, robot).position_start() for name in self._names}
+        self._index = {name: plant.GetJointByName(name, instance).position_start() for name in self._names}
         if list(self._index.values()) != list(range(len(self._names))):
             raise RuntimeError(f"unexpected position order of the robot: {self._index}")
         self._velocity_limits = np.array(
-            [plant.GetJointByName(name, robot).velocity_upper_limits()[0] for name in self._names]
+            [plant.GetJointByName(name, instance).velocity_upper_limits()[0] for name in self._names]
         )
         self._lower = plant.GetPositionLowerLimits().copy()
         self._upper = plant.GetPositionUpperLimits().copy()
-        ik = self._config.ik
         table = scene.table
         self._base = [self._index[name] for name in description.base_joints]
         if self._base:  # a mobile base's workspace
@@ -260,7 +278,7 @@ class KeypointSolver:
         self, plant_context: Context, target: np.ndarray, previous: np.ndarray, *, clearance: bool
     ) -> tuple:
         """The IK program of one keypoint: (program, decision variables)."""
-        ik_config = self._config.ik
+        ik_config = self._ik
         tolerance = ik_config.position_tolerance
         world = self._plant.world_frame()
         ik = InverseKinematics(self._plant, plant_context, with_joint_limits=False)
@@ -308,7 +326,7 @@ class KeypointSolver:
         start_distance = np.hypot(*np.subtract(keypoint.position, self._scene.start))
         if keypoint.action == "start" and start_distance <= START_MATCH_TOLERANCE:
             return self._start.copy(), ""
-        tolerance = self._config.ik.position_tolerance
+        tolerance = self._ik.position_tolerance
         prog, q = self._program(plant_context, target, previous, clearance=True)
         best, reasons = previous.copy(), []
 
@@ -328,7 +346,7 @@ class KeypointSolver:
 
         attempts = 0
         for seed, program, variables in seeds():
-            if attempts == self._config.ik.attempts:
+            if attempts == self._ik.attempts:
                 break
             attempts += 1
             result, solution, feasible = self._solve(program, variables, seed)  # the FK check follows
@@ -356,7 +374,7 @@ class KeypointSolver:
     def trajectory(self, plant_context: Context, keyframes: Keyframes) -> PiecewisePolynomial:
         """The first-order hold from ``keyframes.start`` through their successful keyframes, timed by
         ``motion`` (the tcp's path computed in ``plant_context``)."""
-        motion = self._config.motion
+        motion = self._motion
         knots, lifted = [keyframes.start], [False]
         for q, ok, keypoint in zip(keyframes.positions, keyframes.success, keyframes.keypoints):
             if not ok:

@@ -3,16 +3,15 @@
 Input ports ``scene`` (abstract ``Scene``) and ``plan`` (abstract ``HighLevelPlan``, a person's
 plan); output ports ``robot_plan`` (abstract ``HighLevelPlan``: ``push_transfer.robot_plan``, with
 the actions ``ROBOT_ACTIONS``) and ``robot_alternatives`` (abstract tuple of ``HighLevelPlan``: the
-robot plans of at most ``optimiser.alternatives`` of the plan's other candidates, computed only when
-evaluated). The clearances combine the scenario's ``transfer`` margins with the robot's sizes,
-read from its model once (``transfer_geometry``).
+robot plans of at most ``alternatives`` of the plan's other candidates, computed only when
+evaluated). The clearances combine the ``transfer`` margins with the robot's sizes, read from its
+model once (``gripper_geometry``).
 """
 
 from __future__ import annotations
 
 import functools
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 from pydrake.common.value import AbstractValue
@@ -20,14 +19,19 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
 from hlp_drake.planner import HighLevelPlan
+from hlp_drake.systems.planning.config import DEFAULT_ALTERNATIVES
 from hlp_drake.systems.world.robot import add_robot
 from hlp_drake.systems.world.robot_description import MOBILE_UR5, RobotDescription
 from hlp_drake.systems.world.scene_source import declare_scene_input_port, scene_input
 from hlp_drake.transfer.push import robot_alternatives, robot_plan
-from hlp_drake.transfer.rules import SIZE_RESOLUTION, GripperGeometry, PushRules, length, push_rules
-
-if TYPE_CHECKING:
-    from hlp_drake.systems.scenario import Scenario
+from hlp_drake.transfer.rules import (
+    SIZE_RESOLUTION,
+    GripperGeometry,
+    PushRules,
+    TransferConfig,
+    length,
+    push_rules,
+)
 
 
 def _rounded_up(value: float) -> float:
@@ -77,12 +81,25 @@ def gripper_geometry(robot: RobotDescription = MOBILE_UR5) -> GripperGeometry:
 
 
 class RobotPlanTransfer(LeafSystem):
-    """Turns a human-like plan into the pushing robot's waypoints (see the module's docstring)."""
+    """Turns a human-like plan into the pushing robot's waypoints (see the module's docstring).
 
-    def __init__(self, scenario: Scenario) -> None:
+    Args:
+        robot: the robot, whose sizes the clearances take (``gripper_geometry``).
+        transfer: the transfer's margins (a ``Scenario``'s ``transfer``).
+        alternatives: at most this many alternative robot plans (a ``Scenario``'s
+            ``planner.alternatives``).
+    """
+
+    def __init__(
+        self,
+        *,
+        robot: RobotDescription = MOBILE_UR5,
+        transfer: TransferConfig | None = None,
+        alternatives: int = DEFAULT_ALTERNATIVES,
+    ) -> None:
         super().__init__()
-        rules = push_rules(scenario.transfer, gripper_geometry(scenario.robot))
-        limit = scenario.optimiser.alternatives
+        rules = push_rules(transfer or TransferConfig(), gripper_geometry(robot))
+        limit = alternatives
         self._rules = rules
         self._scene_port = declare_scene_input_port(self)
         self._plan_port = self.DeclareAbstractInputPort(

@@ -14,9 +14,9 @@ from pathlib import Path
 from typing import Literal
 
 import hlp_drake.models
-from hlp_drake.commands.parsing import SHIPPED_ROBOTS
 from hlp_drake.config.ranges import NonNegativeFloat
 from hlp_drake.errors import HlpError
+from hlp_drake.models import SHIPPED_ROBOTS
 from hlp_drake.scene.workspace import Workspace
 
 # The project's own Drake model package (``package://hlp_drake_models/...``); no remote packages.

@@ -1,6 +1,7 @@
 """The simulated world: the scenario's robot, a scene's table and free objects, and the robot's PD control.
 
-``make_world_diagram(scenario)`` returns a Diagram named ``world`` with these exported ports:
+``world_diagram(scene, model)`` (a scene in a ``WorldModel``) returns a Diagram named ``world`` with
+these exported ports (``make_world_diagram(scenario)``: the scenario's scene and world model):
 
 Input:
     ``robot.desired_state``: desired positions then velocities of the robot's actuated joints in
@@ -19,7 +20,7 @@ Outputs:
     ``query_object``: SceneGraph's ``QueryObject`` (distance and collision queries).
 
 The plant is the subsystem ``plant`` (``world.GetSubsystemByName("plant")``) and the SceneGraph
-``scene_graph``; the robot is the model instance ``scenario.robot.name``. The default context has the
+``scene_graph``; the robot is the model instance ``model.robot.name``. The default context has the
 robot in ``start_configuration`` (``hlp_drake.systems.world.start_pose``) and every object at rest on the
 table at its scene pose.
 """
@@ -27,7 +28,6 @@ table at its scene pose.
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -43,94 +43,26 @@ from pydrake.geometry import (
     SceneGraph,
 )
 from pydrake.multibody.meshcat import ContactVisualizer, ContactVisualizerParams
-from pydrake.multibody.plant import AddMultibodyPlant, CoulombFriction, MultibodyPlant, MultibodyPlantConfig
+from pydrake.multibody.plant import AddMultibodyPlant, CoulombFriction, MultibodyPlant
 from pydrake.multibody.tree import JointActuatorIndex, ModelInstanceIndex, PdControllerGains
 from pydrake.systems.controllers import InverseDynamics
 from pydrake.systems.framework import Diagram, DiagramBuilder, OutputPort
 from pydrake.systems.primitives import MatrixGain, TrajectorySource
 from pydrake.trajectories import Trajectory
 
-from hlp_drake.config.ranges import MAX_TIME_STEP, MIN_TIME_STEP, Fields, NonNegativeFloat, Positive, Rule
 from hlp_drake.systems.perception.cameras import add_cameras, label_classes
+from hlp_drake.systems.world.model import WorldModel
 from hlp_drake.systems.world.robot import add_robot
 from hlp_drake.systems.world.robot_description import RobotDescription
 from hlp_drake.systems.world.scene_models import ContactConfig, add_scene
 from hlp_drake.systems.world.start_pose import robot_position_names, start_configuration
+from hlp_drake.systems.world.world_config import DESIRED_STATE_PORT, WRIST_JOINTS, ControlConfig
 
 if TYPE_CHECKING:
+    from hlp_drake.scene.model import Scene
+    from hlp_drake.systems.perception.cameras import CameraConfig
     from hlp_drake.systems.scenario import Scenario
     from hlp_drake.systems.world.uncertainty import WorldPerturbation
-
-WRIST_JOINTS = 3
-"""The arm's last joints that take ``controller.wrist``'s gains."""
-DESIRED_STATE_PORT = "robot.desired_state"
-SAP_APPROXIMATIONS = ("sap", "lagged", "similar")
-"""Discrete contact approximations solved by SAP (TAMSI, "tamsi", cannot simulate the mimic finger)."""
-CONTACT_MODELS = ("point", "hydroelastic", "hydroelastic_with_fallback")
-PLANT_RANGES = Fields(
-    {
-        "time_step": Positive(MIN_TIME_STEP, MAX_TIME_STEP),
-        "discrete_contact_approximation": Rule(
-            lambda v: v in SAP_APPROXIMATIONS,
-            f"{{where}} must be one of {', '.join(SAP_APPROXIMATIONS)} (the robot's mimic finger needs SAP), "
-            "got {value!r}",
-        ),
-        "contact_model": Rule(
-            lambda v: v in CONTACT_MODELS,
-            f"{{where}} must be one of {', '.join(CONTACT_MODELS)}, got {{value!r}}",
-        ),
-    }
-)
-"""The ranges of a ``Scenario``'s ``plant`` (Drake's ``MultibodyPlantConfig`` declares none)."""
-
-
-def default_plant_config() -> MultibodyPlantConfig:
-    """The plant settings of the world, the execution model the optimiser also rolls out on: 10 ms
-    steps, point contact, the SAP solver and approximation, outputs from the current state.
-
-    SAP simulates the gripper's mimic finger (a coupler constraint). The step and the contact geometry
-    (``ContactConfig``) are the fastest setting whose verdicts and final object poses agree with
-    the same model at 1 ms (``benchmarks/physics_models.py``; docs/results.md, "One execution model").
-    """
-    return MultibodyPlantConfig(
-        time_step=0.01,
-        penetration_allowance=0.001,
-        stiction_tolerance=1e-4,
-        contact_model="point",
-        discrete_contact_approximation="sap",
-        use_sampled_output_ports=False,
-    )
-
-
-@dataclass(frozen=True)
-class PdGains:
-    """Gains of a joint PD controller (SI units: N/m and N s/m, or N m/rad and N m s/rad)."""
-
-    kp: NonNegativeFloat = 0.0
-    kd: NonNegativeFloat = 0.0
-
-
-@dataclass(frozen=True)
-class ControlConfig:
-    """The robot's joint PD controllers (Drake's PD-controlled actuators, implicit in SAP).
-
-    Attributes:
-        base: gains of a mobile base's x and y joints (N/m, N s/m).
-        base_yaw: gains of its yaw joint.
-        arm: gains of the arm's joints before the wrist.
-        wrist: gains of the arm's last three joints.
-        gripper: gains of the actuated finger.
-        gravity_compensation: add the robot's gravity torques as feed-forward actuation (computed on
-            a robot-only model), so the arm holds its commanded pose without steady-state sag.
-    """
-
-    base: PdGains = field(default_factory=lambda: PdGains(kp=2.0e4, kd=4.0e3))
-    base_yaw: PdGains = field(default_factory=lambda: PdGains(kp=1.0e4, kd=2.0e3))
-    arm: PdGains = field(default_factory=lambda: PdGains(kp=2.0e3, kd=150.0))
-    wrist: PdGains = field(default_factory=lambda: PdGains(kp=300.0, kd=10.0))
-    gripper: PdGains = field(default_factory=lambda: PdGains(kp=2.0e3, kd=20.0))
-    gravity_compensation: bool = True
-
 
 def _set_robot_contact(
     plant: MultibodyPlant,
@@ -269,56 +201,73 @@ def make_world_diagram(
     cameras: bool | None = None,
     model_error: WorldPerturbation | None = None,
 ) -> Diagram:
-    """Build the world of ``scenario`` (its scene, plant, contact, bodies, controller and start pose):
-    see the module's docstring for the ports.
+    """The world of ``scenario``: ``world_diagram`` of its scene and its ``world_model``.
 
     Args:
+        cameras: add the scenario's cameras (``perception.cameras``; their ports: see
+            ``hlp_drake.systems.perception.cameras``); None (the default): when the scenario
+            perceives the scene through them (``perception.source: camera``).
+        meshcat, contact_forces, welded_objects, model_error: as ``world_diagram``'s.
+    """
+    watching = cameras or (cameras is None and scenario.perception.source == "camera")
+    return world_diagram(
+        scenario.scene,
+        scenario.world_model,
+        cameras=scenario.perception.cameras if watching else (),
+        meshcat=meshcat,
+        contact_forces=contact_forces,
+        welded_objects=welded_objects,
+        model_error=model_error,
+    )
+
+
+def world_diagram(
+    scene: Scene,
+    model: WorldModel | None = None,
+    *,
+    cameras: tuple[CameraConfig, ...] = (),
+    meshcat: Meshcat | None = None,
+    contact_forces: bool = False,
+    welded_objects: Iterable[str] = (),
+    model_error: WorldPerturbation | None = None,
+) -> Diagram:
+    """Build the world of ``scene`` in ``model`` (its robot, plant, contact, bodies, controller and
+    start pose; default ``WorldModel()``): see the module's docstring for the ports.
+
+    Args:
+        cameras: RGB-D cameras fixed in the world (their ports: see
+            ``hlp_drake.systems.perception.cameras``), rendered only when their images are
+            evaluated. Even unrendered, a camera costs ~10 % of the simulation's time (the render
+            engine follows every pose).
         meshcat: if given, the illustration geometry is drawn there ...
         contact_forces: ... and, if this is set, the contact forces (1 cm per 5 N).
         welded_objects: names of scene objects welded to the world at their scene poses instead of
             free (a reduced model: they neither move nor join the contact problem with the table);
             ``state`` then holds only the free objects' states.
-        cameras: add the scenario's cameras (``perception.cameras``; their ports: see
-            ``hlp_drake.systems.perception.cameras``), rendered only when their images are evaluated; None (the
-            default): when the scenario perceives the scene through them (``perception.source:
-            camera``). Even unrendered, a camera costs ~10 % of the simulation's time (the render
-            engine follows every pose).
-        model_error: the world differs from the scenario so (``sample_perturbation``): its objects
+        model_error: the world differs from ``scene`` so (``sample_perturbation``): its objects
             stand where ``model_error.true_scene`` has them, with its mass and friction factors.
     """
-    scene = scenario.scene if model_error is None else model_error.true_scene(scenario.scene)
+    model = model or WorldModel()
+    scene = scene if model_error is None else model_error.true_scene(scene)
     scales = None if model_error is None else model_error.scales()
     builder = DiagramBuilder()
-    plant, scene_graph = AddMultibodyPlant(scenario.plant, builder)
-    instance = add_robot(plant, scenario.robot)
-    _set_robot_contact(plant, scene_graph, instance, scenario.contact, scenario.robot)
-    _set_pd_gains(plant, instance, scenario.controller, scenario.robot)
+    plant, scene_graph = AddMultibodyPlant(model.plant, builder)
+    instance = add_robot(plant, model.robot)
+    _set_robot_contact(plant, scene_graph, instance, model.contact, model.robot)
+    _set_pd_gains(plant, instance, model.controller, model.robot)
     models = add_scene(
-        plant,
-        scene,
-        contact=scenario.contact,
-        bodies=scenario.bodies,
-        welded_objects=welded_objects,
-        scales=scales,
+        plant, scene, contact=model.contact, bodies=model.bodies, welded_objects=welded_objects, scales=scales
     )
     plant.Finalize()
-    if not scenario.contact.robot_self_contact:
+    if not model.contact.robot_self_contact:
         _filter_robot_self_contact(plant, scene_graph, instance)
-    if cameras or (cameras is None and scenario.perception.source == "camera"):
+    if cameras:
         label_classes(plant, scene_graph, instance, models, scene)
-        add_cameras(builder, scene_graph, scenario)
-    plant.SetDefaultPositions(
-        instance, start_configuration(scene, scenario.ik, plant, instance, scenario.robot)
-    )
-
-    if scenario.controller.gravity_compensation:
+        add_cameras(builder, scene_graph, cameras, scene)
+    plant.SetDefaultPositions(instance, start_configuration(scene, model.ik, plant, instance, model.robot))
+    if model.controller.gravity_compensation:
         _add_gravity_compensation(builder, plant, instance)
-    builder.ExportInput(plant.get_desired_state_input_port(instance), DESIRED_STATE_PORT)
-    builder.ExportOutput(plant.get_state_output_port(instance), "robot.state")
-    builder.ExportOutput(plant.get_state_output_port(), "state")
-    builder.ExportOutput(plant.get_body_poses_output_port(), "body_poses")
-    builder.ExportOutput(plant.get_contact_results_output_port(), "contact_results")
-    builder.ExportOutput(scene_graph.get_query_output_port(), "query_object")
+    _export_ports(builder, plant, scene_graph, instance)
     if meshcat is not None:
         MeshcatVisualizer.AddToBuilder(
             builder, scene_graph, meshcat, MeshcatVisualizerParams(role=Role.kIllustration)
@@ -330,6 +279,18 @@ def make_world_diagram(
     diagram = builder.Build()
     diagram.set_name("world")
     return diagram
+
+
+def _export_ports(
+    builder: DiagramBuilder, plant: MultibodyPlant, scene_graph: SceneGraph, instance: ModelInstanceIndex
+) -> None:
+    """Export the world's ports (see the module's docstring)."""
+    builder.ExportInput(plant.get_desired_state_input_port(instance), DESIRED_STATE_PORT)
+    builder.ExportOutput(plant.get_state_output_port(instance), "robot.state")
+    builder.ExportOutput(plant.get_state_output_port(), "state")
+    builder.ExportOutput(plant.get_body_poses_output_port(), "body_poses")
+    builder.ExportOutput(plant.get_contact_results_output_port(), "contact_results")
+    builder.ExportOutput(scene_graph.get_query_output_port(), "query_object")
 
 
 def world_plant(diagram: Diagram) -> tuple[MultibodyPlant, ModelInstanceIndex]:
@@ -370,19 +331,14 @@ def add_position_trajectory(
 
 
 __all__ = [
-    "CONTACT_MODELS",
     "DESIRED_STATE_PORT",
-    "PLANT_RANGES",
-    "SAP_APPROXIMATIONS",
-    "ControlConfig",
-    "PdGains",
     "actuated_state_selector",
     "add_position_trajectory",
     "connect_robot_command",
-    "default_plant_config",
     "desired_state_from_robot_state",
     "make_world_diagram",
     "robot_instance",
     "robot_position_names",
+    "world_diagram",
     "world_plant",
 ]

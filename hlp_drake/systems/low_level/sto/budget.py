@@ -9,41 +9,44 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
-from hlp_drake.systems.low_level.sto.config import PERCEIVED_CHECKS
+from hlp_drake.systems.low_level.sto.config import PERCEIVED_CHECKS, StoConfig
 from hlp_drake.systems.low_level.sto.cost import RolloutOutcome
 from hlp_drake.systems.low_level.sto.pool import RolloutPool
 from hlp_drake.systems.world.uncertainty import displaced_scenes
 
+MAX_ALTERNATIVES = 100
+"""Alternatives an optimisation tries at most (``Budget.of``): all the initialiser offers."""
+
 if TYPE_CHECKING:
     from hlp_drake.systems.low_level.sto.rollout_world import RolloutStart
-    from hlp_drake.systems.scenario import Scenario
+    from hlp_drake.systems.low_level.sto.spec import RolloutSpec
 
 
-def displaced_checks(scenario: Scenario) -> int:
-    """``optimiser.displaced_checks``, or when it is None ``PERCEIVED_CHECKS`` on a perceived scene
-    (``perception.source: camera``) and 0 on the true one."""
-    checks = scenario.optimiser.displaced_checks
-    if checks is not None:
-        return checks
-    return PERCEIVED_CHECKS if scenario.perception.source == "camera" else 0
+def displaced_checks(sto: StoConfig, *, perceived: bool = False) -> int:
+    """``sto.displaced_checks``, or when it is None ``PERCEIVED_CHECKS`` on a ``perceived`` scene (seen
+    by cameras) and 0 on the true one."""
+    if sto.displaced_checks is not None:
+        return sto.displaced_checks
+    return PERCEIVED_CHECKS if perceived else 0
 
 
 @dataclass(frozen=True)
 class Budget:
-    """How much one optimisation may do (``Budget.of(scenario)`` by default; the
-    receding-horizon controller gives its replans smaller ones).
+    """How much one optimisation may do (``Budget.of(sto)`` by default; the receding-horizon
+    controller gives its replans smaller ones).
 
     Attributes:
         samples: noisy rollouts per iteration.
         max_iterations, max_rollouts: the iteration and rollout budgets (no iteration starts that
             would pass ``max_rollouts``).
         time_budget_s: the optional wall-clock cap, s (0: none).
-        alternatives: the planner's alternatives tried when the initial rollout fails (0: none).
+        alternatives: the initialiser's alternatives tried, at most, when the initial rollout fails
+            (0: none).
         verify: verify a passing rollout on the execution model before declaring success.
         max_verifications: verifications at most.
         seed: seed of the noise.
         displaced_checks: worlds with displaced objects a verified sequence must pass in too
-            (``displaced_checks(scenario)``; 0: none).
+            (``displaced_checks``; 0: none).
     """
 
     samples: int
@@ -57,48 +60,46 @@ class Budget:
     displaced_checks: int = 0
 
     @classmethod
-    def of(cls, scenario: Scenario) -> Budget:
-        """The budget ``scenario.optimiser`` sets."""
-        sto = scenario.optimiser
+    def of(cls, sto: StoConfig, *, perceived: bool = False) -> Budget:
+        """The budget ``sto`` sets, on a scene seen by cameras if ``perceived``; every alternative
+        the initialiser offers is tried (``planner.alternatives`` of them)."""
         return cls(
             sto.samples,
             sto.max_iterations,
             sto.max_rollouts,
             sto.time_budget_s,
-            sto.alternatives,
+            MAX_ALTERNATIVES,
             sto.verify,
             sto.max_verifications,
             sto.seed,
-            displaced_checks(scenario),
+            displaced_checks(sto, perceived=perceived),
         )
 
 
 class BudgetedRun:
     """One optimisation's rollouts and verifications, counted into its ``StoResult``."""
 
-    def __init__(
-        self, scenario: Scenario, pool: RolloutPool, budget: Budget, start: RolloutStart | None
-    ) -> None:
-        self.scenario, self.pool, self.budget, self.start = scenario, pool, budget, start
+    def __init__(self, spec: RolloutSpec, pool: RolloutPool, budget: Budget, start: RolloutStart | None) -> None:
+        self.spec, self.pool, self.budget, self.start = spec, pool, budget, start
         self.rollouts = self.verifications = self.rejected = 0
         self.verify_s = 0.0
-        self._displaced: list[Scenario] | None = None
+        self._displaced: list[RolloutSpec] | None = None
 
-    def displaced_scenarios(self) -> list[Scenario]:
-        """The scenario with its objects displaced, ``budget.displaced_checks`` times (none from a
+    def displaced_specs(self) -> list[RolloutSpec]:
+        """The spec with its objects displaced, ``budget.displaced_checks`` times (none from a
         measured start: the closed loop's re-optimisations see where the objects are)."""
         if self._displaced is None:
-            sto = self.scenario.optimiser
+            sto = self.spec.sto
             count = self.budget.displaced_checks if self.start is None else 0
             scenes = displaced_scenes(
-                self.scenario.scene, count, sto.displaced_sigma, sto.displaced_yaw_sigma
+                self.spec.scene, count, sto.displaced_sigma, sto.displaced_yaw_sigma
             )
-            self._displaced = [replace(self.scenario, scene=scene) for scene in scenes]
+            self._displaced = [replace(self.spec, scene=scene) for scene in scenes]
         return self._displaced
 
     def roll(self, sequences: list[ControlSequence]) -> list[RolloutOutcome]:
         """The rollouts of ``sequences`` (from the run's start)."""
-        outcomes = self.pool.rollouts(self.scenario, sequences, start=self.start)
+        outcomes = self.pool.rollouts(self.spec, sequences, start=self.start)
         self.rollouts += len(sequences)
         return outcomes
 
@@ -109,8 +110,8 @@ class BudgetedRun:
         out no passing rollout is trusted. A rollout on the execution model is its own verification."""
         if not self.budget.verify:
             return
-        on_model = not self.scenario.optimiser.reduced_model
-        displaced = self.displaced_scenarios()
+        on_model = not self.spec.sto.reduced_model
+        displaced = self.displaced_specs()
         for i in order:
             if not outcomes[i].success:
                 continue
@@ -126,7 +127,7 @@ class BudgetedRun:
                 continue
             started = time.perf_counter()
             checked = self.pool.verifications(
-                displaced if on_model else [self.scenario, *displaced], sequences[i], start=self.start
+                displaced if on_model else [self.spec, *displaced], sequences[i], start=self.start
             )
             verified, moved = (outcomes[i], checked) if on_model else (checked[0], checked[1:])
             self.verify_s += time.perf_counter() - started

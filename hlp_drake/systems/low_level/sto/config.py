@@ -1,12 +1,15 @@
-"""``StoConfig``: every setting of the stochastic trajectory optimiser (a ``Scenario``'s ``optimiser``).
+"""``StoConfig``: every setting of the stochastic trajectory optimiser, the low-level planner ``sto``
+(a ``Scenario``'s ``planner.low_level`` with ``kind: sto``); ``ClosedLoopConfig``: its closed loop.
 
-In a scenario file it sits under ``optimiser:``::
+In a scenario file it sits under ``planner: {low_level: ...}``::
 
-    optimiser:
-      samples: 8
-      update: mppi
-      noise: {vx: 0.04, vy: 0.04, yaw_rate: 0.02}
-      cost: {goal_weight: 2000.0}
+    planner:
+      low_level:
+        kind: sto
+        samples: 8
+        update: mppi
+        noise: {vx: 0.04, vy: 0.04, yaw_rate: 0.02}
+        cost: {goal_weight: 2000.0}
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ from hlp_drake.config.ranges import (
     Rule,
 )
 from hlp_drake.scene.generators import MAX_SEED
+from hlp_drake.systems.low_level.protocol import LowLevelConfig
 
 MAX_WORKERS = 64
 """Most rollout processes."""
@@ -58,8 +62,6 @@ class StoCost:
     """Weights of the rollout cost (charged from the states at the ends of the control steps).
 
     Attributes:
-        pregrasp_margin: the target is inside the gripper's pre-grasp region when the tcp is within
-            its radius plus this (horizontally) and within this of the keypoint height, m.
         goal_weight: final cost per metre of tcp-to-pre-grasp-region distance outside the region.
         off_table: per object off the table (centre outside the top or below it), at every step.
         table_contact: per control step in which the robot touches the table (its edge or top).
@@ -71,7 +73,6 @@ class StoCost:
         effort_weight: per (rad/s)^2 or (m/s)^2, times seconds, of the commanded joint velocities.
     """
 
-    pregrasp_margin: NonNegativeFloat = 0.03
     goal_weight: NonNegativeFloat = 2000.0
     off_table: NonNegativeFloat = 300.0
     table_contact: NonNegativeFloat = 300.0
@@ -85,10 +86,11 @@ class StoCost:
 
 
 @dataclass(frozen=True)
-class StoConfig:
+class StoConfig(LowLevelConfig):
     """The stochastic trajectory optimiser (``hlp_drake.systems.low_level.sto.optimiser``).
 
     Attributes:
+        kind: "sto".
         samples: noisy rollouts per iteration (K).
         max_iterations: iteration budget (an iteration = K rollouts + an update).
         max_rollouts: rollout budget of one optimisation, the initial and the alternatives'
@@ -116,10 +118,8 @@ class StoConfig:
             (plus the largest motion of a body since the previous sample) of a sleeping object, the
             rollout goes back to the previous sample and on with it awake, m.
         sleep_speed: an awake object slower than this at two samples in a row has come to rest, m/s.
-        settle_s: simulated time after the last control step before the final state is read, s,
-            in a rollout and in the execution alike (a rollout's end is where the execution of the
-            same sequence ends).
-        sample_period: how often a rollout's state is read for the cost, s (the cost terms are per
+        sample_period: how often a rollout's state is read for the cost, s (it ends ``success.settle_s``
+            after the sequence) (the cost terms are per
             second; the reduced model's sleep checks' margins grow with the motion between samples).
         max_object_speed: an object faster than this (m/s) means the simulation blew up.
         max_sink: an object's centre more than this below the table top while over it means it
@@ -134,10 +134,6 @@ class StoConfig:
             the ``displaced_checks`` worlds; they do not count in ``max_rollouts``). Once they are
             spent the optimisation ends, whatever rollouts are left (8: with 4, searches whose
             fifth candidate held ended at half their rollouts, see docs/perception.md).
-        alternatives: when the initial sequence's rollout fails, roll out the planner's next this
-            many distinct candidate plans once (the HLP's, by expected arm collision; the straight
-            line has none) and go on from the best of them all (0: never); when the initial plan's IK
-            fails, the first of them whose IK succeeds takes its place (``KeypointIk``).
         displaced_checks: a sequence that passes its verification counts only if it also passes
             on the execution model in this many worlds with every object displaced (seeded
             Gaussian offsets of ``displaced_sigma`` per axis and ``displaced_yaw_sigma``): a push
@@ -149,6 +145,7 @@ class StoConfig:
         displaced_yaw_sigma: see ``displaced_checks``, rad.
     """
 
+    kind: Literal["sto"] = "sto"
     samples: Annotated[int, Count(1, 1000)] = 8
     max_iterations: Annotated[int, Count(1, 10_000)] = 20
     max_rollouts: Annotated[int, Count(1, 1_000_000)] = 100
@@ -164,14 +161,12 @@ class StoConfig:
     weld_lookahead: Annotated[float, Positive(upper=MAX_DURATION, zero_ok=True)] = 0.5
     weld_margin: NonNegativeFloat = 0.01
     sleep_speed: NonNegativeFloat = 0.005
-    settle_s: Annotated[float, Positive(upper=MAX_DURATION, zero_ok=True)] = 1.0
     sample_period: Annotated[float, PERIOD] = 0.2
     max_object_speed: PositiveFloat = 5.0
     max_sink: PositiveFloat = 0.03
     cost: StoCost = field(default_factory=StoCost)
     verify: bool = True
     max_verifications: Annotated[int, Count(0, 1000)] = 8
-    alternatives: Annotated[int, Count(0, 100)] = 3
     displaced_checks: Annotated[int | None, Count(0, 100)] = None
     displaced_sigma: Annotated[float, Positive(upper=0.1, zero_ok=True)] = 0.001
     displaced_yaw_sigma: Annotated[float, Positive(upper=math.pi, zero_ok=True)] = math.radians(0.5)

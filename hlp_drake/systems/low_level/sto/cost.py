@@ -15,6 +15,7 @@ import numpy as np
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.low_level.sto.config import StoConfig
 from hlp_drake.systems.world.scene_models import off_table_mask
+from hlp_drake.systems.world.success import SuccessConfig, half_extent, pregrasp_check, reach_problem
 
 BLOWN_UP_COST = 1.0e9
 
@@ -68,11 +69,11 @@ class Prediction:
 class FinalState:
     """Where a rollout on the execution model ended: the plant's model instances' positions and
     velocities (by name, ``RolloutWorld.states()``' form) at simulated time ``time``, in the world
-    of the scenario with key ``scenario_key``. Its execution model is deterministic, so an execution
+    with key ``world_key`` (``hlp_drake.systems.world.model.world_key``). Its execution model is deterministic, so an execution
     of the same sequence from the same start in that world ends there too and may start from here.
     """
 
-    scenario_key: str
+    world_key: str
     time: float
     states: dict[str, np.ndarray]
 
@@ -112,40 +113,18 @@ class RolloutOutcome:
     final: FinalState | None = None
 
 
-def _half_extent(size: tuple[float, float, float]) -> float:
-    return 0.5 * max(size[0], size[1])
-
-
-def pregrasp_check(
-    tcp: np.ndarray, target_position: np.ndarray, scene: Scene, *, tcp_height: float, margin: float
-) -> tuple[bool, float]:
-    """Whether the target (centre at ``target_position``) is inside the gripper's pre-grasp region at
-    tcp position ``tcp``: horizontally within the target's radius + ``margin``, and the tcp within
-    ``margin`` of the grasp height. Also returns the horizontal distance."""
-    distance = float(np.hypot(*(np.asarray(tcp)[:2] - np.asarray(target_position)[:2])))
-    inside = distance <= _half_extent(scene.target.size) + margin and abs(tcp[2] - tcp_height) <= margin
-    return inside, distance
-
-
-def reach_problem(fallen, inside: bool, distance: float) -> str | None:
-    """Why a reach failed the success test (None if it passed)."""
-    if fallen:
-        return f"objects fell off the table: {', '.join(fallen)}"
-    if not inside:
-        return f"the target is not in the gripper's pre-grasp region (tcp {distance:.3f} m away)"
-    return None
-
-
 def rollout_cost(
     samples: RolloutSamples,
     scene: Scene,
     sto: StoConfig,
     *,
+    success: SuccessConfig,
     tcp_height: float,
     effort: float,
     step_duration: float,
 ) -> RolloutOutcome:
-    """The cost of a rollout from its samples (see ``StoCost`` for the terms)."""
+    """The cost of a rollout from its samples (see ``StoCost`` for the terms), its success by the
+    ``success`` test."""
     weights = sto.cost
     names = [obj.name for obj in scene.objects]
     simulated = float(samples.times[-1]) if len(samples.times) else 0.0
@@ -164,13 +143,13 @@ def rollout_cost(
     final = positions[-1]
     start = positions[0]
     inside, distance = pregrasp_check(
-        tcp[-1], final[0], scene, tcp_height=tcp_height, margin=weights.pregrasp_margin
+        tcp[-1], final[0], scene, tcp_height=tcp_height, margin=success.pregrasp_margin
     )
     moved = np.sum((final[:, :2] - start[:, :2]) ** 2, axis=1)
     near = [
         name
         for name, obj, p, gone in zip(names[1:], scene.obstacles, final[1:], off[-1, 1:])
-        if not gone and np.hypot(*(tcp[-1, :2] - p[:2])) <= _half_extent(obj.size) + weights.near_distance
+        if not gone and np.hypot(*(tcp[-1, :2] - p[:2])) <= half_extent(obj.size) + weights.near_distance
     ]
     excess = np.clip(samples.max_force - weights.force_limit, 0.0, None)
     terms = {

@@ -1,6 +1,6 @@
 """The physics-based stochastic trajectory optimiser (STO).
 
-``optimise(scenario, initial, pool)`` improves a ``ControlSequence`` as the STO family does
+``optimise(spec, initial, pool)`` improves a ``ControlSequence`` as the STO family does
 (the project's notes, section A): every iteration rolls out ``samples`` noisy copies of the current
 sequence in the contact simulation (``RolloutWorld``), the noise being Gaussian per-step velocities
 of the holonomic base; the update keeps the cheapest copy ("greedy") or the cost-weighted mean of
@@ -25,12 +25,12 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
+from hlp_drake.systems.low_level.result import LowLevelResult
 from hlp_drake.systems.low_level.sto.budget import Budget, BudgetedRun
 from hlp_drake.systems.low_level.sto.config import BaseNoise, StoConfig
 from hlp_drake.systems.low_level.sto.cost import RolloutOutcome
@@ -39,66 +39,7 @@ from hlp_drake.systems.low_level.sto.pool import RolloutPool, WorkersLost
 
 if TYPE_CHECKING:
     from hlp_drake.systems.low_level.sto.rollout_world import RolloutStart
-    from hlp_drake.systems.scenario import Scenario
-
-
-@dataclass
-class StoResult:
-    """The outcome of one optimisation.
-
-    Attributes:
-        sequence: the best sequence found (the initial one if nothing was better).
-        outcome: its rollout.
-        success: whether its rollout passed the success test.
-        failure_reason: why not (None on success), one line.
-        iterations: iterations run (0: the initial sequence already succeeded, or none was run).
-        rollouts: rollouts simulated, the initial one included.
-        optimise_s: wall-clock time of the optimisation, s.
-        costs: the current cost after the initial rollout, after the alternatives' rollouts (if
-            any) and after every iteration.
-        initial_cost: the initial sequence's cost.
-        start: which sequence the result grew from: 0 the initial one, i >= 1 the i-th alternative.
-        verifications: passing rollouts checked again (on the execution model after a reduced
-            model's rollout, or in the displaced worlds; not in ``rollouts``).
-        rejected: of those, how many failed there.
-        verify_s: wall-clock time of the verifications, s (part of ``optimise_s``; the displaced
-            worlds' included).
-        displaced_checks: simulations on the execution model in worlds with the objects displaced
-            (``StoConfig.displaced_checks`` per verification).
-    """
-
-    sequence: ControlSequence
-    outcome: RolloutOutcome | None
-    success: bool
-    failure_reason: str | None
-    iterations: int = 0
-    rollouts: int = 0
-    optimise_s: float = 0.0
-    costs: list[float] = field(default_factory=list)
-    initial_cost: float | None = None
-    start: int = 0
-    verifications: int = 0
-    rejected: int = 0
-    verify_s: float = 0.0
-    displaced_checks: int = 0
-
-    def to_dict(self) -> dict:
-        return {
-            "success": self.success,
-            "failure_reason": self.failure_reason,
-            "iterations": self.iterations,
-            "rollouts": self.rollouts,
-            "optimise_s": self.optimise_s,
-            "initial_cost": self.initial_cost,
-            "start": self.start,
-            "verifications": self.verifications,
-            "rejected": self.rejected,
-            "verify_s": self.verify_s,
-            "displaced_checks": self.displaced_checks,
-            "final_cost": self.outcome.cost if self.outcome is not None else None,
-            "cost_terms": dict(self.outcome.terms) if self.outcome is not None else {},
-            "costs": list(self.costs),
-        }
+    from hlp_drake.systems.low_level.sto.spec import RolloutSpec
 
 
 def sample_base_noise(
@@ -115,12 +56,6 @@ def sample_base_noise(
     return velocity - (1.0 - noise.end_fraction) * drift[:, None, :] / sequence.duration
 
 
-EMPTY_RESULT = StoResult(
-    ControlSequence(np.array([0.0, 1.0]), np.zeros((2, 11))), None, False, "not optimised"
-)
-"""A placeholder result (an abstract port's model value)."""
-
-
 def mppi_weights(costs: np.ndarray, temperature: float) -> np.ndarray:
     """Normalised weights exp(-h (c - c_min) / (c_max - c_min)) of the rollouts' costs."""
     costs = np.asarray(costs, dtype=float)
@@ -132,7 +67,7 @@ def mppi_weights(costs: np.ndarray, temperature: float) -> np.ndarray:
 
 
 def optimise(
-    scenario: Scenario,
+    spec: RolloutSpec,
     initial: ControlSequence,
     pool: RolloutPool,
     *,
@@ -140,8 +75,8 @@ def optimise(
     progress: Callable[[int, float], None] | None = None,
     budget: Budget | None = None,
     start: RolloutStart | None = None,
-) -> StoResult:
-    """Improve ``initial`` on ``scenario``'s scene (see the module's docstring); never raises for a bad
+) -> LowLevelResult:
+    """Improve ``initial`` on ``spec``'s scene (see the module's docstring); never raises for a bad
     scene, nor when the pool gives up on its dead workers (``WorkersLost``: the result fails with its reason).
 
     Args:
@@ -149,29 +84,29 @@ def optimise(
         alternatives: returns the planner's other initial sequences, best first; called only if
             the initial rollout fails and the budget has alternatives (the first that many are used).
         progress: called as ``progress(iteration, cost)`` after every iteration.
-        budget: what the optimisation may spend (default: ``Budget.of(scenario)``).
+        budget: what the optimisation may spend (default: ``Budget.of(spec.sto)``).
         start: roll out from this state rather than the scene's (the receding-horizon controller's
             measured state; the robot's start is then not checked for collisions: it may be pushing).
     """
-    budget = budget or Budget.of(scenario)
+    budget = budget or Budget.of(spec.sto)
     started = time.perf_counter()
-    collisions = () if start is not None else pool.world(scenario).start_collisions
+    collisions = () if start is not None else pool.world(spec).start_collisions
     if collisions:
-        return StoResult(
+        return LowLevelResult(
             initial,
             None,
             False,
             f"the robot starts in collision with {', '.join(collisions)}",
             optimise_s=time.perf_counter() - started,
         )
-    run = BudgetedRun(scenario, pool, budget, start)
-    result = StoResult(initial, None, False, "not optimised")
+    run = BudgetedRun(spec, pool, budget, start)
+    result = LowLevelResult(initial, None, False, "not optimised")
     try:
         _search(run, result, alternatives, progress, budget, started)
     except WorkersLost as error:  # the pool gave up on its dead workers: this optimisation failed
         result.success, result.failure_reason = False, str(error)
     result.rollouts, result.verifications, result.rejected = run.rollouts, run.verifications, run.rejected
-    result.displaced_checks = run.verifications * len(run.displaced_scenarios())
+    result.displaced_checks = run.verifications * len(run.displaced_specs())
     result.verify_s = run.verify_s
     result.optimise_s = time.perf_counter() - started
     return result
@@ -179,14 +114,14 @@ def optimise(
 
 def _search(
     run: BudgetedRun,
-    result: StoResult,
+    result: LowLevelResult,
     alternatives: Callable[[], Sequence[ControlSequence]] | None,
     progress: Callable[[int, float], None] | None,
     budget: Budget,
     started: float,
 ) -> None:
     """The optimisation proper, from ``result.sequence`` (the initial one), filling ``result``."""
-    sto = run.scenario.optimiser
+    sto = run.spec.sto
     initial = result.sequence
     outcomes = run.roll([initial])
     run.settle([initial], outcomes, [0])  # may replace the outcome with its verification's
@@ -213,7 +148,7 @@ def _search(
         result.failure_reason = f"{result.failure_reason} (after {result.iterations} iterations)"
 
 
-def _accept(result: StoResult, sequence: ControlSequence, outcome: RolloutOutcome) -> None:
+def _accept(result: LowLevelResult, sequence: ControlSequence, outcome: RolloutOutcome) -> None:
     """Make ``sequence`` (rolled out as ``outcome``) the result's."""
     result.sequence, result.outcome = sequence, outcome
     result.success, result.failure_reason = outcome.success, outcome.failure_reason
@@ -221,7 +156,7 @@ def _accept(result: StoResult, sequence: ControlSequence, outcome: RolloutOutcom
 
 def _try_alternatives(
     run: BudgetedRun,
-    result: StoResult,
+    result: LowLevelResult,
     alternatives: Callable[[], Sequence[ControlSequence]] | None,
     budget: Budget,
 ) -> None:
@@ -242,10 +177,10 @@ def _try_alternatives(
     result.costs.append(result.outcome.cost)
 
 
-def _budget_spent(run: BudgetedRun, result: StoResult, budget: Budget, elapsed_next_s: float) -> str | None:
+def _budget_spent(run: BudgetedRun, result: LowLevelResult, budget: Budget, elapsed_next_s: float) -> str | None:
     """What of the budget another iteration would overspend (``elapsed_next_s``: the time spent
     and the last iteration's), if anything."""
-    per_iteration = budget.samples + (1 if run.scenario.optimiser.update == "mppi" else 0)
+    per_iteration = budget.samples + (1 if run.spec.sto.update == "mppi" else 0)
     if run.rollouts + per_iteration > budget.max_rollouts:
         return f"rollout budget of {budget.max_rollouts}"
     if budget.time_budget_s > 0 and elapsed_next_s > budget.time_budget_s:
@@ -254,13 +189,13 @@ def _budget_spent(run: BudgetedRun, result: StoResult, budget: Budget, elapsed_n
 
 
 def _iterate(
-    run: BudgetedRun, result: StoResult, rng: np.random.Generator, sto: StoConfig, budget: Budget
+    run: BudgetedRun, result: LowLevelResult, rng: np.random.Generator, sto: StoConfig, budget: Budget
 ) -> None:
     """One iteration: noisy planar velocities (``planar_shift``) round the result's sequence (and, with ``mppi``, their
     weighted mean) rolled out; the best is accepted if it passes or costs less (monotone)."""
     best, outcome = result.sequence, result.outcome
     noise = sample_base_noise(rng, best, sto.noise, budget.samples)
-    shift = planar_shift(run.scenario.robot, best)
+    shift = planar_shift(run.spec.model.robot, best)
     candidates = [shift(v) for v in noise]
     outcomes = run.roll(candidates)
     if sto.update == "mppi":
@@ -279,4 +214,4 @@ def _iterate(
     result.costs.append(outcome.cost)
 
 
-__all__ = ["EMPTY_RESULT", "Budget", "StoResult", "mppi_weights", "optimise", "sample_base_noise"]
+__all__ = ["Budget", "mppi_weights", "optimise", "sample_base_noise"]

@@ -1,11 +1,11 @@
 """``RolloutPool``: STO rollouts on one or several worker processes, owned and closed by the caller.
 
-The pool keeps pre-built ``SceneRollouts`` (one per scenario, keyed by ``Scenario.key``, the latest
-few, each with its world): with one worker in the pool itself, with several in each worker process, which receives the scenario as YAML text once per task and builds
-its worlds on first use. A rollout then only swaps a trajectory and resets a context. A single
+The pool keeps pre-built ``SceneRollouts`` (one per ``RolloutSpec``, keyed by its ``key``, the latest
+few, each with its world): with one worker in the pool itself, with several in each worker process,
+which receives the spec as YAML text with each task and builds its worlds on first use. A rollout then only swaps a trajectory and resets a context. A single
 rollout (the HLP's first, most often its only one) runs in the calling process; the workers start
 when a batch first needs them, so a run that needs none neither waits for them nor shares its cores
-with their start. The results are the same either way: a rollout is a pure function of the scenario
+with their start. The results are the same either way: a rollout is a pure function of the spec
 and the sequence.
 
 A worker that dies (the out-of-memory killer, a ``kill -9``) breaks its process pool: the pool is
@@ -23,7 +23,7 @@ from collections.abc import Callable
 from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from functools import cached_property
-from typing import TYPE_CHECKING, Self
+from typing import Self
 
 from hlp_drake.runtime.processes import (
     interrupts_held,
@@ -37,13 +37,10 @@ from hlp_drake.systems.low_level.sto.cost import RolloutOutcome, RolloutSamples
 from hlp_drake.systems.low_level.sto.rollout_world import RolloutStart, RolloutWorld, timed_rollout
 from hlp_drake.systems.low_level.sto.sampler import sample_rollout
 from hlp_drake.systems.low_level.sto.sleep import AWAKE, SleepSchedule, Sweep
-
-if TYPE_CHECKING:
-    from hlp_drake.systems.scenario import Scenario
-
+from hlp_drake.systems.low_level.sto.spec import RolloutSpec
 
 WORLDS_KEPT = 4
-"""Scenarios whose rollout worlds a pool (or a worker process) keeps: a scene and the displaced
+"""Specs whose rollout worlds a pool (or a worker process) keeps: a scene and the displaced
 copies of it that ``optimiser.displaced_checks`` verifies on (each world built on first use)."""
 MAX_DEATHS = 3
 """Worker deaths in a row (no batch finished between them) after which a pool gives up."""
@@ -59,13 +56,12 @@ def _finished(future: Future) -> bool:
 
 
 class _Worlds:
-    """``SceneRollouts`` by scenario key, the latest ``WORLDS_KEPT``, built on first use."""
+    """``SceneRollouts`` by spec key, the latest ``WORLDS_KEPT``, built on first use."""
 
     def __init__(self) -> None:
         self._kept: OrderedDict[str, SceneRollouts] = OrderedDict()
 
-    def get(self, key: str, make: Callable[[], Scenario]) -> SceneRollouts:
-
+    def get(self, key: str, make: Callable[[], RolloutSpec]) -> SceneRollouts:
         if key not in self._kept:
             self._kept[key] = SceneRollouts(make())
             while len(self._kept) > WORLDS_KEPT:
@@ -81,11 +77,9 @@ _worker_worlds = _Worlds()  # in a worker process: its worlds, for the pool that
 
 
 def _rollout_task(
-    key: str, scenario_yaml: str, times, knots, start: RolloutStart | None, verify: bool
+    key: str, spec_yaml: str, times, knots, start: RolloutStart | None, verify: bool
 ) -> RolloutOutcome:
-    from hlp_drake.systems.scenario import load_scenario
-
-    world = _worker_worlds.get(key, lambda: load_scenario(data=scenario_yaml))
+    world = _worker_worlds.get(key, lambda: RolloutSpec.from_yaml(spec_yaml))
     sequence = ControlSequence(times, knots)
     return world.verify(sequence, start) if verify else world.rollout(sequence, start)
 
@@ -100,7 +94,7 @@ def _warm_up(delay: float) -> int:
 class RolloutPool:
     """Rolls out control sequences on ``workers`` processes (1: in this process).
 
-    Use as a context manager, or call ``close()``; one pool can serve many scenarios in turn. The
+    Use as a context manager, or call ``close()``; one pool can serve many specs in turn. The
     worker processes start when a batch of rollouts first needs them; single rollouts run here.
 
     Args:
@@ -151,13 +145,13 @@ class RolloutPool:
             self.startup_s += time.perf_counter() - started
         return self._executor
 
-    def world(self, scenario: Scenario) -> SceneRollouts:
-        """This pool's pre-built ``SceneRollouts`` for ``scenario`` (for start checks and in-process rollouts)."""
-        return self._worlds.get(scenario.key, lambda: scenario)
+    def world(self, spec: RolloutSpec) -> SceneRollouts:
+        """This pool's pre-built ``SceneRollouts`` for ``spec`` (for start checks and in-process rollouts)."""
+        return self._worlds.get(spec.key, lambda: spec)
 
     def rollouts(
         self,
-        scenario: Scenario,
+        spec: RolloutSpec,
         sequences: list[ControlSequence],
         *,
         start: RolloutStart | None = None,
@@ -165,17 +159,17 @@ class RolloutPool:
     ) -> list[RolloutOutcome]:
         """The ``RolloutOutcome`` of every sequence, in order, from ``start`` (default: the scene's
         start); with ``verify`` on the execution model (``SceneRollouts.verify``)."""
-        return self._simulate([(scenario, s) for s in sequences], start, verify)
+        return self._simulate([(spec, s) for s in sequences], start, verify)
 
     def verifications(
-        self, scenarios: list[Scenario], sequence: ControlSequence, *, start: RolloutStart | None = None
+        self, specs: list[RolloutSpec], sequence: ControlSequence, *, start: RolloutStart | None = None
     ) -> list[RolloutOutcome]:
-        """The execution model's ``RolloutOutcome`` of ``sequence`` on each scenario's scene, in
-        order (all at once on the workers)."""
-        return self._simulate([(scenario, sequence) for scenario in scenarios], start, True)
+        """The execution model's ``RolloutOutcome`` of ``sequence`` on each spec's scene, in order
+        (all at once on the workers)."""
+        return self._simulate([(spec, sequence) for spec in specs], start, True)
 
     def _simulate(
-        self, jobs: list[tuple[Scenario, ControlSequence]], start: RolloutStart | None, verify: bool
+        self, jobs: list[tuple[RolloutSpec, ControlSequence]], start: RolloutStart | None, verify: bool
     ) -> list[RolloutOutcome]:
         if self.workers == 1 or len(jobs) == 1:
             return [
@@ -241,7 +235,7 @@ class RolloutPool:
         self.close(terminate=kind is not None and issubclass(kind, KeyboardInterrupt))
 
 
-# ``SceneRollouts``: the rollouts of one scenario on its execution model.
+# ``SceneRollouts``: the rollouts of one spec on its execution model.
 #
 # The reduced model (``optimiser.reduced_model``, off by default): most of a rollout's time goes to the
 # contact problem, which every resting object joins with its contact points on the table. An object
@@ -255,17 +249,17 @@ class SceneRollouts:
     A rollout's outcome is a pure function of the scene, the configuration, the start and the sequence.
     """
 
-    def __init__(self, scenario: Scenario) -> None:
-        self.scenario = scenario
+    def __init__(self, spec: RolloutSpec) -> None:
+        self.spec = spec
 
     @cached_property
     def full(self) -> RolloutWorld:
         """The scene's world (built on first use)."""
-        return RolloutWorld(self.scenario)
+        return RolloutWorld(self.spec)
 
     @cached_property
     def _sweep(self) -> Sweep | None:
-        return Sweep(self.full) if self.scenario.optimiser.reduced_model else None
+        return Sweep(self.full) if self.spec.sto.reduced_model else None
 
     @property
     def start_collisions(self) -> tuple[str, ...]:
@@ -275,7 +269,7 @@ class SceneRollouts:
         """When ``sequence``'s commanded motion first comes within ``optimiser.weld_clearance`` of each
         object (from ``start``'s object poses, if given), the objects sleeping until
         ``optimiser.weld_lookahead`` before (never with the reduced model off: ``AWAKE``)."""
-        sto = self.scenario.optimiser
+        sto = self.spec.sto
         if self._sweep is None:
             return AWAKE
         states = None if start is None else start.states
@@ -286,7 +280,9 @@ class SceneRollouts:
     def simulate(self, sequence: ControlSequence, start: RolloutStart | None = None) -> RolloutSamples:
         """Roll ``sequence`` out (from ``start``), reading the state every sample period."""
         schedule = self.sleep_schedule(sequence, start)
-        return sample_rollout(sequence, self.full.scenario.optimiser, self.full, schedule, start=start)
+        return sample_rollout(
+            sequence, self.spec.sto, self.full, schedule, settle_s=self.spec.success.settle_s, start=start
+        )
 
     def rollout(self, sequence: ControlSequence, start: RolloutStart | None = None) -> RolloutOutcome:
         """Simulate ``sequence`` (from ``start``) and cost it."""

@@ -1,6 +1,6 @@
 """``RolloutWorld``: a world built once per scene, in which a control sequence is rolled out with contact.
 
-The world is ``make_world_diagram`` of the scenario: the execution model itself (its plant, contact
+The world is ``world_diagram`` of the spec's scene and world model: the execution model itself (its plant, contact
 geometry and settling), with a C++ ``TrajectorySource`` driving the robot; the initial context is
 kept. A rollout swaps the source's trajectory, resets the context (or sets a given start state) and
 simulates, Python only reading the state (``Reading``) every ``optimiser.sample_period``. Objects
@@ -45,24 +45,12 @@ from hlp_drake.systems.low_level.sto.sampler import (
 )
 from hlp_drake.systems.low_level.sto.sleep import AWAKE, ProximityContext
 from hlp_drake.systems.world.scene_models import TABLE_NAME, object_body, over_table_mask
+from hlp_drake.systems.world.simulation import simulation_failure
 from hlp_drake.systems.world.start_pose import tcp_keypoint_height
-from hlp_drake.systems.world.world import add_position_trajectory, make_world_diagram, world_plant
+from hlp_drake.systems.world.world import add_position_trajectory, world_diagram, world_plant
 
 if TYPE_CHECKING:
-    from hlp_drake.systems.scenario import Scenario
-
-
-def simulation_failure(error: BaseException) -> str:
-    """One line on a Drake simulation failure: a ``RuntimeError``'s first line, or one of Drake's
-    internal checks failing (pydrake raises those as ``SystemExit("Failure at ...")``; a state turned
-    non-finite, the contact solver having diverged, is said so). Any other ``SystemExit`` is raised
-    again."""
-    if isinstance(error, SystemExit) and not str(error).startswith("Failure at"):
-        raise error
-    line = str(error).splitlines()[0]
-    if "AllFinite" in line:
-        return "the simulation diverged (the state turned non-finite)"
-    return line
+    from hlp_drake.systems.low_level.sto.spec import RolloutSpec
 
 
 @dataclass(frozen=True)
@@ -75,20 +63,20 @@ class RolloutStart:
 
 
 class RolloutWorld:
-    """A pre-built world for rolling out control sequences on ``scenario``'s scene, on its execution
-    model (one per worker process).
+    """A pre-built world for rolling out control sequences on ``spec``'s scene, in its world model
+    (one per worker process).
 
     Every object is a free body; ``begin(..., asleep=...)`` and ``set_asleep`` lock and unlock their
     joints (``rollout_sampler``).
     """
 
-    def __init__(self, scenario: Scenario) -> None:
-        self.key = scenario.key
-        scene = scenario.scene
+    def __init__(self, spec: RolloutSpec) -> None:
+        self.key = spec.key
+        scene = spec.scene
         self.scene = scene
-        self.scenario = scenario
+        self.spec = spec
         builder = DiagramBuilder()
-        world = builder.AddSystem(make_world_diagram(scenario, cameras=False))
+        world = builder.AddSystem(world_diagram(scene, spec.model))
         plant, robot = world_plant(world)
         start = plant.GetPositions(plant.CreateDefaultContext(), robot)
         hold = ControlSequence(np.array([0.0, 1.0]), np.vstack([start, start])).to_trajectory()
@@ -112,8 +100,8 @@ class RolloutWorld:
         }
         self._table_bodies = {int(i) for i in plant.GetBodyIndices(plant.GetModelInstanceByName(TABLE_NAME))}
         self.robot_bodies = {int(i) for i in plant.GetBodyIndices(robot)}
-        self._tcp = plant.GetFrameByName(scenario.robot.tcp_frame, robot)
-        self._tcp_height = tcp_keypoint_height(scene, scenario.ik)
+        self._tcp = plant.GetFrameByName(spec.model.robot.tcp_frame, robot)
+        self._tcp_height = tcp_keypoint_height(scene, spec.model.ik)
         inspector = world.GetSubsystemByName("scene_graph").model_inspector()
         self.geometry_body = {
             g: int(plant.GetBodyFromFrameId(inspector.GetFrameId(g)).index())
@@ -276,7 +264,7 @@ class RolloutWorld:
             plant.get_contact_results_output_port().Eval(context), self._body_kind
         )
         problem = None
-        sto = self.scenario.optimiser
+        sto = self.spec.sto
         table = self.scene.table
         # Objects pushed off the edge fall freely (a legitimate outcome); only objects over the table
         # are checked for impossible speeds and for sinking into it.
@@ -295,14 +283,17 @@ class RolloutWorld:
     def simulate(self, sequence: ControlSequence, start: RolloutStart | None = None) -> RolloutSamples:
         """Roll ``sequence`` out from the initial state (or ``start``) with every object awake,
         reading the state every sample period (the full model)."""
-        return sample_rollout(sequence, self.scenario.optimiser, self, AWAKE, start=start)
+        return sample_rollout(
+            sequence, self.spec.sto, self, AWAKE, settle_s=self.spec.success.settle_s, start=start
+        )
 
     def cost(self, samples: RolloutSamples, sequence: ControlSequence) -> RolloutOutcome:
         """The cost of ``sequence``'s rollout from its ``samples``."""
         return rollout_cost(
             samples,
             self.scene,
-            self.scenario.optimiser,
+            self.spec.sto,
+            success=self.spec.success,
             tcp_height=self._tcp_height,
             effort=sequence.effort(),
             step_duration=float(np.mean(sequence.steps)),
@@ -323,7 +314,7 @@ def timed_rollout(
     prediction = Prediction(samples.times, samples.positions, samples.tcp)
     final = None
     if start is None and not samples.asleep and samples.switches == 0:
-        final = FinalState(costing.key, costing.time(), costing.states())
+        final = FinalState(costing.spec.world_key, costing.time(), costing.states())
     outcome = replace(
         costing.cost(samples, sequence),
         asleep=samples.asleep,

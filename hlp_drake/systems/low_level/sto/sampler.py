@@ -77,7 +77,7 @@ def _near_asleep(
     step = float(np.max(motion[moved], initial=0.0))
     watchers = {name for name, m in zip(names, moved[world.num_robot_bodies :]) if m}
     near = set()
-    for a, b, _ in pairs.within(world.scenario.optimiser.weld_margin + step):
+    for a, b, _ in pairs.within(world.spec.sto.weld_margin + step):
         for sleeper, other in ((a, b), (b, a)):
             name, other_name = world.object_name(sleeper), world.object_name(other)
             if name in asleep and (other in world.robot_bodies or other_name in watchers):
@@ -130,16 +130,18 @@ def sample_rollout(
     world: RolloutWorld,
     schedule: SleepSchedule,
     *,
+    settle_s: float,
     start: RolloutStart | None = None,
 ) -> RolloutSamples:
     """Roll ``sequence`` out on ``world`` and read the state every ``sto.sample_period``, its objects
-    asleep and awake as ``schedule`` and the checks of the module's docstring say.
+    asleep and awake as ``schedule`` and the checks of the module's docstring say, until ``settle_s``
+    after its end.
 
     Args:
         start: the state to start from (default: the scene's, the robot at its start configuration);
             objects moving in it start awake.
     """
-    end = sequence.duration + sto.settle_s
+    end = sequence.duration + settle_s
     count = max(1, math.ceil(end / sto.sample_period - 1e-9))
     times = np.minimum(sto.sample_period * np.arange(count + 1), end)
     initial = None if start is None else start.states

@@ -78,7 +78,7 @@ class Sweep:
         trajectory = sequence.to_trajectory()
         names = {int(b.index()): b.name() for b in world.objects}
         first = {obj.name: math.inf for obj in world.scene.objects}
-        period = world.scenario.optimiser.sample_period
+        period = world.spec.sto.sample_period
         times = np.union1d(sequence.times, np.arange(0.0, sequence.duration, period))
         for t in times:
             proximity.set_instance_positions(world.robot, trajectory.value(t).ravel())

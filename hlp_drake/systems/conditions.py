@@ -1,0 +1,86 @@
+"""``Conditions``: what a run's command line, or one cell of a study's grid, sets over a scenario.
+
+The one way options become a ``Scenario``: ``run_scene``'s flags, the experiments' flags and a
+study's grid cells are each a ``Conditions``, applied by ``Conditions.applied``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
+
+from hlp_drake.systems.low_level.registry import low_level_entry
+from hlp_drake.systems.planning.initialisers import initialiser_name
+from hlp_drake.systems.world.robot_description import load_robot
+
+if TYPE_CHECKING:
+    from hlp_drake.scene.model import Scene
+    from hlp_drake.systems.scenario import Scenario
+
+EXECUTIONS = ("open", "closed")
+
+
+@dataclass(frozen=True)
+class Conditions:
+    """Settings laid over a scenario; None leaves the scenario's.
+
+    Attributes:
+        robot: a shipped robot's name or a robot description file (``load_robot``).
+        initial: the initialiser (``INITIALISERS``; ``sto`` for ``line``).
+        low_level: the low-level planner (``LOW_LEVEL_PLANNERS``); another than the scenario's
+            starts from its default settings.
+        execution: "open" (play the planned motion) or "closed" (the receding-horizon controller).
+        uncertainty: the seed of the model error the world has and the planners do not know of.
+        perception: "truth" (the plant's poses) or "camera" (the cameras' perception).
+        workers: rollout processes of a low-level planner that rolls out (others ignore it).
+    """
+
+    robot: str | None = None
+    initial: str | None = None
+    low_level: str | None = None
+    execution: str | None = None
+    uncertainty: int | None = None
+    perception: str | None = None
+    workers: int | None = None
+
+    def applied(self, scenario: Scenario, *, scene: Scene | None = None) -> Scenario:
+        """``scenario`` under these conditions, on ``scene`` if given (None: its own), checked once.
+
+        Raises:
+            HlpError: an unknown robot, initialiser or low-level planner, or settings that do not
+                fit together (e.g. a camera source without a camera), one line each.
+        """
+        changes: dict = {} if scene is None else {"scene": scene}
+        if self.robot is not None:
+            changes["robot"] = load_robot(self.robot)
+        planner = self._planner(scenario)
+        if planner is not scenario.planner:
+            changes["planner"] = planner
+        if self.execution is not None:
+            changes["closed_loop"] = replace(scenario.closed_loop, enabled=self.execution == "closed")
+        if self.uncertainty is not None:
+            changes["uncertainty"] = replace(scenario.uncertainty, enabled=True, seed=int(self.uncertainty))
+        if self.perception is not None:
+            changes["perception"] = replace(scenario.perception, source=self.perception)
+        return replace(scenario, **changes) if changes else scenario  # checked as it is made
+
+    def _planner(self, scenario: Scenario):
+        """The scenario's ``planner`` section under these conditions (itself if unchanged)."""
+        planner = scenario.planner
+        if self.initial is not None and initialiser_name(self.initial) != planner.initial:
+            planner = replace(planner, initial=initialiser_name(self.initial))
+        if self.low_level is not None and self.low_level != planner.low_level.kind:
+            planner = replace(planner, low_level=low_level_entry(self.low_level).config_class()())
+        low_level = planner.low_level
+        if self.workers is not None and getattr(low_level, "workers", self.workers) != self.workers:
+            planner = replace(planner, low_level=replace(low_level, workers=self.workers))
+        return planner
+
+
+def rollout_workers(scenario: Scenario) -> int | None:
+    """The rollout processes the scenario's low-level planner needs (None: it does not roll out)."""
+    entry = low_level_entry(scenario.low_level.kind)
+    return getattr(scenario.low_level, "workers", 1) if entry.rolls_out else None
+
+
+__all__ = ["EXECUTIONS", "Conditions", "rollout_workers"]

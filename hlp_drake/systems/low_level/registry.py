@@ -1,0 +1,94 @@
+"""The low-level planners by name: ``LOW_LEVEL_PLANNERS``, the one list the scenario
+(``planner.low_level.kind``), ``--low-level`` and the planning diagram read.
+
+An entry names the planner's settings class and its planner (``"module:name"`` strings, imported on
+first use, so reading the names imports nothing else; or the objects themselves) and says whether
+it rolls out (then it needs a ``RolloutPool``) and whether it can re-plan from a measured state
+(then it can run closed loop). Register a planner of your own with ``register_low_level``.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from hlp_drake.errors import HlpError
+
+if TYPE_CHECKING:
+    from hlp_drake.systems.low_level.protocol import LowLevelConfig, LowLevelContext, LowLevelPlanner
+
+
+def _resolve(reference: str | Any) -> Any:
+    """The object ``"module:name"`` names (imported now), or ``reference`` itself."""
+    if not isinstance(reference, str):
+        return reference
+    module, _, name = reference.partition(":")
+    return getattr(importlib.import_module(module), name)
+
+
+@dataclass(frozen=True)
+class LowLevelEntry:
+    """One low-level planner.
+
+    Attributes:
+        name: its name (``planner.low_level.kind``, ``--low-level``).
+        config: its settings class (a ``LowLevelConfig`` whose ``kind`` defaults to ``name``).
+        planner: makes it: ``planner(config, context)`` with a ``LowLevelContext``.
+        about: one line on what it is.
+        rolls_out: it simulates in a rollout pool (``RolloutPool``), whose size is its ``workers``.
+        replans: it re-plans from a measured state (``replan``): closed-loop execution can use it.
+    """
+
+    name: str
+    config: str | type
+    planner: str | Callable[..., Any]
+    about: str
+    rolls_out: bool = False
+    replans: bool = False
+
+    def config_class(self) -> type[LowLevelConfig]:
+        return _resolve(self.config)
+
+    def make(self, config: LowLevelConfig, context: LowLevelContext) -> LowLevelPlanner:
+        """The planner of ``config`` (this entry's settings) with ``context``."""
+        return _resolve(self.planner)(config, context)
+
+
+LOW_LEVEL_PLANNERS: dict[str, LowLevelEntry] = {}
+"""The registered low-level planners, by name."""
+
+
+def register_low_level(entry: LowLevelEntry) -> LowLevelEntry:
+    """Add ``entry`` (its name must be new) and return it."""
+    if entry.name in LOW_LEVEL_PLANNERS:
+        raise ValueError(f"a low-level planner named {entry.name!r} is registered already")
+    LOW_LEVEL_PLANNERS[entry.name] = entry
+    return entry
+
+
+def low_level_entry(name: str) -> LowLevelEntry:
+    """The entry named ``name``.
+
+    Raises:
+        HlpError: no planner has that name (the message names the known ones).
+    """
+    entry = LOW_LEVEL_PLANNERS.get(name)
+    if entry is None:
+        raise HlpError(f"unknown low-level planner {name!r} (known: {', '.join(LOW_LEVEL_PLANNERS)})")
+    return entry
+
+
+register_low_level(
+    LowLevelEntry(
+        "sto",
+        "hlp_drake.systems.low_level.sto.config:StoConfig",
+        "hlp_drake.systems.low_level.sto.planner:StoPlanner",
+        "the physics-based stochastic trajectory optimiser (the paper's): rollouts with contact",
+        rolls_out=True,
+        replans=True,
+    )
+)
+
+__all__ = ["LOW_LEVEL_PLANNERS", "LowLevelEntry", "low_level_entry", "register_low_level"]

@@ -1,0 +1,118 @@
+"""``StoPlanner``: the stochastic trajectory optimiser as a low-level planner (the registry's ``sto``).
+
+It samples the initial trajectory at its control steps (``step_duration``) and optimises the
+sequence in rollouts of the scene in its world model (``optimise``); when the initial rollout
+fails, it tries the initialiser's alternatives. ``replan`` re-optimises from a measured state
+with a smaller budget: the receding-horizon controller's closed loop.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from hlp_drake.systems.low_level.control_sequence import ControlSequence
+from hlp_drake.systems.low_level.protocol import LowLevelContext, LowLevelProblem
+from hlp_drake.systems.low_level.result import EMPTY_RESULT, LowLevelResult, unplanned
+from hlp_drake.systems.low_level.sto.budget import Budget
+from hlp_drake.systems.low_level.sto.config import StoConfig
+from hlp_drake.systems.low_level.sto.optimiser import optimise
+from hlp_drake.systems.low_level.sto.spec import RolloutSpec
+from hlp_drake.systems.world.model import WorldModel
+from hlp_drake.systems.world.success import SuccessConfig
+
+if TYPE_CHECKING:
+    from pydrake.trajectories import PiecewisePolynomial
+
+    from hlp_drake.scene.model import Scene
+    from hlp_drake.systems.low_level.sto.pool import RolloutPool
+    from hlp_drake.systems.low_level.sto.rollout_world import RolloutStart
+
+
+class StoPlanner:
+    """The STO (see the module's docstring).
+
+    Args:
+        config: its settings.
+        context: ``model``, the world model it rolls out in; ``pool``, the rollout workers (the
+            caller's, who closes them); ``perceived``, whether it plans on a scene seen by cameras
+            (then a passing sequence must also pass with the objects displaced, ``displaced_checks``).
+    """
+
+    kind = "sto"
+
+    def __init__(self, config: StoConfig, context: LowLevelContext) -> None:
+        if context.pool is None:
+            raise ValueError("the STO rolls out: give it a RolloutPool")
+        self.config, self.model, self.pool = config, context.model, context.pool
+        self.perceived, self.success = context.perceived, context.success
+
+    @classmethod
+    def of(
+        cls,
+        config: StoConfig | None = None,
+        *,
+        pool: RolloutPool,
+        model: WorldModel | None = None,
+        perceived: bool = False,
+        success: SuccessConfig | None = None,
+    ) -> StoPlanner:
+        """``StoPlanner`` from keyword arguments (defaults: a ``Scenario``'s settings and world model)."""
+        context = LowLevelContext(model or WorldModel(), pool, perceived, success or SuccessConfig())
+        return cls(config or StoConfig(), context)
+
+    def spec(self, scene: Scene) -> RolloutSpec:
+        """What its rollouts on ``scene`` simulate."""
+        return RolloutSpec(scene, self.model, self.config, self.success)
+
+    def as_commanded(self, trajectory: PiecewisePolynomial) -> ControlSequence:
+        return ControlSequence.from_trajectory(trajectory, self.config.step_duration)
+
+    def plan(self, problem: LowLevelProblem) -> LowLevelResult:
+        if problem.initial.get_number_of_segments() == 0:
+            return unplanned(_held(problem), "no initial trajectory", self.kind)
+        initial = self.as_commanded(problem.initial)
+
+        def alternatives() -> list[ControlSequence]:
+            return [self.as_commanded(t) for t in problem.alternatives()]
+
+        budget = Budget.of(self.config, perceived=self.perceived)
+        return optimise(self.spec(problem.scene), initial, self.pool, alternatives=alternatives, budget=budget)
+
+    def replan(
+        self,
+        scene: Scene,
+        initial: ControlSequence,
+        *,
+        start: RolloutStart,
+        iterations: int,
+        rollouts: int,
+        attempt: int,
+        alternatives: Callable[[], Sequence[ControlSequence]] | None = None,
+    ) -> LowLevelResult:
+        """Re-optimise ``initial`` on ``scene`` from the measured ``start``, with ``iterations`` and
+        ``rollouts`` (its ``attempt``-th re-plan: the noise's seed), trying ``alternatives`` (the first
+        of them; None: none) if its rollout fails; no verification (the execution goes on from there)."""
+        budget = Budget(
+            self.config.samples,
+            iterations,
+            rollouts,
+            alternatives=0 if alternatives is None else 1,
+            seed=self.config.seed + 1 + attempt,
+        )
+        return optimise(
+            self.spec(scene), initial, self.pool, budget=budget, start=start, alternatives=alternatives
+        )
+
+
+def _held(problem: LowLevelProblem) -> ControlSequence:
+    """The robot held at its start for a second (the keyframes' start), when there is no motion."""
+    if problem.keyframes is None:
+        return EMPTY_RESULT.sequence
+    start = np.asarray(problem.keyframes.start, dtype=float)
+    return ControlSequence(np.array([0.0, 1.0]), np.vstack([start, start]))
+
+
+__all__ = ["StoPlanner"]

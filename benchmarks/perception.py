@@ -89,7 +89,7 @@ def perceive_scene(kind_seed: tuple[int, int], camera: CameraConfig, models) -> 
         p: world.GetOutputPort(f"{camera.name}.{p}").Eval(context) for p in ("depth_image", "label_image")
     }
     render_s = time.perf_counter() - started
-    block = ScenePerception(scenario)
+    block = ScenePerception(template=scenario.scene, config=scenario.perception)
     block_context = block.CreateDefaultContext()
     for port, value in frame.items():
         block.GetInputPort(f"{camera.name}.{port}").FixValue(block_context, value)

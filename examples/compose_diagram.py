@@ -9,7 +9,7 @@ from hlp_drake.systems import (
     world_plant,
 )
 
-scenario = load_scenario(data="optimiser: {workers: 1}")  # the bundled default scene, 1 rollout process
+scenario = load_scenario(data="planner: {low_level: {workers: 1}}")  # the bundled default scene, 1 rollout process
 with RolloutPool(scenario.optimiser.workers) as pool:
     builder = DiagramBuilder()
     world = builder.AddNamedSystem("world", make_world_diagram(scenario))

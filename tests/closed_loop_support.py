@@ -7,7 +7,8 @@ from pydrake.systems.framework import DiagramBuilder
 
 from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
-from hlp_drake.systems.low_level.sto.optimiser import StoResult
+from hlp_drake.systems.low_level.result import LowLevelResult
+from hlp_drake.systems.low_level.sto.planner import StoPlanner
 from hlp_drake.systems.low_level.sto.pool import RolloutPool
 from hlp_drake.systems.perception.system import add_scene_perception
 from hlp_drake.systems.scenario import Scenario
@@ -26,11 +27,9 @@ def run_controller(
     world = builder.AddSystem(make_world_diagram(scenario))
     plant, robot = world_plant(world)
     with RolloutPool(1) as pool:
-        controller = builder.AddNamedSystem(
-            "controller", RecedingHorizonController(scenario, plant, pool, initialiser=initialiser)
-        )
+        controller = builder.AddNamedSystem("controller", controller_of(scenario, plant, pool, initialiser))
         if scenario.perception.source == "camera":
-            source = add_scene_perception(builder, world, scenario)
+            source = add_scene_perception(builder, world, template=scenario.scene, config=scenario.perception)
             builder.Connect(source.get_perception_output_port(), controller.GetInputPort("perception"))
         else:
             source = builder.AddNamedSystem("scene_from_plant", SceneFromPlant(plant, scenario.scene))
@@ -41,7 +40,7 @@ def run_controller(
         simulator = Simulator(builder.Build())
         context = simulator.get_mutable_context()
         controller.GetInputPort("initial").FixValue(
-            controller.GetMyMutableContextFromRoot(context), StoResult(sequence, outcome, True, None)
+            controller.GetMyMutableContextFromRoot(context), LowLevelResult(sequence, outcome, True, None)
         )
         simulator.AdvanceTo(until)
         record = controller.record(context)
@@ -50,3 +49,22 @@ def run_controller(
         )
         q = plant.GetPositions(plant.GetMyContextFromRoot(context), robot)
     return record, desired, q
+
+
+def controller_of(
+    scenario: Scenario, plant, pool: RolloutPool, initialiser=None
+) -> RecedingHorizonController:
+    """The receding-horizon controller of ``scenario`` (its STO, closed loop, robot and measured
+    objects: all of them unless the cameras see the scene)."""
+    camera = scenario.perception.source == "camera"
+    planner = StoPlanner.of(
+        scenario.low_level, pool=pool, model=scenario.world_model, perceived=camera, success=scenario.success
+    )
+    return RecedingHorizonController(
+        plant,
+        planner=planner,
+        closed_loop=scenario.closed_loop,
+        robot=scenario.robot.name,
+        objects=() if camera else tuple(o.name for o in scenario.scene.objects),
+        initialiser=initialiser,
+    )

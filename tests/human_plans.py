@@ -96,10 +96,12 @@ def chain_first_rollout(scenario, human: HighLevelPlan):
     from hlp_drake.systems import make_planning_diagram
     from hlp_drake.systems.low_level.control_sequence import ControlSequence
     from hlp_drake.systems.low_level.sto.pool import SceneRollouts
+    from hlp_drake.systems.low_level.sto.spec import RolloutSpec
 
     diagram = make_planning_diagram(scenario, plan=human)
     context = diagram.CreateDefaultContext()
     diagram.GetInputPort("scene").FixValue(context, scenario.scene)
     trajectory = diagram.GetOutputPort("trajectory").Eval(context)
-    sequence = ControlSequence.from_trajectory(trajectory, scenario.optimiser.step_duration)
-    return SceneRollouts(scenario).rollout(sequence)
+    sequence = ControlSequence.from_trajectory(trajectory, scenario.low_level.step_duration)
+    spec = RolloutSpec(scenario.scene, scenario.world_model, scenario.low_level, scenario.success)
+    return SceneRollouts(spec).rollout(sequence)

@@ -1,5 +1,5 @@
-"""Fixtures of the optimiser's tests: the default scene, both planners' initial trajectories on it,
-a rollout world, and helpers for scenarios and short sequences."""
+"""Fixtures of the optimiser's tests: the default scene, both initialisers' trajectories on it, a
+rollout world, and helpers for scenarios, rollout specs and short sequences."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ from hlp_drake.commands.run_scene import DEFAULT_SCENE
 from hlp_drake.scene.io import load_scene
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
 from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld
+from hlp_drake.systems.low_level.sto.spec import RolloutSpec
 from hlp_drake.systems.planning.diagram import make_planning_diagram
 from hlp_drake.systems.scenario import Scenario
 
@@ -20,6 +21,17 @@ def on(scene, data: str | None = None) -> Scenario:
     return scenario if data is None else scenario.updated(data)
 
 
+def spec(scenario: Scenario) -> RolloutSpec:
+    """What the STO of ``scenario`` rolls out: its scene, world model, STO settings and success test."""
+    return RolloutSpec(scenario.scene, scenario.world_model, scenario.low_level, scenario.success)
+
+
+def sto(scene, settings: str = "") -> RolloutSpec:
+    """``spec`` of the default scenario on ``scene`` with the STO's ``settings`` (YAML flow mapping
+    items, e.g. ``"samples: 2"``)."""
+    return spec(on(scene, f"planner: {{low_level: {{{settings}}}}}"))
+
+
 @pytest.fixture(scope="module")
 def scene():
     return load_scene(DEFAULT_SCENE)
@@ -27,19 +39,19 @@ def scene():
 
 @pytest.fixture(scope="module")
 def trajectories(scene):
-    """The initial (IK) trajectories of both planners on the default scene."""
+    """The initial (IK) trajectories of both initialisers on the default scene, by name."""
     result = {}
-    for planner in ("hlp", "sto"):
-        diagram = make_planning_diagram(on(scene, f"planner: {{kind: {planner}}}"))
+    for initial in ("hlp", "line"):
+        diagram = make_planning_diagram(on(scene, f"planner: {{initial: {initial}}}"))
         context = diagram.CreateDefaultContext()
         diagram.GetInputPort("scene").FixValue(context, scene)
-        result[planner] = diagram.GetOutputPort("trajectory").Eval(context)
+        result[initial] = diagram.GetOutputPort("trajectory").Eval(context)
     return result
 
 
 @pytest.fixture(scope="module")
 def world(scene):
-    return RolloutWorld(on(scene))
+    return RolloutWorld(spec(on(scene)))
 
 
 def short(sequence: ControlSequence, horizon: float) -> ControlSequence:

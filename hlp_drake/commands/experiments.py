@@ -1,18 +1,23 @@
-"""The paper's Generalization I and II experiments (Tables II and III), resumable, local or on dask.
+"""Studies: a grid of conditions run on seeded scenes, resumable, local or on dask; the paper's Tables II and III are the bundled gen1 and gen2.
 
-    python -m hlp_drake.experiments {gen1,gen2} [--scenes 100] [--objects 5 7 9] [--seed S]
+    python -m hlp_drake.experiments {gen1,gen2,STUDY.yaml} [--scenes N] [--objects K ...] [--seed S]
+        [--robot NAME|FILE ...] [--tables NAME|FILE] [--planner hlp|line ...] [--low-level NAME ...]
+        [--execution open|closed ...] [--perception truth|camera ...] [--uncertainty [SEED]]
         [--workers N] [--executor local|dask] [--scheduler ADDRESS] [--config SCENARIO.yaml]
-        [--perception truth|camera] [--execution open|closed] [--uncertainty [SEED]] [--fresh] [--quiet | --verbose]
-        --out DIR
+        [--fresh] [--quiet | --verbose] --out DIR
 
-Every scene is planned and executed with both planners (HLP and STO's straight line); scene i has
-seed S + i (gen2: for each object count). Writes DIR/results.csv (resumable: run the same command
-again after an interrupt), config.json (what the rows depend on), run.json (the run's settings,
-what it ran, machine and software), summary.md/.json (Table II or III beside the paper's numbers,
-and the ratio of the planners' mean total times), success.png and times.png. Times are planning times (plan + IK + optimisation), without the
-simulated execution; run with --workers 1 for times comparable to the paper's (parallel jobs share
-the cores). With --perception camera both planners plan on the scene the world's cameras see
-(ScenePerception) while the simulation runs the true one: Table III on perceived scenes.
+A study (hlp_drake.experiments.Study) names its scene generators, object counts, scenes and first
+seed, and the axes of its grid: robots, initialisers, low-level planners, execution modes, perception
+sources and model errors. gen1 (Table II) and gen2 (Table III) plan and execute every scene with both
+initialisers (the human-like plan and the straight line) on the STO; the options replace the study's
+settings (several values: one cell each). Scene i has seed S + i (for each generator and object
+count). Writes DIR/results.csv (resumable: run the same command again after an interrupt), one row
+per scene and cell, config.json (what the rows depend on), run.json (the run's settings, what it
+ran, machine and software), summary.md/.json (the study's table beside the paper's numbers, and the
+ratios of the initialisers' mean total times), success.png and times.png. Times are planning times
+(plan + IK + low-level planning), without the simulated execution; run with --workers 1 for times
+comparable to the paper's (parallel jobs share the cores). With --perception camera the planners plan
+on the scene the world's cameras see (ScenePerception) while the simulation runs the true one.
 """
 
 from __future__ import annotations
@@ -21,6 +26,7 @@ import argparse
 import shlex
 import sys
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
 
 from hlp_drake.commands.parsing import (
@@ -28,6 +34,7 @@ from hlp_drake.commands.parsing import (
     MAX_WORKERS,
     add_conditions,
     add_perception,
+    add_planner_options,
     add_robot_option,
     add_verbosity,
     drake_logging,
@@ -36,39 +43,56 @@ from hlp_drake.commands.parsing import (
 )
 from hlp_drake.experiments.executors import EXECUTORS
 from hlp_drake.experiments.experiment import CONFIG, DERIVED, RESULTS, RUN, ExperimentSettings, run_experiment
-from hlp_drake.experiments.runner import KINDS, JobFunction, ScenarioResolver
+from hlp_drake.experiments.runner import JobFunction, StudyResolver
+from hlp_drake.experiments.study import MAX_SCENES, Study, bundled_studies, load_study
 from hlp_drake.experiments.summary import summary_markdown
-from hlp_drake.files.documents import read_document
 from hlp_drake.scene.generators import MAX_GENERATED
 
 PROG = "python -m hlp_drake.experiments"
+OVERRIDES = {
+    "scenes": "scenes",
+    "objects": "objects",
+    "seed": "seed",
+    "robot": "robots",
+    "planner": "initialisers",
+    "low_level": "low_level",
+    "execution": "execution",
+    "perception": "perception",
+    "tables": "tables",
+}
+"""The options that replace a study's settings: option -> ``Study`` field."""
 
 
 def _parser() -> argparse.ArgumentParser:
     parser = make_parser(PROG, __doc__)
-    parser.add_argument("kind", choices=KINDS, help="gen1: Table II; gen2: Table III")
     parser.add_argument(
-        "--scenes",
-        type=integer(1, 100_000),
-        default=100,
-        metavar="N",
-        help="scenes per condition (default 100)",
+        "study",
+        metavar="STUDY",
+        help=f"a bundled study ({', '.join(bundled_studies())}: Tables II and III) or a study .yaml file",
+    )
+    parser.add_argument(
+        "--scenes", type=integer(1, MAX_SCENES), metavar="N", help="scenes per condition (gen1, gen2: 100)"
     )
     parser.add_argument(
         "--objects",
         type=integer(1, MAX_GENERATED),
         nargs="+",
-        default=[5, 7, 9],
         metavar="K",
-        help="gen2's object counts, one condition each (default 5 7 9; gen1 ignores it: 6)",
+        help="object counts, one condition each (gen2: 5 7 9; gen1 ignores it: 6)",
     )
     parser.add_argument(
-        "--seed",
-        type=integer(0, MAX_SEED - 100_000),
-        default=0,
-        metavar="S",
-        help="scene i has seed S + i (default 0)",
+        "--seed", type=integer(0, MAX_SEED - MAX_SCENES), metavar="S", help="scene i has seed S + i (default 0)"
     )
+    add_robot_option(parser, several=True)
+    parser.add_argument(
+        "--tables",
+        metavar="NAME|FILE",
+        help="generate the tables within this robot's reach instead of --robot's (e.g. --robot "
+        "mobile_ur5 --tables panda: the mobile UR5 on the Panda's scenes)",
+    )
+    add_planner_options(parser, several=True)
+    add_perception(parser, several=True)
+    add_conditions(parser, several=True)
     parser.add_argument(
         "--workers", type=integer(1, MAX_WORKERS), metavar="N", help="jobs at a time (default: one per core)"
     )
@@ -79,74 +103,67 @@ def _parser() -> argparse.ArgumentParser:
         help="local (default): this process or a process pool; dask: a dask cluster",
     )
     parser.add_argument(
-        "--scheduler",
-        metavar="ADDRESS",
-        help="dask scheduler address (default: a LocalCluster of --workers processes)",
+        "--scheduler", metavar="ADDRESS", help="dask scheduler address (default: a LocalCluster of --workers processes)"
     )
     parser.add_argument(
         "--config",
         metavar="SCENARIO.yaml",
         help="scenario settings (see hlp_drake.systems.Scenario); each job has its own scene",
     )
-    add_perception(parser)
-    add_robot_option(parser)
-    parser.add_argument(
-        "--tables",
-        metavar="NAME|FILE",
-        help="generate the tables within this robot's reach instead of --robot's (e.g. --robot "
-        "mobile_ur5 --tables panda: the mobile UR5 on the Panda's scenes)",
-    )
-    add_conditions(parser)
     parser.add_argument("--fresh", action="store_true", help="discard DIR's earlier results and start over")
     add_verbosity(parser)
-    parser.add_argument(
-        "--out", required=True, metavar="DIR", help="output directory (resumes the run there)"
-    )
+    parser.add_argument("--out", required=True, metavar="DIR", help="output directory (resumes the run there)")
     return parser
+
+
+def study_of(args: argparse.Namespace) -> Study:
+    """The study ``args.study`` names, with the options given in place of its settings."""
+    study = load_study(args.study)
+    changes = {
+        field: tuple(value) if isinstance(value, list) else value
+        for option, field in OVERRIDES.items()
+        if (value := getattr(args, option)) is not None
+    }
+    if args.uncertainty is not None:
+        changes["model_error"] = (args.uncertainty,)
+    return replace(study, **changes) if changes else study
 
 
 def main(
     argv: Sequence[str] | None = None,
     *,
     job: JobFunction | None = None,
-    scenario: ScenarioResolver | None = None,
+    resolve: StudyResolver | None = None,
 ) -> int:
-    """Run the experiment of ``argv``; ``job`` and ``scenario`` replace the real (scene, planner) job
-    and scenario reading (``hlp_drake.systems.execution.job``'s, which import Drake), e.g. in tests."""
+    """Run the study of ``argv``; ``job`` and ``resolve`` replace the real (scene, cell) job and the
+    reading of the study's scenario (``hlp_drake.systems.execution.job``'s, which import Drake),
+    e.g. in tests."""
     parser = _parser()
     args = parser.parse_args(argv)
     drake_logging(args.verbose)  # before Drake is first imported
+    study = study_of(args)
     config_yaml = None
     if args.config:
-        config_yaml = read_document(args.config, missing="scenario file not found")
-    if args.config or args.execution is not None or args.uncertainty is not None:
-        from hlp_drake.systems.scenario import load_scenario, with_conditions
+        from hlp_drake.systems.scenario import load_scenario
 
-        loaded = load_scenario(args.config)  # a robot model's relative path: beside the file
-        config_yaml = with_conditions(loaded, execution=args.execution, uncertainty=args.uncertainty).yaml
+        config_yaml = load_scenario(args.config).yaml  # a robot model's relative path: beside the file
     settings = ExperimentSettings(
-        kind=args.kind,
-        scenes=args.scenes,
-        objects=tuple(args.objects),
-        seed=args.seed,
+        study=study,
         workers=args.workers,
         executor=args.executor,
         scheduler=args.scheduler,
         config_yaml=config_yaml,
-        perception=args.perception,
-        robot=args.robot,
-        tables=args.tables,
         scenario_file=args.config,
         fresh=args.fresh,
         progress=not args.quiet,
     )
     command = f"{parser.prog} {shlex.join(sys.argv[1:] if argv is None else argv)}"
-    if job is None or scenario is None:
+    if job is None or resolve is None:
         from hlp_drake.systems.execution import job as drake_side
 
         job = job or drake_side.run_job
-        scenario = scenario or drake_side.scenario_yamls
-    summary = run_experiment(settings, args.out, job=job, scenario=scenario, command=command)
+        resolve = resolve or drake_side.resolve_study
+    summary = run_experiment(settings, args.out, job=job, resolve=resolve, command=command)
     print(summary_markdown(summary), end="")
     print(f"wrote {', '.join(str(Path(args.out) / name) for name in (RESULTS, CONFIG, RUN, *DERIVED))}")
     return 0

@@ -22,6 +22,7 @@ from hlp_drake import DRAKE_LOG, __version__
 from hlp_drake.errors import HlpError
 from hlp_drake.models import SHIPPED_ROBOTS
 from hlp_drake.runtime.processes import Terminated, terminations_raised
+from hlp_drake.systems.names import EXECUTIONS, PERCEPTION_SOURCES
 
 EXIT_USER_ERROR = 2
 EXIT_TERMINATED = 143  # 128 + SIGTERM
@@ -159,38 +160,38 @@ def add_planner_options(parser: argparse.ArgumentParser, *, several: bool = Fals
     )
 
 
-def add_robot_option(parser: argparse.ArgumentParser) -> None:
-    """``--robot NAME|FILE``: run a shipped robot or a description file's (the scenario's ``robot``)."""
+def add_robot_option(parser: argparse.ArgumentParser, *, several: bool = False) -> None:
+    """``--robot NAME|FILE``: run a shipped robot or a description file's (the scenario's ``robot``);
+    ``several``: a list (an experiment's grid)."""
     parser.add_argument(
         "--robot",
         metavar="NAME|FILE",
         help=f"the robot: one of {', '.join(SHIPPED_ROBOTS)} (default: the scenario's, mobile_ur5) or a "
         "robot description .yaml file (see the README, 'Your own robot')",
+        **({"nargs": "+"} if several else {}),
     )
 
 
-PERCEPTION_SOURCES = ("truth", "camera")
-"""``perception.source``'s values (``hlp_drake.systems.perception.cameras``'s, without importing Drake)."""
-
-
-def add_perception(parser: argparse.ArgumentParser) -> None:
+def add_perception(parser: argparse.ArgumentParser, *, several: bool = False) -> None:
     """``--perception truth|camera``: override the scenario's ``perception.source``."""
     parser.add_argument(
         "--perception",
         choices=PERCEPTION_SOURCES,
         help="plan on the true scene (truth, the default) or on what the scenario's cameras see "
         "(camera: ScenePerception; the simulation still runs the true scene)",
+        **({"nargs": "+"} if several else {}),
     )
 
 
-def add_conditions(parser: argparse.ArgumentParser) -> None:
+def add_conditions(parser: argparse.ArgumentParser, *, several: bool = False) -> None:
     """``--execution open|closed`` and ``--uncertainty [SEED]`` (``Scenario.closed_loop``,
-    ``Scenario.uncertainty``; applied by ``hlp_drake.systems.scenario.with_conditions``)."""
+    ``Scenario.uncertainty``; applied by ``hlp_drake.systems.Conditions``)."""
     parser.add_argument(
         "--execution",
-        choices=("open", "closed"),
-        help="open: play the optimised trajectory; closed: re-optimise it every closed_loop.replan_period s "
+        choices=EXECUTIONS,
+        help="open: play the planned motion; closed: re-plan it every closed_loop.replan_period s "
         "of simulated time on the measured state (default: as the scenario says, open)",
+        **({"nargs": "+"} if several else {}),
     )
     parser.add_argument(
         "--uncertainty",

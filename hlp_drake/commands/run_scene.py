@@ -50,8 +50,8 @@ from hlp_drake.scene.constants import DEFAULT_SCENE_FILE, KINDS, MAX_GENERATED
 
 DEFAULT_SCENE = DEFAULT_SCENE_FILE
 PROG = "python -m hlp_drake.run_scene"
-PLANNER_NAMES = {"hlp": "human-like", "sto": "straight-line"}
-"""The planners as the recording's heading names them."""
+INITIALISER_NAMES = {"hlp": "human-like", "line": "straight-line"}
+"""The initialisers as the recording's heading names them."""
 
 
 def verdict(result) -> str:
@@ -74,12 +74,14 @@ def exit_status(result) -> int:
 
 
 def recording_title(result, ran: WhatRan) -> str:
-    """The recording's heading: the scene, the planner and perception, and the verdict in short."""
+    """The recording's heading: the scene, the initialiser, the low-level planner and perception, and
+    the verdict in short."""
     reach = "reach success" if result.success else f"reach failure: {result.failure_reason}"
     held = {None: "", True: ", grasp held", False: ", grasp did not hold"}[result.grasp_held]
-    planners = " and ".join(PLANNER_NAMES.get(p, p) for p in ran.planners)
-    seen = "on the depth camera's view" if ran.perception_source == "camera" else "on the true scene"
-    return f"scene {result.scene.name}, {planners} planner {seen}: {reach}{held}"
+    planners = " and ".join(INITIALISER_NAMES.get(p, p) for p in ran.initials)
+    planners += f" planner with the {' and '.join(ran.low_levels)} low-level planner"
+    seen = "on the depth camera's view" if "camera" in ran.perceptions else "on the true scene"
+    return f"scene {result.scene.name}, {planners} {seen}: {reach}{held}"
 
 
 def summary(result, ran: WhatRan | None = None) -> str:

@@ -150,10 +150,9 @@ def _variant_problems(
     for key in value:
         owners = [other for other, cls in variants.items() if key in _fields(cls)]
         if key not in own and owners:
-            settings = ", ".join(n for n in own if n != tag)
             problems.append(
                 f"{label}: {key!r} is a setting of {' and '.join(owners)}, not of {name} "
-                f"({name}'s settings: {settings}; {base.NOUN}s: {known})"
+                f"(the {base.NOUN}s: {known}; give its {tag} to use another)"
             )
     return kind, problems
 

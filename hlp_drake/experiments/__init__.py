@@ -1,15 +1,19 @@
-"""The paper's Generalization I and II experiments (Tables II and III): ``python -m hlp_drake.experiments``.
+"""Studies: a grid of conditions run on seeded scenes, ``python -m hlp_drake.experiments``.
 
-- ``runner``: one (scene, planner) job -> a ``results.csv`` row (the real job, with Drake, is
-  ``hlp_drake.systems.run_job``; ``hlp_drake.systems.scenario_yamls`` reads the scenario);
+- ``study``: ``Study``, an experiment as data (the bundled ``gen1`` and ``gen2``: Tables II and III);
+- ``runner``: one (scene, cell) job -> a ``results.csv`` row (the real job, with Drake, is
+  ``hlp_drake.systems.run_job``; ``hlp_drake.systems.resolve_study`` reads the scenario and checks
+  the cells);
 - ``executors``: run jobs in this process, a local process pool or on dask;
 - ``results``: ``results.csv`` (columns, reading back, atomic rewrites);
 - ``experiment``: ``run_experiment``: resumable runs into a directory;
-- ``summary``, ``plots``: the paper-format tables beside the paper's numbers, and PNG plots;
-- ``cli``: the command line.
+- ``summary``, ``paper``, ``plots``: the study's table beside the paper's numbers, and PNG plots.
+
+The command line is ``hlp_drake.commands.experiments``.
 """
 
 from hlp_drake.experiments.experiment import ExperimentSettings, run_experiment
-from hlp_drake.experiments.runner import Job, ScenarioYamls, make_row
+from hlp_drake.experiments.runner import Job, ResolvedStudy, make_row
+from hlp_drake.experiments.study import Study, load_study
 
-__all__ = ["ExperimentSettings", "Job", "ScenarioYamls", "make_row", "run_experiment"]
+__all__ = ["ExperimentSettings", "Job", "ResolvedStudy", "Study", "load_study", "make_row", "run_experiment"]

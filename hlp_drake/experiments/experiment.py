@@ -1,10 +1,11 @@
-"""Run a whole experiment into a directory, resumably: jobs -> ``results.csv`` -> summary and plots.
+"""Run a whole study into a directory, resumably: jobs -> ``results.csv`` -> summary and plots.
 
-The directory holds ``config.json`` (what the rows depend on: kind, first seed, scenario settings),
+The directory holds ``config.json`` (what the rows depend on: the study's grid and scenes, the
+scenario settings),
 ``results.csv`` (rewritten atomically after every finished job), ``run.json`` (the run's settings,
 what it ran, machine and software), ``summary.md``/``summary.json`` and ``success.png``/``times.png``.
-Scene i of a run has seed ``seed + i``. Rows already in ``results.csv`` are kept and not run again;
-a job interrupted mid-way is simply run again next time.
+Scene i of a condition has seed ``study.seed + i``. Rows already in ``results.csv`` are kept and not
+run again; a job interrupted mid-way is simply run again next time.
 """
 
 from __future__ import annotations
@@ -15,19 +16,21 @@ import os
 import sys
 import time
 from contextlib import closing
-from dataclasses import asdict, dataclass, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 from tqdm import tqdm
 
+from hlp_drake.config.ranges import config_problems
 from hlp_drake.config.what_ran import WhatRan
 from hlp_drake.errors import HlpError, StorageError
 from hlp_drake.experiments.executors import EXECUTORS, check_executor, run_jobs
 from hlp_drake.experiments.metadata import git_commit, machine_info, software_versions, utc_now
 from hlp_drake.experiments.plots import write_plots
 from hlp_drake.experiments.results import START_OVER, ResultsFile, read_results, read_run_file, row_key
-from hlp_drake.experiments.runner import KINDS, Job, JobFunction, ScenarioResolver, make_jobs
+from hlp_drake.experiments.runner import Job, JobFunction, StudyResolver, make_jobs
+from hlp_drake.experiments.study import Study
 from hlp_drake.experiments.summary import summarise, write_summary
 from hlp_drake.files.atomic import check_writable, write_text_atomic
 from hlp_drake.runtime.terminal import bars_disabled
@@ -36,7 +39,7 @@ RESULTS, CONFIG, RUN = "results.csv", "config.json", "run.json"
 DERIVED = ("summary.md", "summary.json", "success.png", "times.png")
 MAX_RECORD_BYTES = 16 << 20
 """A larger ``config.json`` or ``run.json`` is refused (a run's are a few kB to a few MB)."""
-IDENTITY_LABELS = {"kind": "kind", "seed": "seed", "scenario": "scenario", "tables": "tables"}
+IDENTITY_LABELS = {"study": "grid or scenes", "scenario": "scenario"}
 
 
 @dataclass(frozen=True)
@@ -44,37 +47,23 @@ class ExperimentSettings:
     """What to run and how.
 
     Attributes:
-        kind: "gen1" (Table II) or "gen2" (Table III).
-        scenes: scenes per condition; scene i has seed ``seed + i``.
-        objects: gen2's object counts (one condition each); ignored by gen1.
+        study: the grid and its scenes (``Study``; ``load_study("gen1")`` is Table II).
         workers: jobs at a time (None: one per core); with more than one, or on dask, every job's
-            optimiser rolls out in its own process (``sto.workers = 1``: no nested pools).
+            low-level planner rolls out in its own process (no nested pools).
         executor: "local" (this process, or a spawn process pool) or "dask".
         scheduler: the dask scheduler's address (None: start a ``LocalCluster`` of ``workers``).
         config_yaml: the scenario settings as YAML text (None: ``Scenario()``'s defaults; its scene is
             replaced by each job's).
-        perception: overrides the scenario's ``perception.source`` ("truth" or "camera"; None: the
-            scenario's).
-        robot: overrides the scenario's robot (a shipped robot's name or a description file; None:
-            the scenario's).
-        tables: generate the tables within this robot's reach rather than the run's own robot's
-            (the same scenes for two robots; None: the run's robot's).
         scenario_file: the file ``config_yaml`` was read from (None: none, the built-in default), named
             in ``run.json`` and the summary.
         fresh: start over, discarding the directory's earlier results.
     """
 
-    kind: str
-    scenes: int = 100
-    objects: tuple[int, ...] = (5, 7, 9)
-    seed: int = 0
+    study: Study
     workers: int | None = None
     executor: str = "local"
     scheduler: str | None = None
     config_yaml: str | None = None
-    perception: str | None = None
-    robot: str | None = None
-    tables: str | None = None
     scenario_file: str | None = None
     fresh: bool = False
     progress: bool = True
@@ -90,14 +79,7 @@ class ExperimentSettings:
 
     def problems(self) -> list[str]:
         """The reasons these settings cannot run (empty when they can)."""
-        problems = []
-        if self.kind not in KINDS:
-            problems.append(f"unknown experiment {self.kind!r} (expected one of {', '.join(KINDS)})")
-        if self.scenes < 1:
-            problems.append(f"--scenes must be at least 1, got {self.scenes}")
-        if not self.objects or min(self.objects) < 1:
-            given = " ".join(map(str, self.objects)) or "none"
-            problems.append(f"--objects must be at least 1 each, got {given}")
+        problems = config_problems(self.study)
         if self.workers is not None and self.workers < 1:
             problems.append(f"--workers must be at least 1, got {self.workers}")
         if self.executor not in EXECUTORS:
@@ -118,11 +100,13 @@ def _check_directory(out: Path, identity: dict[str, Any], fresh: bool) -> None:
         earlier = _read_record(config)
         differs = [label for key, label in IDENTITY_LABELS.items() if earlier.get(key) != identity.get(key)]
         if differs:
-            raise HlpError(
-                f"{out} holds a run with a different {', '.join(differs)} "
-                f"({earlier.get('kind')} from seed {earlier.get('seed')}); "
-                f"{START_OVER}"
+            study = earlier.get("study")
+            what = (
+                f"{earlier.get('name')} from seed {study.get('seed')}"
+                if isinstance(study, dict)
+                else "written by an earlier version"
             )
+            raise HlpError(f"{out} holds a run with a different {', '.join(differs)} ({what}); {START_OVER}")
     elif (out / RESULTS).exists():
         raise HlpError(f"{out / RESULTS} exists without {CONFIG}; {START_OVER}")
 
@@ -176,16 +160,13 @@ def _run_record(
     earlier: list[dict[str, Any]],
     ran: WhatRan,
 ) -> dict[str, Any]:
+    study = settings.study
     return {
         "command": command,
         "status": "running",
-        "kind": settings.kind,
+        "study": {"name": study.name, "title": study.heading, **study.identity()},
         **ran.to_dict(),
-        "seeds": {
-            "first": settings.seed,
-            "last": settings.seed + settings.scenes - 1,
-            "scenes": settings.scenes,
-        },
+        "seeds": {"first": study.seed, "last": study.seed + study.scenes - 1, "scenes": study.scenes},
         "objects": sorted({job.objects for job in jobs}),
         "workers": settings.worker_count,
         "executor": settings.executor,
@@ -221,7 +202,7 @@ def _run_pending(
         initial=total - len(pending),
         unit="job",
         dynamic_ncols=True,
-        desc=f"{settings.kind} ({settings.worker_count} at a time)",
+        desc=f"{settings.study.name} ({settings.worker_count} at a time)",
         disable=bars_disabled(settings.progress),
     )
     lines = settings.progress and bar.disable
@@ -239,13 +220,13 @@ def _run_pending(
             if row_key(row) != done.key:
                 raise ValueError(f"the job for {done.key} returned the row of {row_key(row)}")
             results.add(row)
-            outcome = f"{done.scene} {done.planner}: {'success' if row['success'] else 'failure'}"
+            outcome = f"{done.scene} {_cell_name(done)}: {'success' if row['success'] else 'failure'}"
             bar.set_postfix_str(outcome, refresh=False)
             bar.update()
             done_jobs += 1
             if lines:
                 print(
-                    f"{settings.kind}: {done_jobs} of {total} jobs done ({outcome})",
+                    f"{settings.study.name}: {done_jobs} of {total} jobs done ({outcome})",
                     file=sys.stderr,
                     flush=True,
                 )
@@ -261,20 +242,32 @@ def _finish_record(out: Path, record: dict[str, Any], started: float, results: R
     write_text_atomic(out / RUN, json.dumps(record, indent=2) + "\n")
 
 
+def _cell_name(job: Job) -> str:
+    """A job's cell as its progress line names it: its planner pair, then what else the grid varies."""
+    labels = job.cell.labels
+    extra = [v for v in (labels.robot, labels.execution, labels.perception) if v not in DEFAULTS]
+    extra += [] if labels.model_error is None else [f"model error {labels.model_error}"]
+    return " ".join([labels.planner, *extra])
+
+
+DEFAULTS = ("mobile_ur5", "open", "truth")
+"""The cell values a progress line leaves unsaid."""
+
+
 def run_experiment(
     settings: ExperimentSettings,
     out: str | os.PathLike[str],
     *,
     job: JobFunction,
-    scenario: ScenarioResolver,
+    resolve: StudyResolver,
     command: str | None = None,
 ) -> dict[str, Any]:
     """Run every job of ``settings`` not yet in ``out/results.csv``; write the summary and plots.
 
-    Every check (settings, scenario, scene generation, the directory's earlier run) happens
+    Every check (settings, scenario, cells, scene generation, the directory's earlier run) happens
     before anything is written. ``job`` runs one job (``hlp_drake.systems.run_job``: the real
     planners); it must be a picklable module-level function for the process pool and dask
-    executors. ``scenario`` reads ``settings.config_yaml`` (``hlp_drake.systems.scenario_yamls``).
+    executors. ``resolve`` reads the scenario and checks the cells (``hlp_drake.systems.resolve_study``).
 
     Returns:
         The summary (as written to ``summary.json``).
@@ -288,37 +281,22 @@ def run_experiment(
     if problems:
         raise HlpError(*problems)
     check_executor(settings.executor, settings.scheduler)
-    out = Path(out)
-    yamls = scenario(
-        settings.config_yaml,
-        single_process_rollouts=settings.parallel,
-        perception=settings.perception,
-        robot=settings.robot,
-        tables=settings.tables,
-    )
-    config_yaml = yamls.identity
-    jobs = make_jobs(
-        settings.kind,
-        range(settings.seed, settings.seed + settings.scenes),
-        settings.objects,
-        yamls.job,
-        yamls.workspace,
-    )
-    identity = {"kind": settings.kind, "seed": settings.seed, "scenario": config_yaml}
-    if yamls.ran.tables:  # another robot's tables: other scenes (absent otherwise, as before)
-        reach = None if yamls.workspace is None else asdict(yamls.workspace)
-        identity["tables"] = {"robot": yamls.ran.tables, "workspace": reach}
+    out, study = Path(out), settings.study
+    resolved = resolve(study, settings.config_yaml, single_process_rollouts=settings.parallel)
+    jobs = make_jobs(study, resolved)
+    identity = {"name": study.name, "study": study.identity(), "scenario": resolved.scenario}
     _check_directory(out, identity, settings.fresh)
     check_writable(*(out / name for name in (RESULTS, CONFIG, RUN, *DERIVED)))
-    results = ResultsFile(out / RESULTS, [] if settings.fresh else read_results(out / RESULTS, settings.kind))
+    rows = [] if settings.fresh else read_results(out / RESULTS, study.generators)
+    results = ResultsFile(out / RESULTS, rows)
     earlier = _earlier_runs(out, settings.fresh)
 
     started = time.perf_counter()
     _prepare(out, identity, settings.fresh)
     results.save()
     pending = [j for j in jobs if j.key not in results]
-    ran = replace(yamls.ran, scenario_file=settings.scenario_file)
-    record = _run_record(settings, command, config_yaml, jobs, pending, earlier, ran)
+    ran = replace(resolved.ran, scenario_file=settings.scenario_file)
+    record = _run_record(settings, command, resolved.scenario, jobs, pending, earlier, ran)
     write_text_atomic(out / RUN, json.dumps(record, indent=2) + "\n")
     try:
         _run_pending(job, pending, results, settings, len(jobs))
@@ -331,9 +309,9 @@ def run_experiment(
     record["status"] = "complete"
     _finish_record(out, record, started, results)
     measured_on = _measured_on(record["machine"], settings)
-    if yamls.perception_source == "camera":
+    if "camera" in ran.perceptions:
         measured_on += "; the planners saw the scenes through the cameras (perception: camera)"
-    summary = summarise(settings.kind, results.rows.values(), measured_on, ran)
+    summary = summarise(study, results.rows.values(), measured_on, ran)
     write_summary(out, summary)
     write_plots(out, summary)
     return summary

@@ -1,5 +1,6 @@
-"""``success.png`` and ``times.png``: our success rates and mean planning times per condition and planner
-as grouped bars, the paper's values as black markers where the paper (or our notes of it) has them."""
+"""``success.png`` and ``times.png``: our success rates and mean planning times per condition and series
+(a cell of the study's grid) as grouped bars, the paper's values as black markers where the paper (or
+our notes of it) has them."""
 
 from __future__ import annotations
 
@@ -9,12 +10,13 @@ from typing import Any
 
 import numpy as np
 
-from hlp_drake.experiments.runner import PLANNERS
-from hlp_drake.experiments.summary import PLANNER_LABELS, TIME_LABELS, TIMES
+from hlp_drake.experiments.summary import TIME_LABELS, TIMES
 from hlp_drake.files.plotting import plt, save_png
 
-COLOURS = {"hlp": "#1f77b4", "sto": "#ff7f0e"}
-BAR_WIDTH = 0.36
+COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f")
+"""The series' colours, in order (the first two: the HLP's and the straight line's)."""
+GROUP_WIDTH = 0.72
+"""The width of a condition's group of bars (the conditions are 1 apart)."""
 
 
 def _label_bars(axes: plt.Axes, bars, values: list[float | None], label: Callable[[float], str]) -> None:
@@ -45,15 +47,17 @@ def _grouped_bars(
     label: Callable[[float], str],
     errors: Callable[[dict[str, Any]], tuple[float, float]] | None = None,
 ) -> None:
-    """Bars of ``field`` per condition and planner (with ``errors``' (low, high) if given); paper values
+    """Bars of ``field`` per condition and series (with ``errors``' (low, high) if given); paper values
     as black diamonds."""
     conditions = summary["conditions"]
     centres = np.arange(len(conditions))
+    labels = list(dict.fromkeys(s["label"] for c in conditions for s in c["series"]))
+    width = GROUP_WIDTH / max(1, len(labels))
     labelled = []
     paper_shown = False
-    for offset, planner in zip((-BAR_WIDTH / 2, BAR_WIDTH / 2), PLANNERS):
-        x = centres + offset
-        stats = [c["planners"].get(planner) for c in conditions]
+    for i, name in enumerate(labels):
+        x = centres + (i - (len(labels) - 1) / 2) * width
+        stats = [next((s["stats"] for s in c["series"] if s["label"] == name), None) for c in conditions]
         ours = [None if s is None else s[field] for s in stats]
         heights = np.array([np.nan if v is None else v for v in ours], float)
         yerr = None
@@ -63,9 +67,9 @@ def _grouped_bars(
         bars = axes.bar(
             x,
             heights,
-            BAR_WIDTH * 0.95,
-            color=COLOURS[planner],
-            label=PLANNER_LABELS[planner],
+            width * 0.95,
+            color=COLOURS[i % len(COLOURS)],
+            label=name,
             yerr=yerr,
             error_kw={"ecolor": "0.25", "capsize": 3, "lw": 1},
         )
@@ -95,9 +99,9 @@ def _grouped_bars(
 
 def plot_title(summary: dict[str, Any]) -> str:
     """The plots' title: the table, the robot (on another robot's tables), the scenes per condition."""
-    scenes = max((s["n"] for c in summary["conditions"] for s in c["planners"].values()), default=0)
-    robot = summary.get("robot")  # absent from a summary written before robots were named
-    ran = "" if robot is None else f", {robot}"
+    scenes = max((s["stats"]["n"] for c in summary["conditions"] for s in c["series"]), default=0)
+    robots = summary.get("robots") or [summary.get("robot")]
+    ran = "" if robots == [None] else f", {' and '.join(robots)}"
     ran += f" on {summary['tables']}'s tables" if summary.get("tables") else ""
     return f"{summary['table']}{ran} ({scenes} scene{'s' if scenes != 1 else ''} per condition)"
 

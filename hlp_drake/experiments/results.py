@@ -1,14 +1,18 @@
-"""``results.csv``: one row per (scene, planner), read back for resuming, rewritten atomically.
+"""``results.csv``: one row per (scene, cell of the grid), read back for resuming, rewritten atomically.
 
 Columns (in this order): the paper's ``scene, objects, planner, success, failure_reason, init_s,
 optimise_s, total_s, rollouts, objects_moved, objects_dropped``, then ``seed, iterations,
-verifications, rejected, verify_s, passed_then_failed, replans, replan_rollouts, execute_s``
-(``rollouts`` counts the optimiser's rollouts, ``verifications`` its checks on the execution model, of
-which ``rejected`` failed there, ``verify_s`` the seconds they took, part of ``optimise_s``;
-``passed_then_failed``: the optimiser accepted a sequence and the execution failed; ``replans`` and ``replan_rollouts``: the closed-loop controller's).
-Times are seconds; ``init_s`` = plan + IK, ``total_s`` = init + optimise (planning time: the simulated
-execution, ``execute_s``, is excluded); ``objects_moved`` and ``objects_dropped`` are counts.
-Booleans are ``true``/``false``; a missing failure reason is an empty field.
+verifications, rejected, verify_s, passed_then_failed, replans, replan_rollouts, execute_s``, then
+the cell's axes ``generator, robot, initial, low_level, execution, perception, model_error``
+(``planner`` names the initialiser and low-level planner pair: the paper's ``hlp`` and ``sto`` for
+the STO; ``rollouts`` counts the low-level planner's rollouts, ``verifications`` its checks on the
+execution model, of which ``rejected`` failed there, ``verify_s`` the seconds they took, part of
+``optimise_s``; ``passed_then_failed``: the low-level planner accepted a motion and the execution
+failed; ``replans`` and ``replan_rollouts``: the closed-loop controller's; ``model_error``: the
+seed of the world's model error, empty for none). Times are seconds; ``init_s`` = plan + IK,
+``total_s`` = init + low-level planning (the simulated execution, ``execute_s``, is excluded);
+``objects_moved`` and ``objects_dropped`` are counts. Booleans are ``true``/``false``; a missing
+failure reason is an empty field.
 """
 
 from __future__ import annotations
@@ -22,10 +26,12 @@ from pathlib import Path
 from typing import Any
 
 from hlp_drake.errors import HlpError
-from hlp_drake.experiments.runner import PLANNERS, Row
+from hlp_drake.experiments.runner import Row
 from hlp_drake.files.atomic import atomic_path
 from hlp_drake.files.documents import read_bytes
 
+AXIS_COLUMNS = ("generator", "robot", "initial", "low_level", "execution", "perception", "model_error")
+"""The grid's axes, as rows name them."""
 COLUMNS = (
     "scene",
     "objects",
@@ -47,12 +53,14 @@ COLUMNS = (
     "replans",
     "replan_rollouts",
     "execute_s",
+    *AXIS_COLUMNS,
 )
-EARLIER_COLUMNS = tuple(c for c in COLUMNS if c != "verify_s")
-"""The columns before ``verify_s``: such a file is read with ``verify_s`` NaN (unknown), and resumed."""
+KEY_COLUMNS = ("scene", "objects", "robot", "initial", "low_level", "execution", "perception", "model_error")
+"""A row's identity (``row_key``)."""
 BOOL_COLUMNS = frozenset({"success", "passed_then_failed"})
 FLOAT_COLUMNS = frozenset({"init_s", "optimise_s", "total_s", "verify_s", "execute_s"})
-INT_COLUMNS = frozenset(COLUMNS) - BOOL_COLUMNS - FLOAT_COLUMNS - {"scene", "planner", "failure_reason"}
+TEXT_COLUMNS = frozenset({"scene", "planner", "failure_reason", *AXIS_COLUMNS} - {"model_error"})
+INT_COLUMNS = frozenset(COLUMNS) - BOOL_COLUMNS - FLOAT_COLUMNS - TEXT_COLUMNS - {"model_error"}
 BOOLEANS = {"true": True, "false": False}
 MAX_RESULTS_BYTES = 64 << 20
 """A larger ``results.csv`` is refused (a run of thousands of jobs writes a few MB)."""
@@ -62,14 +70,15 @@ START_OVER = "use --fresh to start over or choose another --out"
 """How to get past a directory that cannot be resumed."""
 
 
-def row_key(row: Row) -> tuple[str, str]:
-    """A row's identity: (scene, planner)."""
-    return row["scene"], row["planner"]
+def row_key(row: Row) -> tuple:
+    """A row's identity: its scene (name and object count) and its cell (``KEY_COLUMNS``)."""
+    return tuple(row[column] for column in KEY_COLUMNS)
 
 
-def sort_key(row: Row) -> tuple[int, int, str]:
-    """The file's order: object count, scene seed, planner."""
-    return row["objects"], row["seed"], row["planner"]
+def sort_key(row: Row) -> tuple:
+    """The file's order: generator, object count, scene seed, then the cell."""
+    cell = tuple("" if row[c] is None else str(row[c]) for c in AXIS_COLUMNS[1:])
+    return row["generator"], row["objects"], row["seed"], row["planner"], cell
 
 
 def _format(column: str, value: Any) -> str:
@@ -81,6 +90,8 @@ def _format(column: str, value: Any) -> str:
 
 
 def _parse(column: str, text: str) -> Any:
+    if column == "model_error":
+        return int(text) if text else None
     if column in BOOL_COLUMNS:
         return BOOLEANS[text]  # KeyError: not a boolean
     if column in INT_COLUMNS:
@@ -102,12 +113,12 @@ def results_csv(rows: Iterable[Row]) -> str:
     return out.getvalue()
 
 
-def read_results(path: Path, kind: str | None = None) -> list[Row]:
-    """The rows of ``path`` (none when it does not exist; ``verify_s`` NaN in an ``EARLIER_COLUMNS`` file).
+def read_results(path: Path, generators: Iterable[str] | None = None) -> list[Row]:
+    """The rows of ``path`` (none when it does not exist).
 
     Args:
-        kind: the run's scene generator ("gen1", "gen2"): every row's scene must be one of its
-            (the name its seed and object count give); None: any.
+        generators: the run's scene generators: every row's scene must be one of theirs (the name
+            its generator, seed and object count give); None: any.
 
     Raises:
         HlpError: the file is unreadable, too large, has other columns or a malformed row (one
@@ -118,12 +129,12 @@ def read_results(path: Path, kind: str | None = None) -> list[Row]:
     reader = csv.reader(io.StringIO(read_run_file(path, MAX_RESULTS_BYTES), newline=""))
     try:
         header = tuple(next(reader, ()))
-        if header not in (COLUMNS, EARLIER_COLUMNS):
+        if header != COLUMNS:
             raise HlpError(f"{path}: not an experiment results file (unexpected columns); {START_OVER}")
         rows = []
         for record in reader:
             try:
-                rows.append(_row(header, record, kind))
+                rows.append(_row(header, record, generators))
             except (KeyError, ValueError) as error:
                 raise HlpError(
                     f"{path}: line {reader.line_num}: malformed row ({error}); {START_OVER}"
@@ -148,29 +159,30 @@ def read_run_file(path: Path, limit: int) -> str:
         raise HlpError(f"{path}: unreadable ({error}); {START_OVER}") from None
 
 
-def _row(header: tuple[str, ...], record: list[str], kind: str | None) -> Row:
+def _row(header: tuple[str, ...], record: list[str], generators: Iterable[str] | None) -> Row:
     """The row of one CSV ``record`` under ``header``; ValueError or KeyError names what is wrong."""
     if len(record) != len(header):
         raise ValueError(f"{len(record)} fields")
-    row = {"verify_s": float("nan")} | {c: _parse(c, text) for c, text in zip(header, record)}
-    if row["planner"] not in PLANNERS:
-        raise ValueError(f"planner {row['planner']!r}")
+    row = {c: _parse(c, text) for c, text in zip(header, record)}
     for column in INT_COLUMNS:
         if row[column] < 0:
             raise ValueError(f"{column} {row[column]}, expected a count")
-    for column in FLOAT_COLUMNS:  # NaN: unknown (a crashed job's times, an earlier file's verify_s)
+    for column in FLOAT_COLUMNS:  # NaN: unknown (a crashed job's times)
         value = row[column]
         if not (math.isnan(value) or 0.0 <= value <= MAX_SECONDS):
             raise ValueError(f"{column} {value}, expected 0 to {MAX_SECONDS:g} s or nan")
-    if kind is not None and row["scene"] != scene_name(kind, row["seed"], row["objects"]):
-        raise ValueError(f"scene {row['scene']!r} is not the {kind} scene of its seed and object count")
-    return {column: row[column] for column in COLUMNS}
+    generator = row["generator"]
+    if generators is not None and generator not in generators:
+        raise ValueError(f"generator {generator!r}, not one of the study's")
+    if row["scene"] != scene_name(generator, row["seed"], row["objects"]):
+        raise ValueError(f"scene {row['scene']!r} is not the {generator} scene of its seed and object count")
+    return row
 
 
-def scene_name(kind: str, seed: int, objects: int) -> str:
-    """The name ``generate_scene`` gives the experiments' ``kind`` ("gen1", "gen2") scene of ``seed``
-    with ``objects`` obstacles."""
-    return f"{kind}-{seed}" if kind == "gen1" else f"{kind}-{objects}-{seed}"
+def scene_name(generator: str, seed: int, objects: int) -> str:
+    """The name ``generate_scene`` gives the ``generator``'s scene of ``seed`` with ``objects``
+    obstacles."""
+    return f"{generator}-{objects}-{seed}" if generator == "gen2" else f"{generator}-{seed}"
 
 
 def write_durable(path: Path, text: str) -> None:
@@ -197,13 +209,13 @@ def _fsync_directory(directory: Path) -> None:
 
 
 class ResultsFile:
-    """The rows of ``results.csv`` by (scene, planner); every ``add`` rewrites the file atomically."""
+    """The rows of ``results.csv`` by ``row_key``; every ``add`` rewrites the file atomically."""
 
     def __init__(self, path: Path, rows: Iterable[Row] = ()) -> None:
         self.path = path
-        self.rows: dict[tuple[str, str], Row] = {row_key(row): row for row in rows}
+        self.rows: dict[tuple, Row] = {row_key(row): row for row in rows}
 
-    def __contains__(self, key: tuple[str, str]) -> bool:
+    def __contains__(self, key: tuple) -> bool:
         return key in self.rows
 
     def add(self, row: Row) -> None:

@@ -1,51 +1,93 @@
-"""One experiment job: plan and execute one scene with one planner, reduced to a ``results.csv`` row.
+"""One experiment job: plan and execute one scene in one cell of a study's grid, reduced to a
+``results.csv`` row.
 
-A job is a pure function of its ``Job`` (kind, seed, object count, planner, scenario YAML), so the
-same job gives the same outcome in this process, a local worker process or a dask worker. The real
-job and the scenario reading are Drake's (``hlp_drake.systems.execution.job``): this module only
-defines what they take and give, and worker processes are spawned and import what they run.
+A job is a pure function of its ``Job`` (the scene's generator, seed and object count, the cell,
+the scenario YAML), so the same job gives the same outcome in this process, a local worker process
+or a dask worker. The real job and the reading of the study's scenario are Drake's
+(``hlp_drake.systems.execution.job``): this module only defines what they take and give, and worker
+processes are spawned and import what they run.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Protocol
 
 from hlp_drake.config.what_ran import WhatRan
 from hlp_drake.errors import SceneError
+from hlp_drake.experiments.study import Cell, Study
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.workspace import Workspace
-
-PLANNERS = ("hlp", "sto")  # the planners of Tables II and III: human-like plan; STO's straight line
-KINDS = ("gen1", "gen2")  # Generalization I (Table II) and II (Table III)
 
 Row = dict[str, Any]
 """One ``results.csv`` row: the columns of ``hlp_drake.experiments.results.COLUMNS``."""
 
 
 @dataclass(frozen=True)
-class Job:
-    """One (scene, planner) run: everything its outcome depends on, in picklable plain values."""
+class Labels:
+    """A cell's values as its rows name them (the scenario's own where the cell leaves an axis):
+    the robot's name, the initialiser, the low-level planner, their pair's name (``planner``:
+    the paper's ``hlp``/``sto`` for the STO), the execution mode, the perception source and the
+    model error's seed (None: none)."""
 
-    kind: str
+    robot: str
+    initial: str
+    low_level: str
+    planner: str
+    execution: str
+    perception: str
+    model_error: int | None
+
+
+@dataclass(frozen=True)
+class ResolvedCell:
+    """A cell of the grid, checked against the scenario: its ``labels``, the ``workspace`` its
+    tables are kept within (a fixed robot's reach, or the study's ``tables`` robot's) and the
+    rollout ``workers`` of its jobs' low-level planner (1 when jobs run side by side: no nested
+    pools; None: the scenario's)."""
+
+    cell: Cell
+    labels: Labels
+    workspace: Workspace | None = None
+    workers: int | None = None
+
+
+@dataclass(frozen=True)
+class Job:
+    """One (scene, cell) run: everything its outcome depends on, in picklable plain values."""
+
+    generator: str
     seed: int
+    count: int | None  # the generator's object count (None: its fixed count)
     objects: int  # the scene's number of obstacles
     scene: str  # the scene's name, e.g. "gen1-3" or "gen2-7-12"
-    planner: str
-    config_yaml: (
-        str  # the scenario as YAML text (``Scenario.yaml``; its scene is replaced), not a Drake object
-    )
-    workspace: Workspace | None = None  # a fixed robot's reach, which the scene's table is kept within
+    cell: ResolvedCell
+    config_yaml: str  # the scenario as YAML text (``Scenario.yaml``; its scene is replaced)
 
     @property
-    def key(self) -> tuple[str, str]:
-        """The job's identity in ``results.csv``: (scene, planner)."""
-        return self.scene, self.planner
+    def planner(self) -> str:
+        """The pair's name (``Labels.planner``)."""
+        return self.cell.labels.planner
+
+    @property
+    def key(self) -> tuple:
+        """The job's identity in ``results.csv`` (``row_key`` of its row)."""
+        labels = self.cell.labels
+        return (
+            self.scene,
+            self.objects,
+            labels.robot,
+            labels.initial,
+            labels.low_level,
+            labels.execution,
+            labels.perception,
+            labels.model_error,
+        )
 
     def make_scene(self) -> Scene:
-        return generate_scene(self.kind, self.seed, self.objects, self.workspace)
+        return generate_scene(self.generator, self.seed, self.count, self.cell.workspace)
 
 
 JobFunction = Callable[[Job], Row]
@@ -54,80 +96,61 @@ JobFunction = Callable[[Job], Row]
 
 
 @dataclass(frozen=True)
-class ScenarioYamls:
-    """A run's scenario, read once, as plain values.
+class ResolvedStudy:
+    """A study's scenario and cells, checked, as plain values.
 
     Attributes:
-        identity: the scenario as YAML (the run's identity, in ``config.json`` and ``run.json``).
-        job: the scenario as the jobs run it, as YAML (``Job.config_yaml``).
-        ran: what its jobs run: the robot, both planners, the execution mode, the model error's seed
-            and the perception source (no scenario file: the run's settings name it).
-        workspace: the robot's reach if it is fixed (the generated tables are kept within it).
+        scenario: the scenario as YAML (part of the run's identity, in ``config.json`` and
+            ``run.json``; the jobs' ``Job.config_yaml``).
+        cells: every cell of the grid, resolved.
+        ran: what its jobs run: the robots, initialisers, low-level planners, execution modes, model
+            errors and perception sources, and the tables' robot.
     """
 
-    identity: str
-    job: str
+    scenario: str
+    cells: tuple[ResolvedCell, ...]
     ran: WhatRan
-    workspace: Workspace | None = None
-
-    @property
-    def perception_source(self) -> str:
-        """The scenario's ``perception.source`` ("truth" or "camera")."""
-        return self.ran.perception_source
 
 
-class ScenarioResolver(Protocol):
-    """Reads a run's scenario (``hlp_drake.systems.scenario_yamls`` is the real one).
-
-    ``text``: the scenario settings as YAML (None: the defaults); ``perception`` overrides its
-    ``perception.source`` and ``robot`` its robot (a shipped robot's name or a description file)
-    unless None; ``tables``: the generated tables are kept within that robot's reach instead;
-    ``single_process_rollouts``: the jobs' optimiser rolls out in its own process
-    (``optimiser.workers = 1``). Raises ``HlpError`` for an invalid scenario.
-    """
+class StudyResolver(Protocol):
+    """Reads a study's scenario and checks its cells (``hlp_drake.systems.resolve_study`` is the real
+    one): ``config_yaml`` the scenario settings (None: the defaults); ``single_process_rollouts``:
+    the jobs' low-level planner rolls out in its own process. Raises ``HlpError`` for an invalid
+    scenario or cell."""
 
     def __call__(
-        self,
-        text: str | None,
-        *,
-        single_process_rollouts: bool,
-        perception: str | None,
-        robot: str | None = None,
-        tables: str | None = None,
-    ) -> ScenarioYamls: ...
+        self, study: Study, config_yaml: str | None, *, single_process_rollouts: bool
+    ) -> ResolvedStudy: ...
 
 
-def make_jobs(
-    kind: str,
-    seeds: Iterable[int],
-    objects: Iterable[int],
-    config_yaml: str,
-    workspace: Workspace | None = None,
-) -> list[Job]:
-    """Every (scene, planner) job, ordered by (objects, seed, planner).
-
-    gen2: one scene per (object count, seed); gen1: one scene per seed (``objects`` is ignored);
-    the tables within ``workspace`` (a fixed robot's reach).
+def make_jobs(study: Study, resolved: ResolvedStudy) -> list[Job]:
+    """Every (scene, cell) job, ordered by (generator, object count, seed, cell).
 
     Raises:
         SceneError: a scene cannot be generated (the message names its seed).
     """
-    counts = [None] if kind == "gen1" else sorted(set(objects))
-    jobs = []
-    for count in counts:
-        for seed in seeds:
-            try:
-                scene = generate_scene(kind, seed, count, workspace)
-            except SceneError as error:
-                objects_note = "" if count is None else f" with {count} objects"
-                raise SceneError(
-                    f"cannot generate the {kind} scene of seed {seed}{objects_note}: {error}"
-                ) from None
-            jobs += [
-                Job(kind, seed, len(scene.obstacles), scene.name, planner, config_yaml, workspace)
-                for planner in PLANNERS
-            ]
+    jobs, scenes = [], {}
+    for generator in study.generators:
+        for count in study.counts(generator):
+            for seed in range(study.seed, study.seed + study.scenes):
+                for cell in resolved.cells:
+                    key = (generator, seed, count, cell.workspace)
+                    if key not in scenes:
+                        scenes[key] = _scene(*key)
+                    scene = scenes[key]
+                    jobs.append(
+                        Job(generator, seed, count, len(scene.obstacles), scene.name, cell, resolved.scenario)
+                    )
     return jobs
+
+
+def _scene(generator: str, seed: int, count: int | None, workspace: Workspace | None) -> Scene:
+    """The generated scene (``SceneError`` naming the seed and count if it cannot be made)."""
+    try:
+        return generate_scene(generator, seed, count, workspace)
+    except SceneError as error:
+        objects = "" if count is None else f" with {count} objects"
+        raise SceneError(f"cannot generate the {generator} scene of seed {seed}{objects}: {error}") from None
 
 
 def make_row(
@@ -150,12 +173,14 @@ def make_row(
     replans: int = 0,
     replan_rollouts: int = 0,
 ) -> Row:
-    """The row of ``job``'s outcome: init = plan + IK, total = init + optimise (execution excluded)."""
+    """The row of ``job``'s outcome: init = plan + IK, total = init + low-level planning (execution
+    excluded), then the cell's labels."""
     init_s = plan_s + ik_s
+    labels = job.cell.labels
     return {
         "scene": job.scene,
         "objects": job.objects,
-        "planner": job.planner,
+        "planner": labels.planner,
         "success": bool(success),
         "failure_reason": failure_reason,
         "init_s": init_s,
@@ -173,6 +198,13 @@ def make_row(
         "replans": int(replans),
         "replan_rollouts": int(replan_rollouts),
         "execute_s": execute_s,
+        "generator": job.generator,
+        "robot": labels.robot,
+        "initial": labels.initial,
+        "low_level": labels.low_level,
+        "execution": labels.execution,
+        "perception": labels.perception,
+        "model_error": labels.model_error,
     }
 
 
@@ -194,3 +226,17 @@ def crash_row(job: Job, reason: str) -> Row:
         objects_moved=0,
         objects_dropped=0,
     )
+
+
+__all__ = [
+    "Job",
+    "JobFunction",
+    "Labels",
+    "ResolvedCell",
+    "ResolvedStudy",
+    "Row",
+    "StudyResolver",
+    "crash_row",
+    "make_jobs",
+    "make_row",
+]

@@ -1,8 +1,11 @@
-"""Tables II and III: success rate and mean planning times per condition and planner, beside the paper's.
+"""A study's summary: success rate and mean planning times per condition and series, beside the
+paper's where the series is one of its planners.
 
-``summarise`` turns the rows of ``results.csv`` into a JSON-ready dict; ``summary_markdown`` prints it
-in the paper's format. A condition is Generalization I (one group) or one object count of
-Generalization II.
+``summarise`` turns the rows of ``results.csv`` into a JSON-ready dict; ``summary_markdown`` prints
+it in the paper's format. A condition is one generator at one object count (Gen I: one group); a
+series is one cell of the grid: its planner pair, and whatever else the grid varies (robot,
+execution, perception, model error). Where two series differ only in the initialiser, the ratio of
+their mean total times says what the human prior saves.
 """
 
 from __future__ import annotations
@@ -11,84 +14,30 @@ import json
 import math
 from collections import defaultdict
 from collections.abc import Iterable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 from pathlib import Path
 from statistics import fmean
 from typing import Any
 
 from hlp_drake.config.what_ran import WhatRan
-from hlp_drake.experiments.runner import PLANNERS, Row
+from hlp_drake.experiments.paper import PaperFigures, notes, paper_figures
+from hlp_drake.experiments.runner import Row
+from hlp_drake.experiments.study import Study
 from hlp_drake.files.atomic import write_text_atomic
 
 PLANNER_LABELS = {"hlp": "HLP", "sto": "STO (straight line)"}
+"""The paper's planners as the tables name them."""
 TIMES = ("init_s", "optimise_s", "total_s")
 TIME_LABELS = {"init_s": "init", "optimise_s": "optimisation", "total_s": "total"}
-TABLES = {"gen1": "Table II: Generalization I", "gen2": "Table III: Generalization II"}
+CELL = ("robot", "initial", "low_level", "execution", "perception", "model_error")
+"""The columns of a row's cell (a series)."""
 
 
-@dataclass(frozen=True)
-class PaperFigures:
-    """One planner's figures in the paper (None: not reported, or not in our notes)."""
-
-    success_pct: float | None = None
-    init_s: float | None = None
-    optimise_s: float | None = None
-    total_s: float | None = None
-
-
-# Paper Table II (Gen I): success and total time; the init times are total - optimisation.
-# Table III (Gen II): success only; its times are not in our notes.
-PAPER: dict[tuple[str, int | None], dict[str, PaperFigures]] = {
-    ("gen1", None): {
-        "hlp": PaperFigures(94.0, round(1.56 - 0.97, 2), 0.97, 1.56),
-        "sto": PaperFigures(84.0, round(17.88 - 17.84, 2), 17.84, 17.88),
-    },
-    ("gen2", 5): {"hlp": PaperFigures(93.0), "sto": PaperFigures(96.0)},
-    ("gen2", 7): {"hlp": PaperFigures(93.0), "sto": PaperFigures(96.0)},
-    ("gen2", 9): {"hlp": PaperFigures(95.0), "sto": PaperFigures(98.0)},
-}
-COMMON_NOTES = [
-    (
-        "Times are planning times per scene in seconds, means over all scenes of the condition (successes "
-        "and failures): init = high-level plan + keypoint IK (plan_s + ik_s), optimisation = the stochastic "
-        "trajectory optimiser, total = init + optimisation. The simulated execution (execute_s in "
-        "results.csv) is excluded. Verification = the optimiser's checks of a passing rollout on the "
-        "execution model (verify_s, part of optimisation); the ratio without it compares the search alone."
-    ),
-    (
-        "Success % is followed by its 95 % Wilson interval; success = the target in the gripper's pre-grasp "
-        "region at the end of the executed motion and no object fallen off the table."
-    ),
-    (
-        "A run that crashed (an exception in plan_and_execute) counts as a failure; its times are left out "
-        "of the means."
-    ),
-]
-NOTES = {
-    "gen1": [
-        *COMMON_NOTES,
-        (
-            "The paper's init times are derived as total - optimisation "
-            "(HLP 1.56 - 0.97 s, STO 17.88 - 17.84 s)."
-        ),
-    ],
-    "gen2": [
-        *COMMON_NOTES,
-        (
-            "Table III's times are not in our notes: the paper's time columns show n/a "
-            "(null in summary.json) rather than invented numbers."
-        ),
-    ],
-}
-
-
-def paper_figures(kind: str, objects: int, planner: str) -> PaperFigures:
-    table = PAPER.get((kind, None if kind == "gen1" else objects), {})
-    return table.get(planner, PaperFigures())
-
-
-def condition_label(kind: str, objects: int) -> str:
-    return f"Gen I ({objects} objects)" if kind == "gen1" else f"{objects} objects"
+def condition_label(generator: str, objects: int, generators: tuple[str, ...]) -> str:
+    label = f"Gen I ({objects} objects)" if generator == "gen1" else f"{objects} objects"
+    if generator != "gen1" and len(generators) > 1:
+        label = f"{generator}, {label}"
+    return label
 
 
 def wilson_interval(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
@@ -116,7 +65,7 @@ def _less(total: float | None, part: float | None) -> float | None:
 
 
 def planner_stats(rows: list[Row], paper: PaperFigures) -> dict[str, Any]:
-    """n, successes, success % (and interval), crashes and mean times of one planner in one condition."""
+    """n, successes, success % (and interval), crashes and mean times of one series in one condition."""
     n = len(rows)
     successes = sum(row["success"] for row in rows)
     stats: dict[str, Any] = {
@@ -133,45 +82,78 @@ def planner_stats(rows: list[Row], paper: PaperFigures) -> dict[str, Any]:
     return stats
 
 
+def series_label(cell: dict[str, Any], varying: tuple[str, ...]) -> str:
+    """A series' name: its planner pair (the paper's names for its two), then the other axes the
+    grid varies."""
+    parts = [PLANNER_LABELS.get(cell["planner"], cell["planner"])]
+    for axis in varying:
+        value = cell[axis]
+        if axis in ("initial", "low_level"):
+            continue
+        parts.append(f"model error {value}" if axis == "model_error" and value is not None else str(value))
+    return ", ".join(parts)
+
+
+def _ratios(series: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Per pair of series that differ only in the initialiser (hlp and line): the ratio of their mean
+    total times, with and without verification."""
+    ratios = []
+    others = [axis for axis in CELL if axis != "initial"]
+    for human in (s for s in series if s["cell"]["initial"] == "hlp"):
+        for line in series:
+            same = all(line["cell"][a] == human["cell"][a] for a in others)
+            if not same or line["cell"]["initial"] != "line":
+                continue
+            hlp, sto = human["stats"], line["stats"]
+            ratios.append(
+                {
+                    "of": f"{human['label']} / {line['label']}",
+                    "total": _ratio(hlp["total_s"], sto["total_s"]),
+                    "total_without_verification": _ratio(
+                        _less(hlp["total_s"], hlp["verify_s"]), _less(sto["total_s"], sto["verify_s"])
+                    ),
+                    "paper": _ratio(hlp["paper"]["total_s"], sto["paper"]["total_s"]),
+                }
+            )
+    return ratios
+
+
 def summarise(
-    kind: str, rows: Iterable[Row], measured_on: str | None = None, ran: WhatRan | None = None
+    study: Study, rows: Iterable[Row], measured_on: str | None = None, ran: WhatRan | None = None
 ) -> dict[str, Any]:
-    """Per condition (object count) and planner: the figures of Table II (gen1) or III (gen2); what
-    the run ran (``ran``: robot, planners, execution, model error, perception, scenario file)."""
-    groups: dict[int, dict[str, list[Row]]] = defaultdict(lambda: defaultdict(list))
+    """Per condition and series: the figures of the study's table (Table II or III for the bundled
+    ``gen1`` and ``gen2``); what the run ran (``ran``)."""
+    rows = list(rows)
+    varying = tuple(axis for axis in CELL if len({row[axis] for row in rows}) > 1)
+    groups: dict[tuple, dict[tuple, list[Row]]] = defaultdict(lambda: defaultdict(list))
     for row in rows:
-        groups[row["objects"]][row["planner"]].append(row)
+        cell = (row["planner"], *(row[axis] for axis in CELL))
+        groups[(row["generator"], row["objects"])][cell].append(row)
+    order = {g: i for i, g in enumerate(study.generators)}
     conditions = []
-    for objects in sorted(groups):
-        by_planner = groups[objects]
-        planners = {
-            p: planner_stats(by_planner[p], paper_figures(kind, objects, p))
-            for p in PLANNERS
-            if by_planner[p]
-        }
-        hlp, sto = planners.get("hlp", {}), planners.get("sto", {})
+    for (generator, objects), cells in sorted(groups.items(), key=lambda item: (order.get(item[0][0], 99), item[0])):
+        series = []
+        for key in sorted(cells, key=lambda k: tuple("" if v is None else str(v) for v in k)):
+            cell = dict(zip(("planner", *CELL), key))
+            paper = paper_figures(generator, objects, cell["planner"])
+            stats = planner_stats(cells[key], paper if cell["low_level"] == "sto" else PaperFigures())
+            series.append({"label": series_label(cell, varying), "cell": cell, "stats": stats})
         conditions.append(
             {
-                "condition": condition_label(kind, objects),
+                "condition": condition_label(generator, objects, study.generators),
+                "generator": generator,
                 "objects": objects,
-                "planners": planners,
-                "hlp_to_sto_total": _ratio(hlp.get("total_s"), sto.get("total_s")),
-                "hlp_to_sto_total_without_verification": _ratio(
-                    _less(hlp.get("total_s"), hlp.get("verify_s")),
-                    _less(sto.get("total_s"), sto.get("verify_s")),
-                ),
-                "paper_hlp_to_sto_total": _ratio(
-                    paper_figures(kind, objects, "hlp").total_s, paper_figures(kind, objects, "sto").total_s
-                ),
+                "series": series,
+                "ratios": _ratios(series),
             }
         )
     return {
-        "kind": kind,
-        "table": TABLES[kind],
+        "study": study.name,
+        "table": study.heading,
         **({} if ran is None else ran.to_dict()),
         "measured_on": measured_on,
         "conditions": conditions,
-        "notes": NOTES[kind],
+        "notes": notes(study.generators),
     }
 
 
@@ -185,12 +167,13 @@ def _paper_number(value: float | None) -> str:
 
 def _table_rows(condition: dict[str, Any]) -> list[str]:
     lines = []
-    for planner, stats in condition["planners"].items():
+    for series in condition["series"]:
+        stats = series["stats"]
         paper = stats["paper"]
         low, high = stats["success_ci95"]
         cells = [
             condition["condition"],
-            PLANNER_LABELS[planner],
+            series["label"],
             str(stats["n"]),
             f"{stats['success_pct']:.1f} [{low:.0f}-{high:.0f}] ({_paper_number(paper['success_pct'])})",
         ]
@@ -219,24 +202,25 @@ def summary_markdown(summary: dict[str, Any]) -> str:
         lines += _table_rows(condition)
     lines += [
         "",
-        "| condition | ratio HLP / STO of the mean total times | the ratio without verification | the paper's ratio |",
-        "|---|---:|---:|---:|",
+        "| condition | mean total times | ratio | the ratio without verification | the paper's ratio |",
+        "|---|---|---:|---:|---:|",
     ]
     for condition in summary["conditions"]:
-        lines.append(
-            f"| {condition['condition']} | {_number(condition['hlp_to_sto_total'], 3)} | "
-            f"{_number(condition['hlp_to_sto_total_without_verification'], 3)} | "
-            f"{_number(condition['paper_hlp_to_sto_total'], 3)} |"
-        )
+        for ratio in condition["ratios"]:
+            lines.append(
+                f"| {condition['condition']} | {ratio['of']} | {_number(ratio['total'], 3)} | "
+                f"{_number(ratio['total_without_verification'], 3)} | {_number(ratio['paper'], 3)} |"
+            )
     lines += [
         "",
         "| condition | planner | rollouts (mean) | verification s (mean) | rollout passed, execution failed |",
         "|---|---|---:|---:|---:|",
     ]
     for condition in summary["conditions"]:
-        for planner, stats in condition["planners"].items():
+        for series in condition["series"]:
+            stats = series["stats"]
             lines.append(
-                f"| {condition['condition']} | {PLANNER_LABELS[planner]} | {_number(stats['rollouts_mean'], 1)} | "
+                f"| {condition['condition']} | {series['label']} | {_number(stats['rollouts_mean'], 1)} | "
                 f"{_number(stats['verify_s'])} | {stats['passed_then_failed']} of {stats['n']} |"
             )
     lines += ["", "Notes:", ""] + [f"- {note}" for note in summary["notes"]]
@@ -249,3 +233,6 @@ def write_summary(directory: Path, summary: dict[str, Any]) -> list[Path]:
     write_text_atomic(paths[0], json.dumps(summary, indent=2) + "\n")
     write_text_atomic(paths[1], summary_markdown(summary))
     return paths
+
+
+__all__ = ["PLANNER_LABELS", "TIMES", "TIME_LABELS", "summarise", "summary_markdown", "write_summary"]

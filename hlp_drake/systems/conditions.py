@@ -17,8 +17,6 @@ if TYPE_CHECKING:
     from hlp_drake.scene.model import Scene
     from hlp_drake.systems.scenario import Scenario
 
-EXECUTIONS = ("open", "closed")
-
 
 @dataclass(frozen=True)
 class Conditions:
@@ -83,4 +81,4 @@ def rollout_workers(scenario: Scenario) -> int | None:
     return getattr(scenario.low_level, "workers", 1) if entry.rolls_out else None
 
 
-__all__ = ["EXECUTIONS", "Conditions", "rollout_workers"]
+__all__ = ["Conditions", "rollout_workers"]

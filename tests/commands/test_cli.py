@@ -60,7 +60,10 @@ def test_hlp_drake_dispatches_to_the_commands(capsys):
 @pytest.mark.parametrize("command", sorted(COMMANDS))
 def test_help_and_version_name_the_command_as_typed_and_show_the_usage_once(command, capsys):
     python_m = f"python -m hlp_drake.{command.replace('-', '_')}"  # the module's own name
-    for run, name in ((lambda argv: main([command, *argv]), f"hlp-drake {command}"), (command_main(command), python_m)):
+    for run, name in (
+        (lambda argv: main([command, *argv]), f"hlp-drake {command}"),
+        (command_main(command), python_m),
+    ):
         with pytest.raises(SystemExit):
             run(["--help"])
         text = capsys.readouterr().out

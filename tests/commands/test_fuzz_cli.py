@@ -147,7 +147,7 @@ def test_hostile_input_never_shows_a_traceback_to_the_user(tmp_path, case):
         "deep": "start: " + "[" * 100_000 + "]" * 100_000,
         "laughs": "a: &a [x, x, x, x, x, x, x, x, x]\nb: &b [*a, *a, *a, *a, *a, *a, *a, *a, *a]\nstart: [*b, *b]\n",
         "number": "plant: {time_step: " + "9" * 400 + "}\n",
-        "samples": "optimiser: {samples: " + "1" * 401 + "}\n",
+        "samples": "planner: {low_level: {samples: " + "1" * 401 + "}}\n",
         "afile": "a file, not a folder",
     }
     paths = {}

@@ -526,7 +526,7 @@ def test_a_drake_check_failing_in_a_job_is_that_jobs_crash_and_a_real_exit_is_no
     from hlp_drake.systems.execution import job as job_module
     from hlp_drake.systems.scenario import Scenario
 
-    job = Job("gen1", 0, 6, "gen1-0", "hlp", Scenario().updated("optimiser: {workers: 1}").yaml)
+    job = Job("gen1", 0, 6, "gen1-0", "hlp", Scenario().updated("planner: {low_level: {workers: 1}}").yaml)
 
     def failing_check(scenario, *, pool, **kwargs):
         assert scenario.scene.name == "gen1-0" and scenario.planner.kind == "hlp" and pool.workers == 1
@@ -600,7 +600,7 @@ def test_drake_info_lines_from_worker_processes_only_with_verbose(
 
 def test_run_json_and_the_summary_say_what_ran(tmp_path, capsys):
     config = tmp_path / "scenario.yaml"
-    config.write_text("optimiser: {samples: 2}\n")
+    config.write_text("planner: {low_level: {samples: 2}}\n")
     out = tmp_path / "out"
     argv = ["gen1", "--scenes", "1", "--workers", "1", "--quiet", "--config", str(config), "--out", str(out)]
     argv += ["--execution", "closed", "--uncertainty", "4"]

@@ -80,7 +80,7 @@ def warnings(text: str) -> list[str]:
 
 
 def test_a_killed_rollout_worker_is_replaced_and_its_rollouts_run_again(scene, trajectories, capsys):
-    base = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)
+    base = short(ControlSequence.from_trajectory(trajectories["line"], 0.5), 1.0)
     config = on(scene)
     noise = sample_base_noise(np.random.default_rng(0), base, config.optimiser.noise, 3)
     sequences = [base.with_base_velocity(v) for v in noise]
@@ -101,8 +101,8 @@ def test_workers_dying_again_and_again_end_the_optimisation_as_a_failure(
     scene, trajectories, capsys, monkeypatch
 ):
     monkeypatch.setattr(pool_module, "_rollout_task", rollout_exiting)
-    config = on(scene, "optimiser: {samples: 2, max_iterations: 3}")
-    initial = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)  # fails: too short
+    config = on(scene, "planner: {low_level: {samples: 2, max_iterations: 3}}")
+    initial = short(ControlSequence.from_trajectory(trajectories["line"], 0.5), 1.0)  # fails: too short
     with RolloutPool(2) as pool:
         result = optimise(config, initial, pool)  # the initial rollout here, the iterations' on the workers
         with pytest.raises(pool_module.WorkersLost):  # the pool stays given up

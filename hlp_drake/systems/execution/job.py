@@ -1,93 +1,132 @@
-"""The Drake side of an experiment (``hlp_drake.experiments``): its scenario and its real job.
+"""The Drake side of an experiment (``hlp_drake.experiments``): its study's scenario and cells, and
+its real job.
 
-``python -m hlp_drake.experiments`` hands both to ``run_experiment``: ``scenario_yamls`` reads the
-run's scenario once, ``run_job`` plans and executes one (scene, planner) job. ``run_job`` is a
-module-level function, so process pools and dask workers can unpickle it.
+``python -m hlp_drake.experiments`` hands both to ``run_experiment``: ``resolve_study`` reads the
+run's scenario once and checks every cell of the grid against it, ``run_job`` plans and executes one
+(scene, cell) job. ``run_job`` is a module-level function, so process pools and dask workers can
+unpickle it.
 """
 
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import TYPE_CHECKING
 
+from hlp_drake.config.what_ran import WhatRan, distinct
 from hlp_drake.errors import HlpError
 from hlp_drake.learners.bundled import default_models
-from hlp_drake.systems.execution.result import what_ran
+from hlp_drake.systems.conditions import Conditions, rollout_workers
 from hlp_drake.systems.execution.run import plan_and_execute
+from hlp_drake.systems.low_level.registry import low_level_entry
 from hlp_drake.systems.low_level.sto.pool import RolloutPool
-from hlp_drake.systems.low_level.sto.rollout_world import simulation_failure
-from hlp_drake.systems.scenario import load_scenario, with_conditions
+from hlp_drake.systems.planning.initialisers import planner_label
+from hlp_drake.systems.scenario import Scenario, load_scenario
 from hlp_drake.systems.world.robot_description import load_robot
+from hlp_drake.systems.world.simulation import simulation_failure
 
 if TYPE_CHECKING:
-    from hlp_drake.experiments.runner import Job, Row, ScenarioYamls
+    from hlp_drake.experiments.runner import Job, ResolvedStudy, Row
+    from hlp_drake.experiments.study import Cell, Study
 
 
-def scenario_yamls(
-    text: str | None,
-    *,
-    single_process_rollouts: bool = False,
-    perception: str | None = None,
-    robot: str | None = None,
-    tables: str | None = None,
-) -> ScenarioYamls:
-    """The scenario of ``text`` (None: the defaults; ``perception.source`` set to ``perception`` and
-    the robot to ``robot`` unless None), read once: its YAML (the run's identity), written out in
-    full as the jobs run it (``optimiser.workers = 1`` if ``single_process_rollouts``), what its
-    jobs run and the workspace the tables are kept within: the robot's, or that of ``tables`` (a
-    shipped robot's name or a description file) to run this robot on another's tables.
+def conditions(cell: Cell, *, workers: int | None = None) -> Conditions:
+    """The ``Conditions`` a study's ``cell`` lays over the scenario (``workers``: the rollout
+    processes of a job's low-level planner; None: the scenario's)."""
+    return Conditions(
+        robot=cell.robot,
+        initial=cell.initial,
+        low_level=cell.low_level,
+        execution=cell.execution,
+        uncertainty=cell.model_error,
+        perception=cell.perception,
+        workers=workers,
+    )
+
+
+def resolve_study(study: Study, config_yaml: str | None, *, single_process_rollouts: bool) -> ResolvedStudy:
+    """The scenario of ``config_yaml`` (None: the defaults), read once, and every cell of ``study``
+    checked against it: its labels (the robot's name, the initialiser, the low-level planner, ...)
+    and the workspace its tables are kept within (the robot's, or ``study.tables``'s).
 
     Raises:
-        HlpError: the scenario is invalid.
+        HlpError: the scenario, a cell (an unknown robot, a camera source without a camera, a closed
+            loop with a low-level planner that cannot re-plan) or the tables' robot is invalid.
     """
-    # hlp_drake.experiments is imported when needed: importing hlp_drake.systems does not load it
-    from hlp_drake.experiments.runner import PLANNERS, ScenarioYamls
+    from hlp_drake.experiments.runner import Labels, ResolvedCell, ResolvedStudy
 
-    scenario = with_conditions(load_scenario(data=text, where="--config"), perception=perception, robot=robot)
-    jobs = (
-        replace(scenario, optimiser=replace(scenario.optimiser, workers=1))
-        if single_process_rollouts
-        else scenario
-    )
+    scenario = load_scenario(data=config_yaml, where="--config")
     try:
-        other = None if tables is None else load_robot(tables)
+        tables = load_robot(study.tables) if study.tables else None
     except HlpError as error:
         raise HlpError(f"--tables: {error}") from None
-    return ScenarioYamls(
-        identity=scenario.yaml,
-        job=jobs.yaml,
-        ran=replace(what_ran(scenario, planners=PLANNERS), tables=other and other.name),
-        workspace=(other or scenario.robot).workspace,
+    cells = []
+    for cell in study.cells():
+        applied = conditions(cell).applied(scenario)
+        _check_closed_loop(applied)
+        labels = Labels(
+            robot=applied.robot.name,
+            initial=applied.planner.initial,
+            low_level=applied.low_level.kind,
+            planner=planner_label(applied.planner.initial, applied.low_level.kind),
+            execution="closed" if applied.closed_loop.enabled else "open",
+            perception=applied.perception.source,
+            model_error=applied.uncertainty.seed if applied.uncertainty.enabled else None,
+        )
+        workers = 1 if single_process_rollouts else None  # jobs side by side: no nested pools
+        cells.append(ResolvedCell(cell, labels, (tables or applied.robot).workspace, workers))
+    return ResolvedStudy(scenario.yaml, tuple(cells), _what_ran(cells, tables))
+
+
+def _check_closed_loop(scenario: Scenario) -> None:
+    """Refuse a closed loop whose low-level planner cannot re-plan (before any job runs)."""
+    entry = low_level_entry(scenario.low_level.kind)
+    if scenario.closed_loop.enabled and not entry.replans:
+        raise HlpError(f"closed-loop execution needs a low-level planner that re-plans; {entry.name} does not")
+
+
+def _what_ran(cells, tables) -> WhatRan:
+    labels = [c.labels for c in cells]
+    return WhatRan(
+        robots=distinct(x.robot for x in labels),
+        planners=distinct(x.planner for x in labels),
+        initials=distinct(x.initial for x in labels),
+        low_levels=distinct(x.low_level for x in labels),
+        executions=distinct(x.execution for x in labels),
+        model_errors=distinct(x.model_error for x in labels),
+        perceptions=distinct(x.perception for x in labels),
+        tables=None if tables is None else tables.name,
     )
 
 
 def run_job(job: Job) -> Row:
-    """Plan and execute ``job``'s scene in the Drake world.
+    """Plan and execute ``job``'s scene in the Drake world, in its cell's conditions.
 
     A scene the robot cannot run (``HlpError``, e.g. a start out of a fixed arm's reach) is this
-    planner's failure with that reason; any other exception (or one of Drake's internal checks
-    failing, which pydrake raises as ``SystemExit``) is recorded as its failure ("crashed: ..."), its times as NaN (left
-    out of the means), rather than ending the run. The bundled decision models are loaded
-    before the timed call, so a worker's first scene is not charged for loading them, and
-    every job has a rollout pool of its own: no job uses rollout worlds an earlier one (maybe the
-    other planner on the same scene) built.
+    cell's failure with that reason; any other exception (or one of Drake's internal checks
+    failing, which pydrake raises as ``SystemExit``) is recorded as its failure ("crashed: ..."),
+    its times as NaN (left out of the means), rather than ending the run. The bundled decision
+    models are loaded before the timed call, so a worker's first scene is not charged for loading
+    them, and every job has a rollout pool of its own: no job uses rollout worlds an earlier one
+    (maybe another cell on the same scene) built.
     """
-    from hlp_drake.experiments.runner import crash_row, make_row  # as in scenario_yamls
+    from hlp_drake.experiments.runner import crash_row, make_row  # experiments is imported when needed
 
     settings = load_scenario(data=job.config_yaml, where="the job's scenario")
     try:
-        scenario = replace(
-            settings, scene=job.make_scene(), planner=replace(settings.planner, kind=job.planner)
-        )
-        with RolloutPool(scenario.optimiser.workers) as pool:
-            result = plan_and_execute(scenario, pool=pool, models=default_models())
+        cell = conditions(job.cell.cell, workers=job.cell.workers)
+        scenario = cell.applied(settings, scene=job.make_scene())
+        workers = rollout_workers(scenario)
+        if workers is None:
+            result = plan_and_execute(scenario, models=default_models())
+        else:
+            with RolloutPool(workers) as pool:
+                result = plan_and_execute(scenario, pool=pool, models=default_models())
     except HlpError as error:  # the scene does not suit the robot, e.g. a start out of its reach
         return crash_row(job, str(error))
-    except (Exception, SystemExit) as error:  # noqa: BLE001 - a crash is this planner's failure here
+    except (Exception, SystemExit) as error:  # noqa: BLE001 - a crash is this cell's failure here
         if isinstance(error, SystemExit):
             simulation_failure(error)  # raises it again unless it is Drake's
         return crash_row(job, f"crashed: {type(error).__name__}: {error}")
-    t = result.timings
+    t, low_level = result.timings, result.optimisation
     return make_row(
         job,
         success=result.success,
@@ -100,10 +139,13 @@ def run_job(job: Job) -> Row:
         iterations=result.iterations,
         objects_moved=len(result.objects_moved),
         objects_dropped=len(result.objects_dropped),
-        verifications=result.optimisation.get("verifications", 0),
-        rejected=result.optimisation.get("rejected", 0),
-        verify_s=result.optimisation.get("verify_s", 0.0),
+        verifications=low_level.get("verifications", 0),
+        rejected=low_level.get("rejected", 0),
+        verify_s=low_level.get("verify_s", 0.0),
         passed_then_failed=result.rollout_passed_execution_failed,
         replans=result.closed_loop.get("replans", 0),
         replan_rollouts=result.closed_loop.get("rollouts", 0),
     )
+
+
+__all__ = ["conditions", "resolve_study", "run_job"]

@@ -18,26 +18,20 @@ if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
 
 
-def what_ran(
-    scenario: Scenario,
-    scenario_file: str | None = None,
-    *,
-    pairs: tuple[tuple[str, str], ...] | None = None,
-) -> WhatRan:
+def what_ran(scenario: Scenario, scenario_file: str | None = None) -> WhatRan:
     """What a run of ``scenario`` (read from ``scenario_file``; None: the built-in default) runs: its
-    robot, initialiser and low-level planner (or the (initialiser, low-level planner) ``pairs`` of an
-    experiment), execution mode, model error's seed, perception source."""
+    robot, initialiser, low-level planner, execution mode, model error's seed, perception source."""
     uncertainty = scenario.uncertainty
-    pairs = pairs or ((scenario.planner.initial, scenario.low_level.kind),)
+    initial, low_level = scenario.planner.initial, scenario.low_level.kind
     return WhatRan(
-        robot=scenario.robot.name,
-        planners=tuple(planner_label(*pair) for pair in pairs),
-        execution="closed" if scenario.closed_loop.enabled else "open",
-        model_error_seed=uncertainty.seed if uncertainty.enabled else None,
-        perception_source=scenario.perception.source,
+        robots=(scenario.robot.name,),
+        planners=(planner_label(initial, low_level),),
+        initials=(initial,),
+        low_levels=(low_level,),
+        executions=("closed" if scenario.closed_loop.enabled else "open",),
+        model_errors=(uncertainty.seed if uncertainty.enabled else None,),
+        perceptions=(scenario.perception.source,),
         scenario_file=scenario_file,
-        initials=tuple(dict.fromkeys(i for i, _ in pairs)),
-        low_levels=tuple(dict.fromkeys(k for _, k in pairs)),
     )
 
 

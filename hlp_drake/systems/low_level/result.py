@@ -88,4 +88,13 @@ def unplanned(sequence: ControlSequence, reason: str, low_level: str) -> LowLeve
     return LowLevelResult(sequence, None, False, reason, low_level=low_level)
 
 
-__all__ = ["EMPTY_RESULT", "LowLevelResult", "StoResult", "unplanned"]
+def held(start: np.ndarray | None) -> ControlSequence:
+    """The robot held at its ``start`` positions for a second (no positions at all for None): what
+    is commanded when there is no motion to plan."""
+    if start is None or len(start) == 0:
+        return EMPTY_RESULT.sequence
+    start = np.asarray(start, dtype=float)
+    return ControlSequence(np.array([0.0, 1.0]), np.vstack([start, start]))
+
+
+__all__ = ["EMPTY_RESULT", "LowLevelResult", "StoResult", "held", "unplanned"]

@@ -26,7 +26,7 @@ from pydrake.systems.framework import LeafSystem
 from pydrake.trajectories import PiecewisePolynomial
 
 from hlp_drake.systems.low_level.protocol import LowLevelProblem
-from hlp_drake.systems.low_level.result import EMPTY_RESULT
+from hlp_drake.systems.low_level.result import EMPTY_RESULT, held, unplanned
 from hlp_drake.systems.planning.keyframes import Keyframes
 from hlp_drake.systems.world.scene_source import declare_scene_input_port, scene_input
 
@@ -58,7 +58,7 @@ class LowLevelPlannerSystem(LeafSystem):
         self._result = self.DeclareAbstractOutputPort(
             name="result",
             alloc=lambda: AbstractValue.Make(EMPTY_RESULT),
-            calc=lambda context, output: output.set_value(planner.plan(self._problem(context))),
+            calc=self._calc_result,
             prerequisites_of_calc=ticket,
         )
         self._trajectory = self.DeclareAbstractOutputPort(
@@ -90,16 +90,20 @@ class LowLevelPlannerSystem(LeafSystem):
     def get_result_output_port(self):
         return self._result
 
-    def _problem(self, context) -> LowLevelProblem:
+    def _calc_result(self, context, output) -> None:
+        """The planner's result, or with no initial trajectory the robot held at its start."""
+        keyframes = self._keyframes.Eval(context) if self._keyframes.HasValue(context) else None
+        initial = self._input.Eval(context) if self._input.HasValue(context) else PiecewisePolynomial()
+        if initial.get_number_of_segments() == 0:
+            start = None if keyframes is None else keyframes.start
+            output.set_value(unplanned(held(start), "no initial trajectory", self._planner.kind))
+            return
+
         def alternatives() -> tuple:
             return self._alternatives.Eval(context) if self._alternatives.HasValue(context) else ()
 
-        return LowLevelProblem(
-            scene=scene_input(self._scene, context),
-            keyframes=self._keyframes.Eval(context) if self._keyframes.HasValue(context) else None,
-            initial=self._input.Eval(context) if self._input.HasValue(context) else PiecewisePolynomial(),
-            alternatives=alternatives,
-        )
+        scene = scene_input(self._scene, context)
+        output.set_value(self._planner.plan(LowLevelProblem(scene, keyframes, initial, alternatives)))
 
 
 class StochasticTrajectoryOptimiser(LowLevelPlannerSystem):

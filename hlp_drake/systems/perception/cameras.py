@@ -47,6 +47,7 @@ from hlp_drake.config.ranges import Between, First, Rule
 from hlp_drake.scene.generators import MAX_SEED
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.validation import name_problem
+from hlp_drake.systems.names import PERCEPTION_SOURCES
 from hlp_drake.systems.world.scene_models import SceneModels
 
 RENDERER = "vtk"
@@ -187,7 +188,6 @@ def add_cameras(
 #       cameras:                       # the world's RGB-D cameras (default: one above the table)
 #       - {name: table_camera, position: [0.0, 0.0, 1.6], depth_noise: 0.002, dropout: 0.05, seed: 3}
 #       cluster_radius: 0.005
-PERCEPTION_SOURCES = ("truth", "camera")
 MAX_PIXELS = 4096
 """The widest and tallest camera image, pixels; its square is the most pixels of all cameras together
 (memory per frame grows with them)."""

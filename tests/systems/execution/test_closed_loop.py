@@ -7,6 +7,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from closed_loop_support import run_controller
+from sto_support import spec
 
 from hlp_drake.commands.run_scene import DEFAULT_SCENE
 from hlp_drake.errors import HlpError
@@ -15,14 +16,14 @@ from hlp_drake.systems.execution.receding_horizon import remainder
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
 from hlp_drake.systems.low_level.sto.cost import Prediction, RolloutOutcome
 from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld
-from hlp_drake.systems.planning.diagram import ObservedScenePlanner
+from hlp_drake.systems.planning.diagram import ObservedScenePlanner, make_planning_diagram
 from hlp_drake.systems.scenario import Scenario
 from hlp_drake.systems.world.robot_description import MOBILE_UR5
 from hlp_drake.systems.world.uncertainty import UncertaintyConfig, sample_perturbation
 from hlp_drake.systems.world.world import make_world_diagram, world_plant
 
 SETTINGS = (
-    "optimiser: {samples: 2, workers: 1, verify: false}\n"
+    "planner: {low_level: {samples: 2, workers: 1, verify: false}}\n"
     "closed_loop: {replan_period: 0.4, iterations: 1, rollouts: 3}\n"
 )
 
@@ -49,7 +50,7 @@ def test_the_remainder_starts_where_the_sequence_is_and_keeps_its_later_knots():
 
 
 def test_the_controller_re_optimises_every_period_within_its_budget_and_the_robot_follows(scenario):
-    start = RolloutWorld(scenario).start_positions
+    start = RolloutWorld(spec(scenario)).start_positions
     sequence = forward(start, 0.05, 1.6)
     record, desired, q = run_controller(scenario, sequence, 1.0)
     assert record.replans == 2 and record.t0 == pytest.approx(0.8)  # at 0.4 s and 0.8 s
@@ -65,7 +66,7 @@ def test_the_controller_re_optimises_every_period_within_its_budget_and_the_robo
 def test_the_closed_loops_rollout_budget_ends_the_re_optimisations(scenario):
     """An execution the controller cannot rescue ends: once ``max_rollouts`` are spent the
     commanded sequence plays to its end."""
-    start = RolloutWorld(scenario).start_positions
+    start = RolloutWorld(spec(scenario)).start_positions
     sequence = forward(start, 0.05, 1.6)
     capped = scenario.updated("closed_loop: {max_rollouts: 1}\n")
     record, desired, _ = run_controller(capped, sequence, 1.3)  # periods at 0.4, 0.8 and 1.2 s
@@ -102,20 +103,21 @@ def test_model_error_is_seeded_per_scene_and_changes_the_world(scenario):
 
 
 def test_the_observed_scene_planner_plans_on_the_observed_scene_from_where_the_robot_is(scenario):
-    world = RolloutWorld(scenario)
+    world = RolloutWorld(spec(scenario))
     world.begin(forward(world.start_positions, 0.0, 1.0))
     robot = world.states()[MOBILE_UR5.name]
     robot[0] += 0.02  # the base 2 cm on
     template = scenario.scene
     pushed = template.obstacles[0]
     scene = replace(template, obstacles=(pushed.moved(pushed.x + 0.03, pushed.y), *template.obstacles[1:]))
-    sequence = ObservedScenePlanner(scenario)(scene, robot)
+    planning = make_planning_diagram(scenario)
+    sequence = ObservedScenePlanner(planning, lambda t: ControlSequence.from_trajectory(t, 0.5))(scene, robot)
     np.testing.assert_allclose(sequence.knots[0], robot[:11])
     assert sequence.duration > 1.0
 
 
 def test_an_object_far_from_where_the_plan_expected_it_asks_for_a_new_initial_sequence(scenario):
-    start = RolloutWorld(scenario).start_positions
+    start = RolloutWorld(spec(scenario)).start_positions
     sequence, fresh = forward(start, 0.05, 1.6), forward(start, 0.0, 1.0)
     positions = np.array([[o.x, o.y, 0.8] for o in scenario.scene.objects])
     calls = []
@@ -139,7 +141,7 @@ def test_an_object_far_from_where_the_plan_expected_it_asks_for_a_new_initial_se
 
 
 def test_a_verified_sequence_on_track_is_kept_and_re_optimised_once_off_track(scenario):
-    sequence = forward(RolloutWorld(scenario).start_positions, 0.0, 1.6)  # the robot holds still
+    sequence = forward(RolloutWorld(spec(scenario)).start_positions, 0.0, 1.6)  # the robot holds still
     positions = np.array([[o.x, o.y, 0.8] for o in scenario.scene.objects])
 
     def verified(offset: float, *, passed: bool = True) -> RolloutOutcome:

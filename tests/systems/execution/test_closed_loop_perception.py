@@ -7,15 +7,15 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from closed_loop_support import run_controller
+from closed_loop_support import controller_of, run_controller
 from pydrake.systems.analysis import Simulator
+from sto_support import spec
 
 from hlp_drake.commands.run_scene import DEFAULT_SCENE
 from hlp_drake.scene.io import load_scene
-from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
+from hlp_drake.systems.low_level.result import LowLevelResult
 from hlp_drake.systems.low_level.sto.cost import Prediction, RolloutOutcome
-from hlp_drake.systems.low_level.sto.optimiser import StoResult
 from hlp_drake.systems.low_level.sto.pool import RolloutPool
 from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld
 from hlp_drake.systems.perception.cameras import CameraConfig, PerceptionConfig
@@ -24,7 +24,7 @@ from hlp_drake.systems.scenario import Scenario
 from hlp_drake.systems.world.world import make_world_diagram, world_plant
 
 SETTINGS = (
-    "optimiser: {samples: 2, workers: 1, verify: false}\n"
+    "planner: {low_level: {samples: 2, workers: 1, verify: false}}\n"
     "closed_loop: {replan_period: 0.4, iterations: 1, rollouts: 2}\n"
 )
 CAMERA = CameraConfig(width=320, height=240, depth_noise=0.001, dropout=0.01, seed=4)
@@ -37,7 +37,7 @@ def scenario() -> Scenario:
 
 
 def hold(scenario: Scenario, duration: float) -> ControlSequence:
-    start = RolloutWorld(scenario).start_positions
+    start = RolloutWorld(spec(scenario)).start_positions
     return ControlSequence(np.array([0.0, duration]), np.vstack([start, start]))
 
 
@@ -73,12 +73,14 @@ def test_a_failed_frame_at_a_re_plan_keeps_the_last_good_scene_and_its_reason(sc
     plant, _ = world_plant(world)
     good = replace(scenario.scene, name="seen")
     with RolloutPool(1) as pool:
-        controller = RecedingHorizonController(scenario, plant, pool)
+        controller = controller_of(scenario, plant, pool)
         simulator = Simulator(controller)
         context = simulator.get_mutable_context()
         x = plant.GetPositionsAndVelocities(plant.CreateDefaultContext())
         controller.GetInputPort("state").FixValue(context, x)
-        controller.GetInputPort("initial").FixValue(context, StoResult(hold(scenario, 1.6), None, True, None))
+        controller.GetInputPort("initial").FixValue(
+            context, LowLevelResult(hold(scenario, 1.6), None, True, None)
+        )
         controller.GetInputPort("scene").FixValue(context, good)
         simulator.Initialize()
         controller.GetInputPort("scene").FixValue(context, unperceived_scene(good))

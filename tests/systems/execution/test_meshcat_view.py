@@ -9,7 +9,7 @@ from itertools import pairwise
 
 import numpy as np
 import pytest
-from test_run_scene import animation_tracks, messages
+from meshcat_support import animation_tracks, messages
 
 from hlp_drake.planner.plan import HighLevelPlan, PlanKeypoint
 from hlp_drake.scene.generators import generate_scene

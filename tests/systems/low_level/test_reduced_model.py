@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from sto_support import on, short
+from sto_support import on, short, spec
 
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
 from hlp_drake.systems.low_level.sto.pool import SceneRollouts
@@ -13,7 +13,7 @@ from hlp_drake.systems.low_level.sto.rollout_world import RolloutStart, RolloutW
 from hlp_drake.systems.low_level.sto.sampler import OBJECT, ROBOT, TABLE, contact_summary
 from hlp_drake.systems.low_level.sto.sleep import ProximityContext, Sweep
 
-REDUCED = "optimiser: {reduced_model: true}"
+REDUCED = "planner: {low_level: {reduced_model: true}}"
 """The reduced model, an approximation of the execution model (off by default)."""
 
 
@@ -65,17 +65,17 @@ def _gaps_within_own_spread(
 
 def test_the_reduced_model_lets_only_objects_nothing_comes_near_sleep(scene, trajectories, world):
     config = on(scene, REDUCED)
-    reduced = SceneRollouts(config)
-    sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), PUSHING_HORIZON)
+    reduced = SceneRollouts(spec(config))
+    sequence = short(ControlSequence.from_trajectory(trajectories["line"], 0.5), PUSHING_HORIZON)
     full, samples = world.simulate(sequence), reduced.simulate(sequence)
     names = [obj.name for obj in scene.objects]
     pushed = {
         n for n, d in zip(names, np.linalg.norm(full.positions[-1] - full.positions[0], axis=1)) if d > 0.01
     }
     assert len(pushed) == 2 and samples.asleep and samples.switches > 0
-    approach = Sweep(world).approach_times(sequence, config.optimiser.weld_clearance)
+    approach = Sweep(world).approach_times(sequence, config.low_level.weld_clearance)
     initially = reduced.sleep_schedule(sequence).initially_asleep()
-    assert initially and all(approach[name] > config.optimiser.weld_lookahead for name in initially)
+    assert initially and all(approach[name] > config.low_level.weld_lookahead for name in initially)
     assert "FailOnTouchObstacleLong" not in initially  # the one the robot pushes at once starts awake
     # Sleeping objects simply stay put (they do not sag); the pushed ones land as far from the full
     # model's as a 0.03 mm nudge of the chained one moves the full model itself.
@@ -87,17 +87,17 @@ def test_the_reduced_model_lets_only_objects_nothing_comes_near_sleep(scene, tra
     assert a.success == b.success and a.fallen == b.fallen
     assert abs(a.cost - b.cost) <= cost_spread + 1e-3 * b.cost
     assert a.asleep == samples.asleep and b.asleep == () and b.switches == 0
-    off = config.updated("optimiser: {reduced_model: false}")
-    assert SceneRollouts(off).rollout(sequence).terms == b.terms  # off: the full model
+    off = config.updated("planner: {low_level: {reduced_model: false}}")
+    assert SceneRollouts(spec(off)).rollout(sequence).terms == b.terms  # off: the full model
 
 
 def test_an_object_pushed_towards_a_sleeping_one_wakes_it_from_the_sample_before(scene, trajectories, world):
-    sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), PUSHING_HORIZON)
+    sequence = short(ControlSequence.from_trajectory(trajectories["line"], 0.5), PUSHING_HORIZON)
     chained = CHAINED
     config = on(
-        scene, "optimiser: {reduced_model: true, weld_clearance: 0.01, weld_lookahead: 0.0}"
+        scene, "planner: {low_level: {reduced_model: true, weld_clearance: 0.01, weld_lookahead: 0.0}}"
     )  # the schedule wakes late...
-    reduced = SceneRollouts(config)
+    reduced = SceneRollouts(spec(config))
     assert chained in reduced.sleep_schedule(sequence).initially_asleep()
     samples = reduced.simulate(sequence)  # ...so the check during the rollout must
     assert chained not in samples.asleep and samples.switches >= 2
@@ -105,12 +105,12 @@ def test_an_object_pushed_towards_a_sleeping_one_wakes_it_from_the_sample_before
 
 
 def test_an_object_come_to_rest_after_a_push_goes_back_to_sleep(scene, trajectories, world):
-    pushing = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 2.0)  # pushes Long aside
+    pushing = short(ControlSequence.from_trajectory(trajectories["line"], 0.5), 2.0)  # pushes Long aside
     times = np.append(pushing.times, pushing.times[-1] + np.array([1.0, 2.0]))
     sequence = ControlSequence(
         times, np.vstack([pushing.knots, pushing.knots[-2], pushing.knots[0]])
     )  # ...back
-    samples = SceneRollouts(on(scene, REDUCED)).simulate(sequence)
+    samples = SceneRollouts(spec(on(scene, REDUCED))).simulate(sequence)
     pushed = scene.objects.index(next(o for o in scene.objects if o.name == "FailOnTouchObstacleLong"))
     assert np.linalg.norm(samples.positions[-1, pushed] - samples.positions[0, pushed]) > 0.05
     assert set(samples.asleep) == {obj.name for obj in scene.objects}  # it too, once the robot is away
@@ -118,13 +118,13 @@ def test_an_object_come_to_rest_after_a_push_goes_back_to_sleep(scene, trajector
 
 
 def test_a_rollout_restarted_from_its_states_goes_on_exactly(scene, trajectories, world):
-    sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 2.0)
+    sequence = short(ControlSequence.from_trajectory(trajectories["line"], 0.5), 2.0)
     world.begin(sequence)
     world.advance_to(2.0)
     end = world.states()
     world.begin(sequence)
     world.advance_to(1.0)
-    other = RolloutWorld(on(scene, REDUCED))
+    other = RolloutWorld(spec(on(scene, REDUCED)))
     other.begin(sequence, time=1.0, states=world.states())
     other.advance_to(2.0)
     assert other.states().keys() == end.keys()
@@ -133,13 +133,13 @@ def test_a_rollout_restarted_from_its_states_goes_on_exactly(scene, trajectories
 
 
 def test_a_rollout_from_a_given_state_starts_there(scene, trajectories, world):
-    sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)
+    sequence = short(ControlSequence.from_trajectory(trajectories["line"], 0.5), 1.0)
     world.begin(sequence)
     states = world.states()
     obstacle = scene.obstacles[0].name
     states[obstacle] = states[obstacle].copy()
     states[obstacle][4:6] += [0.0, 0.02]  # the obstacle 2 cm to the left (x, y, z follow the quaternion)
-    samples = SceneRollouts(on(scene, REDUCED)).simulate(sequence, RolloutStart(states))
+    samples = SceneRollouts(spec(on(scene, REDUCED))).simulate(sequence, RolloutStart(states))
     assert samples.positions[0, 1, 1] == pytest.approx(scene.obstacles[0].y + 0.02, abs=1e-6)
     assert samples.positions[-1, 1, 1] == pytest.approx(scene.obstacles[0].y + 0.02, abs=1e-3)
 
@@ -156,7 +156,7 @@ def _closest_by_body_pair(pairs) -> dict[tuple[int, int], float]:
 
 
 def test_the_checks_see_the_robot_and_object_pairs_at_their_full_distances(scene, trajectories, world):
-    sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), PUSHING_HORIZON)
+    sequence = short(ControlSequence.from_trajectory(trajectories["line"], 0.5), PUSHING_HORIZON)
     world.begin(sequence)
     world.advance_to(1.5)  # pushing Long, near the others
     context = world.diagram.CreateDefaultContext()  # every geometry pair checked there
@@ -190,7 +190,7 @@ def test_the_commanded_sweep_checks_the_robot_against_the_objects_only(world):
 
 
 def test_object_positions_and_speeds_are_their_bodies_poses_and_velocities(scene, trajectories, world):
-    sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), PUSHING_HORIZON)
+    sequence = short(ControlSequence.from_trajectory(trajectories["line"], 0.5), PUSHING_HORIZON)
     world.begin(sequence)
     world.advance_to(1.5)
     plant, context = world.plant, world.plant.CreateDefaultContext()

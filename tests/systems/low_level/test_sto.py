@@ -1,27 +1,21 @@
-"""The stochastic trajectory optimiser: control sequences, rollout cost, the optimiser, its block."""
+"""The STO's parts: control sequences, the noise, the rollout cost, rollout worlds and their pool."""
 
 from __future__ import annotations
 
-import dataclasses
 import re
 
 import numpy as np
 import pytest
 from human_plans import GEN1_15, GEN2_9_39, GEN2_9_39_NEXT, chain_first_rollout, human_plan
-from pydrake.trajectories import PiecewisePolynomial
-from sto_support import on, short
+from sto_support import on, short, spec, sto
 
 from hlp_drake.errors import HlpError
 from hlp_drake.scene.generators import generate_scene
-from hlp_drake.scene.model import SceneObject
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
-from hlp_drake.systems.low_level.sto.budget import Budget
-from hlp_drake.systems.low_level.sto.config import PERCEIVED_CHECKS, StoConfig
 from hlp_drake.systems.low_level.sto.cost import BLOWN_UP_COST, RolloutSamples, rollout_cost
-from hlp_drake.systems.low_level.sto.optimiser import mppi_weights, optimise, sample_base_noise
+from hlp_drake.systems.low_level.sto.optimiser import mppi_weights, sample_base_noise
 from hlp_drake.systems.low_level.sto.pool import RolloutPool, SceneRollouts
 from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld
-from hlp_drake.systems.low_level.sto.system import StochasticTrajectoryOptimiser
 from hlp_drake.systems.planning.diagram import make_planning_diagram
 from hlp_drake.systems.scenario import Scenario
 from hlp_drake.systems.world.start_pose import tcp_keypoint_height
@@ -66,7 +60,7 @@ def test_base_velocity_is_integrated_and_the_start_stays():
 
 
 def test_noise_is_seeded_and_keeps_only_part_of_its_drift():
-    config = Scenario().optimiser
+    config = Scenario().low_level
     sequence = ControlSequence(np.linspace(0.0, 4.0, 9), np.zeros((9, 11)))
     a = sample_base_noise(np.random.default_rng(3), sequence, config.noise, 6)
     b = sample_base_noise(np.random.default_rng(3), sequence, config.noise, 6)
@@ -112,7 +106,8 @@ def test_cost_rewards_reaching_and_charges_falls_forces_and_blow_ups(scene):
     height = tcp_keypoint_height(scene, config.ik)
     kwargs = {"tcp_height": height, "effort": 0.0, "step_duration": 0.5}
     target = (scene.target.x, scene.target.y)
-    sto = config.optimiser
+    sto = config.low_level
+    kwargs["success"] = config.success
     reached = rollout_cost(synthetic_samples(scene, tcp_end=target), scene, sto, **kwargs)
     assert reached.success and reached.failure_reason is None and reached.cost < 1.0
     short_of = rollout_cost(
@@ -139,19 +134,19 @@ def test_rollouts_are_repeatable_and_the_hlp_initialisation_reaches_the_default_
     first, second = world.rollout(sequence), world.rollout(sequence)
     assert first.success, first.failure_reason
     assert first.cost == second.cost and first.terms == second.terms  # contexts are reset, not rebuilt
-    assert first.simulated_s == pytest.approx(sequence.duration + world.scenario.optimiser.settle_s)
+    assert first.simulated_s == pytest.approx(sequence.duration + world.spec.success.settle_s)
 
 
 def test_rollouts_read_their_state_every_sample_period(scene, trajectories):
-    config = on(scene, "optimiser: {sample_period: 0.25, settle_s: 0.0}")
-    rollouts = SceneRollouts(config)
-    sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)
+    config = on(scene, "planner: {low_level: {sample_period: 0.25}}\nsuccess: {settle_s: 0.0}")
+    rollouts = SceneRollouts(spec(config))
+    sequence = short(ControlSequence.from_trajectory(trajectories["line"], 0.5), 1.0)
     rolled, verified = rollouts.rollout(sequence), rollouts.verify(sequence)
     np.testing.assert_allclose(rolled.prediction.times, [0.0, 0.25, 0.5, 0.75, 1.0])
     np.testing.assert_array_equal(verified.prediction.times, rolled.prediction.times)
     assert verified.cost == rolled.cost  # one model: the verification is the rollout again
-    with pytest.raises(HlpError, match=r"optimiser\.sample_period must be > 0"):
-        on(scene, "optimiser: {sample_period: 0.0}")
+    with pytest.raises(HlpError, match=r"planner\.low_level\.sample_period must be > 0"):
+        on(scene, "planner: {low_level: {sample_period: 0.0}}")
 
 
 def test_a_gripper_closed_among_the_obstacles_does_not_carry_one_into_the_target():
@@ -171,7 +166,7 @@ def test_where_the_hlps_plan_fails_at_its_first_rollout_its_next_candidates_are_
     the pushed obstacle and knocks another off the table; of the next three distinct candidate
     plans, the second passes at its first rollout. The straight line has no candidates to try."""
     scene = generate_scene("gen2", 39, 9)
-    config = on(scene, "optimiser: {max_iterations: 1, samples: 2}")
+    config = on(scene, "planner: {low_level: {max_iterations: 1, samples: 2}}")
     person = human_plan(scene, GEN2_9_39, GEN2_9_39_NEXT)
     with RolloutPool(1) as pool:
         diagram = make_planning_diagram(config, pool=pool, plan=person)
@@ -180,7 +175,7 @@ def test_where_the_hlps_plan_fails_at_its_first_rollout_its_next_candidates_are_
         transfer = diagram.GetSubsystemByName("robot_plan_transfer")
         count = len(transfer.GetOutputPort("robot_alternatives").Eval(transfer.GetMyContextFromRoot(context)))
         hlp = diagram.GetOutputPort("optimisation").Eval(context)
-        sto = make_planning_diagram(config.updated("planner: {kind: sto}"), pool=pool)
+        sto = make_planning_diagram(config.updated("planner: {initial: line}"), pool=pool)
         sto_context = sto.CreateDefaultContext()
         sto.GetInputPort("scene").FixValue(sto_context, scene)
         straight = sto.GetOutputPort("optimisation").Eval(sto_context)
@@ -198,8 +193,8 @@ def test_holding_still_fails_with_the_goal_cost(world, scene):
 
 
 def test_impossible_object_speed_counts_as_a_blow_up(scene, trajectories):
-    config = on(scene, "optimiser: {max_object_speed: 1.0e-4}")  # any push now exceeds it
-    outcome = RolloutWorld(config).rollout(ControlSequence.from_trajectory(trajectories["sto"], 0.5))
+    config = on(scene, "planner: {low_level: {max_object_speed: 1.0e-4}}")  # any push now exceeds it
+    outcome = RolloutWorld(spec(config)).rollout(ControlSequence.from_trajectory(trajectories["line"], 0.5))
     assert (
         not outcome.success and outcome.cost == BLOWN_UP_COST and "over the table" in outcome.failure_reason
     )
@@ -208,8 +203,8 @@ def test_impossible_object_speed_counts_as_a_blow_up(scene, trajectories):
 def test_a_drake_internal_check_failing_mid_rollout_is_a_failure_and_the_world_goes_on(scene, trajectories):
     # Non-finite state (as after a blow-up) makes Drake's SetPositions check fail inside AdvanceTo;
     # pydrake raises that as SystemExit. The rollout reports it; the world is reusable after it.
-    world = RolloutWorld(on(scene))
-    sequence = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 0.5)
+    world = RolloutWorld(spec(on(scene)))
+    sequence = short(ControlSequence.from_trajectory(trajectories["line"], 0.5), 0.5)
     world.begin(sequence)
     state = world._context.get_mutable_discrete_state_vector()
     x = state.get_value().copy()
@@ -219,7 +214,7 @@ def test_a_drake_internal_check_failing_mid_rollout_is_a_failure_and_the_world_g
     assert re.fullmatch(
         r"the solver failed at t = 0\.0\d s: the simulation diverged \(the state turned non-finite\)", problem
     )
-    clean = RolloutWorld(on(scene)).rollout(sequence)
+    clean = RolloutWorld(spec(on(scene))).rollout(sequence)
     again = world.rollout(sequence)
     assert (again.cost, again.success, again.fallen) == (clean.cost, clean.success, clean.fallen)
     world.begin(sequence)  # a solver that diverged without failing: the state is not finite after it
@@ -228,7 +223,7 @@ def test_a_drake_internal_check_failing_mid_rollout_is_a_failure_and_the_world_g
 
 
 def test_only_drake_failures_count_as_simulation_failures():
-    from hlp_drake.systems.low_level.sto.rollout_world import simulation_failure
+    from hlp_drake.systems.world.simulation import simulation_failure
 
     assert simulation_failure(RuntimeError("SAP failed\nmore")) == "SAP failed"
     assert simulation_failure(SystemExit("Failure at x.h:1 in f(): condition 'c' failed.")).startswith(
@@ -241,9 +236,9 @@ def test_only_drake_failures_count_as_simulation_failures():
 
 
 def test_two_workers_give_the_same_outcomes_as_one(scene, trajectories):
-    base = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)
-    config = on(scene, "optimiser: {reduced_model: true}")
-    noise = sample_base_noise(np.random.default_rng(0), base, config.optimiser.noise, 3)
+    base = short(ControlSequence.from_trajectory(trajectories["line"], 0.5), 1.0)
+    config = sto(scene, "reduced_model: true")
+    noise = sample_base_noise(np.random.default_rng(0), base, config.sto.noise, 3)
     sequences = [base.with_base_velocity(v) for v in noise]
     local = [SceneRollouts(config).rollout(s) for s in sequences]  # a fresh set of worlds for each
     with RolloutPool(2) as pool:
@@ -256,204 +251,21 @@ def test_two_workers_give_the_same_outcomes_as_one(scene, trajectories):
     assert [o.asleep for o in remote] == [o.asleep for o in local] and all(o.asleep for o in local)
 
 
-# --- The optimiser ---------------------------------------------------------------------------------
-
-
-def test_optimiser_is_seeded_monotone_and_stops_at_its_iteration_budget(scene, trajectories):
-    config = on(scene, "optimiser: {max_iterations: 2, samples: 2, update: mppi}")
-    initial = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)  # too short to reach
+def test_a_pool_keeps_its_worlds_by_spec_until_it_is_closed(scene):
     with RolloutPool(1) as pool:
-        first = optimise(config, initial, pool)
-        second = optimise(config, initial, pool)
-    assert not first.success and "after 2 iterations" in first.failure_reason
-    assert first.iterations == 2 and first.rollouts == 1 + 2 * (2 + 1)  # mppi rolls its mean out too
-    assert all(b <= a for a, b in zip(first.costs, first.costs[1:]))
-    assert first.costs == second.costs
-    np.testing.assert_array_equal(first.sequence.knots, second.sequence.knots)
-
-
-def test_optimiser_respects_its_time_budget(scene, trajectories):
-    config = on(scene, "optimiser: {time_budget_s: 1.0e-3}")
-    initial = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)
-    with RolloutPool(1) as pool:
-        result = optimise(config, initial, pool)
-    assert not result.success and result.iterations == 0 and result.rollouts == 1
-    assert "time budget" in result.failure_reason
-
-
-def test_optimiser_stops_at_its_rollout_budget_with_the_same_result_on_two_workers(scene, trajectories):
-    assert Scenario().optimiser.time_budget_s == 0.0  # by default no wall-clock budget at all
-    config = on(scene, "optimiser: {samples: 2, max_iterations: 20, max_rollouts: 5}")
-    initial = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)  # too short to reach
-    with RolloutPool(1) as pool:
-        one = optimise(config, initial, pool)
-    with RolloutPool(2) as pool:
-        two = optimise(config, initial, pool)
-    assert not one.success and one.rollouts == 5 and one.iterations == 2
-    assert "rollout budget of 5 spent" in one.failure_reason
-    assert (two.costs, two.rollouts, two.failure_reason) == (one.costs, one.rollouts, one.failure_reason)
-    np.testing.assert_array_equal(two.sequence.knots, one.sequence.knots)
-
-
-def test_a_failed_initial_rollout_goes_on_from_the_planners_first_passing_alternative(scene, trajectories):
-    config = on(scene, "optimiser: {max_iterations: 1, samples: 1}")
-    stuck = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)  # fails: too short
-    reaching = ControlSequence.from_trajectory(trajectories["hlp"], 0.5)  # passes
-    calls = []
-
-    def alternatives():
-        calls.append(1)
-        return [stuck, reaching, reaching]
-
-    with RolloutPool(1) as pool:
-        passed = optimise(config, reaching, pool, alternatives=alternatives)
-        assert passed.success and passed.start == 0 and passed.rollouts == 1 and not calls  # not needed
-        # rolled out on the execution model: its own verification, nothing simulated again
-        assert passed.verifications == 0 and passed.verify_s == 0.0
-        assert passed.outcome.verification.cost == passed.outcome.cost
-        reduced = config.updated("optimiser: {reduced_model: true}")  # an approximation: verified
-        checked = optimise(reduced, reaching, pool)
-        assert checked.success and checked.verifications == 1 and checked.rejected == 0
-        assert checked.outcome.verification.success and checked.outcome.verification.wall_s > 0
-        assert checked.outcome.verification.wall_s <= checked.verify_s <= checked.optimise_s
-        unverified = optimise(reduced.updated("optimiser: {max_verifications: 0}"), reaching, pool)
-        assert not unverified.success and "verifications ran out" in unverified.failure_reason
-        assert unverified.verify_s == 0.0 and unverified.to_dict()["verify_s"] == 0.0
-        result = optimise(config, stuck, pool, alternatives=alternatives)
-        assert calls == [1]
-        assert result.success and result.iterations == 0 and result.start == 2  # the first that passes
-        assert result.rollouts == 1 + 3 and result.sequence is not stuck
-        assert result.to_dict()["start"] == 2 and result.costs[-1] < result.costs[0]
-        one = config.updated(
-            "optimiser: {alternatives: 1}"
-        )  # only the first: it fails too, and costs no less
-        capped = optimise(one, stuck, pool, alternatives=alternatives)
-        assert not capped.success and capped.start == 0 and capped.rollouts == 1 + 1 + 1
-        none = config.updated("optimiser: {alternatives: 0}")
-        never = optimise(none, stuck, pool, alternatives=lambda: pytest.fail("called"))
-        assert never.rollouts == 1 + 1
-
-
-def test_a_start_in_collision_fails_without_rollouts(scene, trajectories):
-    blocker = SceneObject(
-        name="Blocker",
-        shape="box",
-        x=float(scene.start[0]) + 0.03,
-        y=float(scene.start[1]),
-        size=(0.04, 0.16, 0.12),
-    )  # wider than the open fingers
-    blocked = dataclasses.replace(scene, obstacles=(*scene.obstacles, blocker))
-    initial = short(ControlSequence.from_trajectory(trajectories["sto"], 0.5), 1.0)
-    with RolloutPool(1) as pool:
-        result = optimise(on(blocked, "optimiser: {max_iterations: 1}"), initial, pool)
-    assert not result.success and result.rollouts == 0
-    assert result.failure_reason == "the robot starts in collision with Blocker"
-
-
-def test_optimiser_block_ports_and_cache(scene, trajectories):
-    with RolloutPool(1) as pool:
-        block = StochasticTrajectoryOptimiser(on(scene, "optimiser: {max_iterations: 1}"), pool)
-        assert [block.get_input_port(i).get_name() for i in range(block.num_input_ports())] == [
-            "scene",
-            "initial_trajectory",
-            "alternative_trajectories",
-        ]
-        context = block.CreateDefaultContext()
-        empty = block.get_result_output_port().Eval(context)
-        assert not empty.success and empty.failure_reason == "no initial trajectory"
-        block.GetInputPort("initial_trajectory").FixValue(context, trajectories["hlp"])
-        with pytest.raises(RuntimeError, match="connect or fix its 'scene' input"):
-            block.GetOutputPort("result").Eval(context)
-        block.get_scene_input_port().FixValue(context, scene)
-        result = block.GetOutputPort("result").Eval(context)
-        trajectory = block.GetOutputPort("trajectory").Eval(context)
-        assert block.GetOutputPort("result").Eval(context) is result  # cached
-        assert result.success and result.iterations == 0  # the HLP initialisation already succeeds here
-        assert isinstance(trajectory, PiecewisePolynomial)
-        assert trajectory.end_time() == pytest.approx(trajectories["hlp"].end_time())
-        block.GetInputPort("alternative_trajectories").FixValue(context, (trajectories["hlp"],))
-        again = block.GetOutputPort("result").Eval(context)  # a new input value: optimised again
-        assert again is not result and again.success and again.start == 0
-
-
-def test_an_unreachable_target_fails_with_a_reason_and_no_rollouts(scene):
-    from hlp_drake.systems.execution.run import plan_and_execute
-
-    far = dataclasses.replace(scene.target, x=scene.table.length + 1.5)
-    with RolloutPool(1) as pool:
-        unreachable = on(dataclasses.replace(scene, target=far))  # (an invalid scene: built, not loaded)
-        straight = dataclasses.replace(
-            unreachable, planner=dataclasses.replace(unreachable.planner, kind="sto")
-        )
-        result = plan_and_execute(straight, pool=pool)
-    assert (
-        not result.success
-        and result.failure_reason.startswith("IK failed")
-        and "Target" in result.failure_reason
-    )
-    assert result.rollouts == 0 and result.grasp_held is None
-
-
-def test_a_pool_keeps_its_worlds_by_scenario_until_it_is_closed(scene):
-    with RolloutPool(1) as pool:
-        kept = pool.world(on(scene))
-        assert pool.world(on(scene)) is kept  # an equal scenario: the same key, the same worlds
-        assert pool.world(on(scene, "optimiser: {samples: 3}")) is not kept
+        kept = pool.world(sto(scene))
+        assert pool.world(sto(scene)) is kept  # an equal spec: the same key, the same worlds
+        assert pool.world(sto(scene, "samples: 3")) is not kept
     with RolloutPool(1) as other:  # worlds belong to their pool
-        assert other.world(on(scene)) is not kept
+        assert other.world(sto(scene)) is not kept
 
 
-def test_displaced_scenes_move_every_object_by_about_sigma_and_are_seeded(scene):
-    from hlp_drake.systems.world.uncertainty import displaced_scenes
+def test_a_rollout_spec_reads_back_from_its_yaml_as_a_worker_gets_it(scene):
+    from hlp_drake.systems.low_level.sto.spec import RolloutSpec
 
-    a, b = displaced_scenes(scene, 2, 0.001, 0.01), displaced_scenes(scene, 2, 0.001, 0.01)
-    assert a == b and len(a) == 2 and a[0] != a[1]
-    for moved in a:
-        pairs = list(zip(scene.objects, moved.objects))
-        assert all(o.name == m.name and o.size == m.size for o, m in pairs)
-        offsets = np.array([np.hypot(m.x - o.x, m.y - o.y) for o, m in pairs])
-        assert 0.0 < offsets.max() < 0.006  # a few sigma, every object displaced by a different amount
-        assert len(set(np.round(offsets, 9))) == len(offsets)
-    assert displaced_scenes(scene, 1, 0.0, 0.0) == [scene]
-
-
-def test_a_verified_sequence_counts_only_if_it_passes_with_the_objects_displaced(scene, trajectories):
-    reaching = ControlSequence.from_trajectory(trajectories["hlp"], 0.5)  # passes, verified too
-    settings = "optimiser: {{max_rollouts: 1, samples: 1, displaced_checks: 1, displaced_sigma: {}}}"
-    with RolloutPool(2) as pool:
-        kept = optimise(on(scene, settings.format(0.001)), reaching, pool)
-        moved = optimise(on(scene, settings.format(0.05)), reaching, pool)  # the target 5 cm off and more
-    assert kept.success and (kept.verifications, kept.displaced_checks, kept.rejected) == (1, 1, 0)
-    assert kept.outcome.verification is not None and kept.to_dict()["displaced_checks"] == 1
-    assert not moved.success and (moved.verifications, moved.displaced_checks, moved.rejected) == (1, 1, 1)
-    assert "passed its verification, failed with the objects displaced (1 of 1)" in moved.failure_reason
-    assert "rollout budget of 1 spent" in moved.failure_reason
-    with pytest.raises(HlpError, match=r"optimiser\.displaced_checks must be between 0 and 100"):
-        on(scene, "optimiser: {displaced_checks: -1}")
-
-
-def test_the_search_ends_once_its_verifications_are_spent_whatever_rollouts_are_left(scene, trajectories):
-    reaching = ControlSequence.from_trajectory(trajectories["hlp"], 0.5)  # passes every rollout
-    settings = (
-        "optimiser: {max_rollouts: 40, samples: 2, max_verifications: 2, displaced_checks: 1,"
-        " displaced_sigma: 0.05}"  # every verified sequence fails with the objects displaced
-    )
-    with RolloutPool(2) as pool:
-        result = optimise(on(scene, settings), reaching, pool)
-    assert not result.success and (result.verifications, result.rejected) == (2, 2)
-    assert result.failure_reason.endswith("(verifications spent)") and result.rollouts < 40
-    assert StoConfig().max_verifications == 8
-
-
-def test_perceived_scenes_get_displaced_checks_unless_the_scenario_sets_them(scene, trajectories):
-    camera = "perception: {source: camera}"
-    assert Budget.of(on(scene)).displaced_checks == 0
-    assert Budget.of(on(scene, camera)).displaced_checks == PERCEIVED_CHECKS == 2
-    assert Budget.of(on(scene, camera).updated("optimiser: {displaced_checks: 0}")).displaced_checks == 0
-    assert Budget.of(on(scene, "optimiser: {displaced_checks: 3}")).displaced_checks == 3
-    reaching = ControlSequence.from_trajectory(trajectories["hlp"], 0.5)
-    with RolloutPool(2) as pool:
-        result = optimise(
-            on(scene, camera).updated("optimiser: {max_rollouts: 1, samples: 1}"), reaching, pool
-        )
-    assert result.success and (result.verifications, result.displaced_checks) == (1, PERCEIVED_CHECKS)
+    original = sto(scene, "samples: 3")
+    again = RolloutSpec.from_yaml(original.yaml)
+    assert again.yaml == original.yaml and again.key == original.key and again.world_key == original.world_key
+    assert again.scene == original.scene and again.sto == original.sto
+    assert sto(scene, "samples: 4").world_key == original.world_key  # the same world, another search
+    assert spec(on(scene, "plant: {time_step: 0.005}")).world_key != original.world_key

@@ -56,7 +56,7 @@ def frame() -> dict[str, object]:
 
 def perceive_fixed(depth, labels, pose, scenario: Scenario = SCENARIO):
     """``ScenePerception``'s ``perception`` and ``scene`` outputs with its inputs fixed."""
-    block = ScenePerception(scenario)
+    block = ScenePerception(template=scenario.scene, config=scenario.perception)
     context = block.CreateDefaultContext()
     name = scenario.perception.cameras[0].name
     block.GetInputPort(f"{name}.depth_image").FixValue(context, depth)
@@ -187,7 +187,7 @@ def test_unlabelled_objects_and_a_wrong_image_size_give_their_reasons(frame):
 
 
 def test_an_unconnected_input_is_a_wiring_error():
-    block = ScenePerception(SCENARIO)
+    block = ScenePerception(template=SCENARIO.scene, config=SCENARIO.perception)
     with pytest.raises(RuntimeError, match="connect or fix table_camera.depth_image"):
         block.get_scene_output_port().Eval(block.CreateDefaultContext())
 
@@ -245,7 +245,7 @@ def test_the_scenario_file_sets_the_cameras_and_the_perception_block_follows_it(
         "side",
     ]
     assert scenario.perception.cameras[0].depth_noise == CameraConfig().depth_noise
-    block = ScenePerception(scenario)
+    block = ScenePerception(template=scenario.scene, config=scenario.perception)
     ports = {block.get_input_port(i).get_name() for i in range(block.num_input_ports())}
     assert ports == {
         f"{c}.{p}" for c in ("top", "side") for p in ("depth_image", "label_image", "camera_pose")
@@ -263,7 +263,7 @@ def test_add_scene_perception_wires_the_worlds_cameras():
         SCENARIO, perception=replace(SCENARIO.perception, cameras=(replace(CAMERA, width=160, height=120),))
     )
     world = builder.AddSystem(make_world_diagram(scenario))
-    block = add_scene_perception(builder, world, scenario)
+    block = add_scene_perception(builder, world, template=scenario.scene, config=scenario.perception)
     diagram = builder.Build()
     context = diagram.CreateDefaultContext()
     mine = block.GetMyContextFromRoot(context)
@@ -305,7 +305,7 @@ def test_two_tilted_cameras_frames_are_perceived_together():
     scenario = replace(SCENARIO, perception=replace(SCENARIO.perception, cameras=cameras))
     builder = DiagramBuilder()
     world = builder.AddSystem(make_world_diagram(scenario))
-    block = add_scene_perception(builder, world, scenario)
+    block = add_scene_perception(builder, world, template=scenario.scene, config=scenario.perception)
     diagram = builder.Build()
     perception = block.get_perception_output_port().Eval(
         block.GetMyContextFromRoot(diagram.CreateDefaultContext())
@@ -323,7 +323,7 @@ def test_the_perceived_scene_follows_an_object_moved_in_the_plant():
     """What a re-planning controller needs: the same diagram perceives again when an object moves."""
     builder = DiagramBuilder()
     world = builder.AddSystem(make_world_diagram(SCENARIO))
-    block = add_scene_perception(builder, world, SCENARIO)
+    block = add_scene_perception(builder, world, template=SCENARIO.scene, config=SCENARIO.perception)
     diagram = builder.Build()
     context = diagram.CreateDefaultContext()
     mine = block.GetMyContextFromRoot(context)

@@ -9,7 +9,7 @@ import pytest
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.planner import plan
 from hlp_drake.scene.generators import generate_scene
-from hlp_drake.systems.planning.diagram import HlpPlannerSystem
+from hlp_drake.systems.planning.initialiser_blocks import HlpPlannerSystem
 
 
 def test_plan_output_matches_the_planner_and_is_cached_by_drake():

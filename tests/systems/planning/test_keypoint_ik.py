@@ -24,7 +24,8 @@ CONFIG = Scenario()
 
 
 def ik_for(scene: Scene, scenario: Scenario = CONFIG) -> KeypointIk:
-    return KeypointIk(replace(scenario, scene=scene))
+    """``KeypointIk`` on ``scene`` with ``scenario``'s sections (alone: the block takes its own)."""
+    return KeypointIk(scene, robot=scenario.robot, ik=scenario.ik, motion=scenario.motion)
 
 
 def solve(system: KeypointIk, plan: HighLevelPlan) -> Keyframes:

@@ -120,7 +120,7 @@ def test_the_command_line_names_an_unknown_robot_and_a_bad_description(own_robot
 
     unknown = run("--robot", "r2d2")
     assert unknown.returncode == 2 and "Traceback" not in unknown.stderr
-    assert "robot 'r2d2': not a shipped robot (mobile_ur5, panda, iiwa14)" in unknown.stderr
+    assert "robot 'r2d2': not a shipped robot (mobile_ur5, iiwa14, panda)" in unknown.stderr
     broken = run("--robot", str(_broken(own_robot, tmp_path, "joint_6]", "joint_7]")))
     assert broken.returncode == 2 and broken.stderr.strip().splitlines() == [
         "error: robot.arm_joints: the model has no joint 'joint_7'"
@@ -217,7 +217,7 @@ def test_a_users_own_arm_runs_a_scene_end_to_end(own_robot, tmp_path):
         check=False,
     )
     assert "Traceback" not in result.stderr, result.stderr
-    assert "run: robot arm6, planner hlp" in result.stdout
+    assert "run: robot arm6, initialiser hlp, low-level planner sto" in result.stdout
     record = json.loads(out.read_text())
     assert record["robot"] == "arm6" and record["robot_actuated_dofs"] == 7  # 6 joints and a gripper
     assert result.returncode == 0, result.stdout + result.stderr
@@ -235,12 +235,13 @@ def test_a_fixed_arms_recording_looks_past_the_arm():
 
 
 def test_a_start_out_of_a_fixed_arms_reach_is_that_jobs_failure():
-    from hlp_drake.experiments.runner import Job
+    from job_support import one_job
+
     from hlp_drake.systems.execution.job import run_job
 
     panda = load_robot("panda")  # a reach claimed beyond the arm's: the start 1.2 m to the side is out of it
     robot = replace(panda, reach=1.5, base=replace(panda.base, pose=(-0.1, 1.2, 0.0)))
-    job = Job("gen2", 20, 7, "gen2-7-20", "hlp", Scenario(robot=robot).yaml, Workspace(-0.3, 0.0, 0.88))
+    job = one_job(Scenario(robot=robot).yaml, "gen2", 20, 7, workspace=Workspace(-0.3, 0.0, 0.88))
     row = run_job(job)
     assert row["success"] is False and "the arm cannot put the tcp above the start" in row["failure_reason"]
     assert "out of its reach" in row["failure_reason"] and not row["failure_reason"].startswith("crashed")
@@ -276,7 +277,7 @@ def test_a_push_start_out_of_a_fixed_arms_reach_gives_way_to_the_plans_next_cand
     assert line.startswith("IK: ") and "the plan's alternative 2 runs in its place" in line
     assert keyframes.replaced[0] in line
 
-    alone = make_planning_diagram(replace(scenario, optimiser=replace(scenario.optimiser, alternatives=0)))
+    alone = make_planning_diagram(replace(scenario, planner=replace(scenario.planner, alternatives=0)))
     alone_context = alone.CreateDefaultContext()
     alone.GetInputPort(SCENE_PORT).FixValue(alone_context, scene)
     failed = alone.GetOutputPort("keyframes").Eval(alone_context)  # no alternatives: the plan's failure

@@ -1,4 +1,5 @@
-"""The simulated world: scenario loading, scene models, the world diagram, resting and pushed objects."""
+"""The simulated world: scene models, the world diagram (a scene in a ``WorldModel``), resting and
+pushed objects."""
 
 from __future__ import annotations
 
@@ -15,7 +16,6 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.trajectories import PiecewisePolynomial
 
-from hlp_drake.errors import HlpError
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene, SceneObject, Table, plan_view_order
 from hlp_drake.systems.planning.keyframes import PlanningModel
@@ -61,130 +61,6 @@ def worlds(scenes):
 
 def resting_z(scene: Scene) -> dict[str, float]:
     return {obj.name: scene.table.height + obj.height / 2.0 for obj in scene.objects}
-
-
-# --- Scenario -----------------------------------------------------------------------------------
-
-
-def test_default_scenario_uses_sap_point_contact_and_stiff_materials():
-    scenario = load_scenario()
-    assert scenario.plant.time_step == pytest.approx(0.01)  # benchmarks/physics_models.py
-    assert not scenario.plant.use_sampled_output_ports and not scenario.optimiser.reduced_model
-    assert scenario.plant.discrete_contact_approximation == "sap"
-    assert scenario.plant.contact_model == "point"
-    assert scenario.contact.stiffness >= 1e6 and scenario.contact.corner_sphere_radius > 0
-    assert scenario.controller.gravity_compensation
-    assert 0.1 <= scenario.bodies.object_min_mass < scenario.bodies.object_max_mass <= 0.5
-    assert scenario.scene.name.startswith("default") and scenario.planner.kind == "hlp"
-
-
-def test_scenario_loads_from_yaml_and_overrides_and_reads_back_its_own_yaml(tmp_path):
-    path = tmp_path / "scenario.yaml"
-    path.write_text(
-        "plant:\n  time_step: 0.005\ncontroller:\n  arm: {kp: 3000.0, kd: 200.0}\nmotion:\n  tcp_speed: 0.2\n"
-    )
-    scenario = load_scenario(path, data="motion: {tcp_speed: 0.15}\nplanner: {kind: sto}\n")
-    assert scenario.plant.time_step == 0.005
-    assert scenario.plant.discrete_contact_approximation == "sap"  # untouched defaults stay
-    assert (scenario.controller.arm.kp, scenario.controller.arm.kd) == (3000.0, 200.0)
-    assert scenario.controller.wrist == Scenario().controller.wrist
-    assert scenario.motion.tcp_speed == 0.15 and scenario.planner.kind == "sto"
-    again = load_scenario(data=scenario.yaml)
-    assert again.yaml == scenario.yaml and again.key == scenario.key != Scenario().key
-    assert again.scene == scenario.scene and again.optimiser == scenario.optimiser
-    (tmp_path / "empty.yaml").write_text("# nothing to change\n")
-    assert load_scenario(tmp_path / "empty.yaml").key == Scenario().key
-
-
-def test_a_scenarios_scene_is_read_whole_in_the_scene_file_format(tmp_path):
-    from hlp_drake.scene.io import scene_to_text
-
-    scene = generate_scene("gen1", 5)
-    text = "scene:\n" + "".join(f"  {line}\n" for line in scene_to_text(scene).splitlines())
-    scenario = load_scenario(data=text + "optimiser: {samples: 3}\n")
-    assert scenario.scene == scene and scenario.optimiser.samples == 3
-    with pytest.raises(HlpError) as info:  # a scene is whole: no field of the default scene is kept
-        load_scenario(data="scene: {name: partial, start: [0.1, 0.0]}\n")
-    assert info.value.problems == (
-        "overrides: scene: missing field 'table'",
-        "overrides: scene: missing field 'target'",
-    )
-
-
-@pytest.mark.parametrize(
-    "text, problem",
-    [
-        ("plant: [0.002,\n", "not valid YAML at line 2"),
-        ("plant: {time_stp: 0.002}\n", "plant: unknown field 'time_stp'"),
-        ("controller: {arm: {kp: fast}}\n", "controller.arm.kp: expected a number, got 'fast'"),
-        ("ik: 3\n", "ik: expected a mapping, got int"),
-        ("plant: {discrete_contact_approximation: tamsi}\n", "SAP"),
-        ("plant: {time_step: 0.0}\n", "plant.time_step must be > 0"),
-        ("plant: {time_step: 0.015}\n", "plant.time_step must be <= 0.01, got 0.015"),  # unstable
-        ("bodies: {object_min_mass: 1.0, object_max_mass: 0.5}\n", "object_max_mass"),
-        (
-            "optimiser: {update: annealing}\n",
-            "optimiser.update: expected one of greedy, mppi, got 'annealing'",
-        ),
-        ("optimiser: {samples: 0}\n", "optimiser.samples"),
-        ("optimiser: {noise: {end_fraction: 1.5}}\n", "optimiser.noise.end_fraction"),
-        ("optimiser: {weld_clearance: 0.0}\n", "optimiser.weld_clearance"),
-        ("optimiser: {weld_margin: 0.5}\n", "optimiser.weld_margin"),
-        ("transfer: {travel_step: 0.0}\n", "transfer.travel_step"),
-        ("planner: {kind: astar}\n", "planner.kind: expected one of hlp, sto, got 'astar'"),
-        ("scene: {table: 3}\n", "scene.table: expected a mapping"),
-        ("grasp: {lift_s: 0.0}\n", "grasp.lift_s"),
-        ("closed_loop: {replan_period: 0.0}\n", "closed_loop.replan_period must be > 0, got 0.0"),
-        ("closed_loop: {rollouts: 0}\n", "closed_loop.rollouts must be between 1 and 1000000, got 0"),
-        ("closed_loop: {track_distance: -0.01}\n", "closed_loop.track_distance must be >= 0"),
-        # Values that loaded and then failed inside Drake, or ran out of memory or time:
-        ("plant: {time_step: 1.0e-9}\n", "plant.time_step must be between 0.0001 and 0.01, got 1e-09"),
-        ("motion: {tcp_speed: 1.0e-9}\n", "motion.tcp_speed must be between 0.01 and 10, got 1e-09"),
-        ("optimiser: {step_duration: 1.0e-9}\n", "optimiser.step_duration must be between 0.001 and 60"),
-        ("grasp: {hold_s: 1.0e+9}\n", "grasp.hold_s must be <= 60, got 1e+09"),
-        (
-            "transfer: {travel_step: 1.0e-9}\n",
-            "transfer.travel_step must be between 0.0001 and 0.1, got 1e-09",
-        ),
-        (
-            "perception: {cameras: [{width: 100000}]}\n",
-            "perception.cameras[0].width must be between 8 and 4096",
-        ),
-        ("perception: {cameras: [{fov_y: -5}]}\n", "perception.cameras[0].fov_y must be between 1 and 170"),
-        ("perception: {cameras: [{up: [0, 0, 1]}]}\n", "up [0.0, 0.0, 1.0] is parallel to its view"),
-        ("perception: {cameras: [{look_at: [0, 0, 1.6]}]}\n", "look_at is its position"),
-        (
-            "perception: {cameras: [{min_depth: 3, max_depth: 1}]}\n",
-            "min_depth < max_depth <= 10 m, got 3 and 1",
-        ),
-        (
-            "perception: {cameras: [{dropout: 1.0}]}\n",
-            "perception.cameras[0].dropout must be in [0, 1), got 1",
-        ),
-        ("perception: {cameras: [{name: a}, {name: a}]}\n", "two cameras are named 'a'"),
-        ("perception: {cameras: [{name: ''}]}\n", "perception.cameras[0]: name is empty"),
-        (
-            "perception: {source: camera, cameras: []}\n",
-            "perception.cameras is empty, but perception.source is camera",
-        ),
-        ("perception: {ransac_points: 0}\n", "perception.ransac_points must be between 3 and 1000000, got 0"),
-        (
-            "uncertainty: {mass_scale: [-1, 0]}\n",
-            "uncertainty.mass_scale must be [low, high] with 0.01 <= low",
-        ),
-        ("uncertainty: {friction_scale: [2, 0.5]}\n", "got [2, 0.5]"),
-        ("uncertainty: {position_sigma: 10.0}\n", "uncertainty.position_sigma must be between 0 and 0.5 m"),
-    ],
-)
-def test_bad_scenario_file_raises_one_line_hlp_errors_naming_the_file_and_field(tmp_path, text, problem):
-    path = tmp_path / "bad_scenario.yaml"
-    path.write_text(text)
-    with pytest.raises(HlpError) as info:
-        load_scenario(path)
-    assert any(problem in p for p in info.value.problems), info.value.problems
-    assert all(p.startswith(str(path)) and "\n" not in p for p in info.value.problems)
-    with pytest.raises(HlpError, match=r"missing\.yaml"):
-        load_scenario(tmp_path / "missing.yaml")
 
 
 # --- Scene models -------------------------------------------------------------------------------
@@ -293,10 +169,10 @@ def test_chosen_objects_can_be_welded(scenes):
 
 
 def test_planning_model_welds_the_objects_or_leaves_them_out(scenes):
-    model = PlanningModel(Scenario(scene=scenes["gen1"]))
+    model = PlanningModel(scenes["gen1"])  # alone: the robot, contact and bodies by default
     assert model.plant.num_positions() == 11 and model.plant.time_step() == 0.0
     assert set(model.scene_models.objects) == {o.name for o in scenes["gen1"].objects}
-    bare = PlanningModel(Scenario(scene=scenes["gen1"]), with_objects=False)
+    bare = PlanningModel(scenes["gen1"], robot=MOBILE_UR5, with_objects=False)
     assert bare.plant.num_positions() == 11 and not bare.scene_models.objects
 
 
@@ -452,43 +328,3 @@ def test_meshcat_visualisation_is_optional(monkeypatch):
     simulator = Simulator(world)
     simulator.AdvanceTo(0.05)
     assert meshcat.HasPath("/drake/visualizer") and meshcat.HasPath("/drake/contact_forces")
-
-
-def test_a_camera_source_without_a_camera_is_refused_whichever_way_it_is_asked_for():
-    from hlp_drake.systems.execution.job import scenario_yamls
-    from hlp_drake.systems.scenario import with_conditions
-
-    no_cameras = "perception: {cameras: []}\n"
-    scenario = load_scenario(data=no_cameras)  # fine while the scene comes from the plant
-    assert with_conditions(scenario, perception="truth").perception.cameras == ()
-    expected = "perception.cameras is empty, but perception.source is camera"
-    with pytest.raises(HlpError, match=expected):
-        with_conditions(scenario, perception="camera")
-    with pytest.raises(HlpError, match=expected):
-        scenario_yamls(no_cameras, perception="camera")
-
-
-def test_a_scenario_made_in_python_is_checked_as_it_is_made_so_no_builder_gets_a_bad_one():
-    from hlp_drake.systems.perception.cameras import CameraConfig, PerceptionConfig
-
-    bad = PerceptionConfig(source="camera", cameras=(CameraConfig(width=0),))
-    with pytest.raises(HlpError, match=r"perception\.cameras\[0\]\.width must be between 8 and 4096"):
-        Scenario(perception=bad)
-    with pytest.raises(HlpError, match=r"perception\.cameras\[0\]\.width must be between 8 and 4096"):
-        replace(Scenario(), perception=bad)  # a variant is made too
-    nan = PerceptionConfig(cameras=(CameraConfig(position=(math.nan, 0.0, 1.6)),))
-    with pytest.raises(HlpError, match=r"perception\.cameras\[0\]\.position must be finite"):
-        Scenario(perception=nan)  # the loader refuses NaN itself; a scenario made in Python is checked here
-
-
-def test_a_scene_of_more_obstacles_than_a_world_takes_is_refused_before_any_is_built():
-    from hlp_drake.scene.model import SceneObject
-    from hlp_drake.systems.scenario import MAX_WORLD_OBSTACLES
-
-    scene = load_scenario().scene
-    crowd = tuple(
-        SceneObject(f"o{i}", "box", 0.05 + 0.02 * (i % 30), -0.45 + 0.03 * (i // 30), (0.01, 0.01, 0.05))
-        for i in range(MAX_WORLD_OBSTACLES + 1)
-    )
-    with pytest.raises(HlpError, match=r"scene: 101 obstacles, more than the 100 a simulated world takes"):
-        replace(Scenario(), scene=replace(scene, obstacles=crowd))

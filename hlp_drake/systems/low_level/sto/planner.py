@@ -11,11 +11,9 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
 from hlp_drake.systems.low_level.protocol import LowLevelContext, LowLevelProblem
-from hlp_drake.systems.low_level.result import EMPTY_RESULT, LowLevelResult, unplanned
+from hlp_drake.systems.low_level.result import LowLevelResult, held, unplanned
 from hlp_drake.systems.low_level.sto.budget import Budget
 from hlp_drake.systems.low_level.sto.config import StoConfig
 from hlp_drake.systems.low_level.sto.optimiser import optimise
@@ -72,7 +70,8 @@ class StoPlanner:
 
     def plan(self, problem: LowLevelProblem) -> LowLevelResult:
         if problem.initial.get_number_of_segments() == 0:
-            return unplanned(_held(problem), "no initial trajectory", self.kind)
+            start = None if problem.keyframes is None else problem.keyframes.start
+            return unplanned(held(start), "no initial trajectory", self.kind)
         initial = self.as_commanded(problem.initial)
 
         def alternatives() -> list[ControlSequence]:
@@ -105,14 +104,6 @@ class StoPlanner:
         return optimise(
             self.spec(scene), initial, self.pool, budget=budget, start=start, alternatives=alternatives
         )
-
-
-def _held(problem: LowLevelProblem) -> ControlSequence:
-    """The robot held at its start for a second (the keyframes' start), when there is no motion."""
-    if problem.keyframes is None:
-        return EMPTY_RESULT.sequence
-    start = np.asarray(problem.keyframes.start, dtype=float)
-    return ControlSequence(np.array([0.0, 1.0]), np.vstack([start, start]))
 
 
 __all__ = ["StoPlanner"]

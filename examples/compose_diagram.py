@@ -9,8 +9,8 @@ from hlp_drake.systems import (
     world_plant,
 )
 
-scenario = load_scenario(data="planner: {low_level: {workers: 1}}")  # the bundled default scene, 1 rollout process
-with RolloutPool(scenario.optimiser.workers) as pool:
+scenario = load_scenario(data="planner: {low_level: {workers: 1}}")  # the default scene; the STO, 1 process
+with RolloutPool(scenario.low_level.workers) as pool:  # the STO rolls out: its pool is yours to close
     builder = DiagramBuilder()
     world = builder.AddNamedSystem("world", make_world_diagram(scenario))
     plant, _ = world_plant(world)
@@ -24,7 +24,7 @@ with RolloutPool(scenario.optimiser.workers) as pool:
     planning_context = planning.GetMyContextFromRoot(context)
     robot_plan = planning.GetOutputPort("robot_plan").Eval(planning_context)
     print("robot plan:", " -> ".join(k.action for k in robot_plan.keypoints))
-    result = planning.GetOutputPort("optimisation").Eval(planning_context)
+    result = planning.GetOutputPort("optimisation").Eval(planning_context)  # the low-level planner's
     print(f"optimised: success {result.success} after {result.rollouts} rollout(s)")
 
     # Move an obstacle in the plant: the same diagram plans again from the new body poses.

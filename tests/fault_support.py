@@ -48,13 +48,13 @@ VICTIM = ("gen1-11", "sto")
 
 def job_killing_its_worker_once(job):
     """``cheap_job``, whose ``VICTIM``'s first run kills its worker process."""
-    if job.key == VICTIM and first_time("job"):
+    if (job.scene, job.planner) == VICTIM and first_time("job"):
         die()
     return cheap_job(job)
 
 
 def job_killing_its_worker(job):
     """``cheap_job``, whose ``VICTIM`` kills its worker process every time."""
-    if job.key == VICTIM:
+    if (job.scene, job.planner) == VICTIM:
         die()
     return cheap_job(job)

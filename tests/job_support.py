@@ -1,13 +1,19 @@
 """``cheap_job``: a deterministic stand-in for the experiments' real job, a module-level function so
-process pools and dask workers can unpickle it; ``one_job``: a job made by hand."""
+process pools and dask workers can unpickle it; ``one_job``: a job made by hand; ``settings`` and
+``run_experiment``: a bundled study run in the test's own process."""
 
 from __future__ import annotations
 
+import csv
+import dataclasses
 import random
+from pathlib import Path
 
-from hlp_drake.experiments import Job, make_row
-from hlp_drake.experiments.runner import Labels, ResolvedCell
-from hlp_drake.experiments.study import Cell
+from hlp_drake import experiments
+from hlp_drake.experiments import ExperimentSettings, Job, make_row
+from hlp_drake.experiments.results import COLUMNS
+from hlp_drake.experiments.runner import JobFunction, Labels, ResolvedCell
+from hlp_drake.experiments.study import Cell, load_study
 from hlp_drake.scene.generators import generate_scene
 
 
@@ -49,3 +55,41 @@ def one_job(config_yaml: str, generator: str, seed: int, count: int | None = Non
     labels = Labels("robot", "hlp", "sto", "hlp", "open", "truth", None)
     cell = ResolvedCell(Cell(initial="hlp"), labels, workspace)
     return Job(generator, seed, count, len(scene.obstacles), scene.name, cell, config_yaml)
+
+
+STUDY_FIELDS = ("scenes", "seed", "objects", "robots", "initialisers", "low_level", "execution", "perception")
+
+
+def settings(name: str = "gen1", **changes) -> ExperimentSettings:
+    """The bundled study ``name`` (3 scenes from seed 10 unless ``changes`` say otherwise) in this
+    process, the study's fields and the settings' from ``changes``."""
+    defaults = {"scenes": 3, "seed": 10, "workers": 1, "progress": False, **changes}
+    study = load_study(name)
+    study = dataclasses.replace(study, **{k: v for k, v in defaults.items() if k in STUDY_FIELDS})
+    return ExperimentSettings(study=study, **{k: v for k, v in defaults.items() if k not in STUDY_FIELDS})
+
+
+def run_experiment(settings: ExperimentSettings, out: Path, *, job: JobFunction) -> dict:
+    """``hlp_drake.experiments.run_experiment`` with the real study resolution and the test's ``job``."""
+    from hlp_drake.systems import resolve_study
+
+    return experiments.run_experiment(settings, out, job=job, resolve=resolve_study)
+
+
+def never_called(job: Job) -> dict:
+    raise AssertionError(f"{job.key} was run again")
+
+
+def read_rows(path: Path) -> list[dict[str, str]]:
+    with path.open(newline="") as file:
+        return list(csv.DictReader(file))
+
+
+def assert_well_formed(path: Path) -> list[dict[str, str]]:
+    """The CSV has exactly the columns and every row has every field; no temp file beside it."""
+    with path.open(newline="") as file:
+        records = list(csv.reader(file))
+    assert tuple(records[0]) == COLUMNS
+    assert all(len(record) == len(COLUMNS) for record in records[1:])
+    assert not list(path.parent.glob(".*.tmp"))
+    return read_rows(path)

@@ -81,7 +81,10 @@ def _parser() -> argparse.ArgumentParser:
         help="object counts, one condition each (gen2: 5 7 9; gen1 ignores it: 6)",
     )
     parser.add_argument(
-        "--seed", type=integer(0, MAX_SEED - MAX_SCENES), metavar="S", help="scene i has seed S + i (default 0)"
+        "--seed",
+        type=integer(0, MAX_SEED - MAX_SCENES),
+        metavar="S",
+        help="scene i has seed S + i (default 0)",
     )
     add_robot_option(parser, several=True)
     parser.add_argument(
@@ -103,7 +106,9 @@ def _parser() -> argparse.ArgumentParser:
         help="local (default): this process or a process pool; dask: a dask cluster",
     )
     parser.add_argument(
-        "--scheduler", metavar="ADDRESS", help="dask scheduler address (default: a LocalCluster of --workers processes)"
+        "--scheduler",
+        metavar="ADDRESS",
+        help="dask scheduler address (default: a LocalCluster of --workers processes)",
     )
     parser.add_argument(
         "--config",
@@ -112,7 +117,9 @@ def _parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--fresh", action="store_true", help="discard DIR's earlier results and start over")
     add_verbosity(parser)
-    parser.add_argument("--out", required=True, metavar="DIR", help="output directory (resumes the run there)")
+    parser.add_argument(
+        "--out", required=True, metavar="DIR", help="output directory (resumes the run there)"
+    )
     return parser
 
 

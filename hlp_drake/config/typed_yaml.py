@@ -198,7 +198,9 @@ def document_problems(
         for name, sub in value.items():
             if name in hints:
                 below = getattr(default, name, None) if merged else None
-                problems += document_problems(hints[name], sub, join_path(where, name), top=top, default=below)
+                problems += document_problems(
+                    hints[name], sub, join_path(where, name), top=top, default=below
+                )
         return problems
     problem = _scalar_problem(schema, value)
     return [] if problem is None else [f"{label}: {problem}"]

@@ -64,10 +64,16 @@ class WhatRan:
         parts = []
         for axis, word in WORDS.items():
             values = [
-                "none" if v is None and axis == "model_errors" else f"seed {v}" if axis == "model_errors" else v
+                "none"
+                if v is None and axis == "model_errors"
+                else f"seed {v}"
+                if axis == "model_errors"
+                else v
                 for v in getattr(self, axis)
             ]
-            plural = "s" if len(values) > 1 and axis not in ("model_errors", "executions", "perceptions") else ""
+            plural = (
+                "s" if len(values) > 1 and axis not in ("model_errors", "executions", "perceptions") else ""
+            )
             parts.append(f"{word}{plural} {' and '.join(map(str, values))}")
         parts.append(f"scenario {self.scenario_file or BUILT_IN_SCENARIO}")
         return ", ".join(parts) + (f", tables of {self.tables}" if self.tables else "")
@@ -89,7 +95,9 @@ class WhatRan:
             return None
         axes = {}
         for axis, (one, several) in KEYS.items():
-            axes[axis] = tuple(record[several]) if several in record else ((record[one],) if one in record else ())
+            axes[axis] = (
+                tuple(record[several]) if several in record else ((record[one],) if one in record else ())
+            )
         known = {f.name for f in fields(cls)}
         return cls(**axes, **{k: record.get(k) for k in ("scenario_file", "tables") if k in known})
 

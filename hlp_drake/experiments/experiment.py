@@ -16,7 +16,7 @@ import os
 import sys
 import time
 from contextlib import closing
-from dataclasses import dataclass, replace
+from dataclasses import asdict, astuple, dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -164,7 +164,7 @@ def _run_record(
     return {
         "command": command,
         "status": "running",
-        "study": {"name": study.name, "title": study.heading, **study.identity()},
+        "study": asdict(study),
         **ran.to_dict(),
         "seeds": {"first": study.seed, "last": study.seed + study.scenes - 1, "scenes": study.scenes},
         "objects": sorted({job.objects for job in jobs}),
@@ -285,9 +285,11 @@ def run_experiment(
     resolved = resolve(study, settings.config_yaml, single_process_rollouts=settings.parallel)
     jobs = make_jobs(study, resolved)
     identity = {"name": study.name, "study": study.identity(), "scenario": resolved.scenario}
+    identity = json.loads(json.dumps(identity))  # as config.json holds it: lists, not tuples
     _check_directory(out, identity, settings.fresh)
     check_writable(*(out / name for name in (RESULTS, CONFIG, RUN, *DERIVED)))
-    rows = [] if settings.fresh else read_results(out / RESULTS, study.generators)
+    cells = [astuple(cell.labels) for cell in resolved.cells]
+    rows = [] if settings.fresh else read_results(out / RESULTS, study.generators, cells)
     results = ResultsFile(out / RESULTS, rows)
     earlier = _earlier_runs(out, settings.fresh)
 

@@ -57,6 +57,8 @@ COLUMNS = (
 )
 KEY_COLUMNS = ("scene", "objects", "robot", "initial", "low_level", "execution", "perception", "model_error")
 """A row's identity (``row_key``)."""
+CELL_COLUMNS = ("robot", "initial", "low_level", "planner", "execution", "perception", "model_error")
+"""A row's cell of the grid, as ``hlp_drake.experiments.runner.Labels`` names it."""
 BOOL_COLUMNS = frozenset({"success", "passed_then_failed"})
 FLOAT_COLUMNS = frozenset({"init_s", "optimise_s", "total_s", "verify_s", "execute_s"})
 TEXT_COLUMNS = frozenset({"scene", "planner", "failure_reason", *AXIS_COLUMNS} - {"model_error"})
@@ -113,12 +115,16 @@ def results_csv(rows: Iterable[Row]) -> str:
     return out.getvalue()
 
 
-def read_results(path: Path, generators: Iterable[str] | None = None) -> list[Row]:
+def read_results(
+    path: Path, generators: Iterable[str] | None = None, cells: Iterable[tuple] | None = None
+) -> list[Row]:
     """The rows of ``path`` (none when it does not exist).
 
     Args:
         generators: the run's scene generators: every row's scene must be one of theirs (the name
             its generator, seed and object count give); None: any.
+        cells: the run's cells as rows name them (``CELL_COLUMNS``' values): every row's must be
+            one of them; None: any.
 
     Raises:
         HlpError: the file is unreadable, too large, has other columns or a malformed row (one
@@ -134,7 +140,7 @@ def read_results(path: Path, generators: Iterable[str] | None = None) -> list[Ro
         rows = []
         for record in reader:
             try:
-                rows.append(_row(header, record, generators))
+                rows.append(_row(header, record, generators, None if cells is None else set(cells)))
             except (KeyError, ValueError) as error:
                 raise HlpError(
                     f"{path}: line {reader.line_num}: malformed row ({error}); {START_OVER}"
@@ -159,7 +165,9 @@ def read_run_file(path: Path, limit: int) -> str:
         raise HlpError(f"{path}: unreadable ({error}); {START_OVER}") from None
 
 
-def _row(header: tuple[str, ...], record: list[str], generators: Iterable[str] | None) -> Row:
+def _row(
+    header: tuple[str, ...], record: list[str], generators: Iterable[str] | None, cells: set | None
+) -> Row:
     """The row of one CSV ``record`` under ``header``; ValueError or KeyError names what is wrong."""
     if len(record) != len(header):
         raise ValueError(f"{len(record)} fields")
@@ -176,6 +184,9 @@ def _row(header: tuple[str, ...], record: list[str], generators: Iterable[str] |
         raise ValueError(f"generator {generator!r}, not one of the study's")
     if row["scene"] != scene_name(generator, row["seed"], row["objects"]):
         raise ValueError(f"scene {row['scene']!r} is not the {generator} scene of its seed and object count")
+    cell = tuple(row[column] for column in CELL_COLUMNS)
+    if cells is not None and cell not in cells:
+        raise ValueError(f"the cell {', '.join(map(str, cell))}, not one of the study's")
     return row
 
 

@@ -127,10 +127,12 @@ class Study:
         return self.title or self.name
 
     def identity(self) -> dict[str, Any]:
-        """What the rows depend on (a directory holding another study's rows is refused): every
-        field but the name and the title."""
+        """What a run folder's rows depend on (a folder holding another study's rows is refused):
+        every field but the name and the title, and the scene and object counts (a run extends
+        to more scenes or counts: their rows are added)."""
         record = asdict(self)
-        return {f.name: record[f.name] for f in fields(self) if f.name not in ("name", "title")}
+        extensible = ("name", "title", "scenes", "objects")
+        return {f.name: record[f.name] for f in fields(self) if f.name not in extensible}
 
 
 def bundled_studies() -> tuple[str, ...]:

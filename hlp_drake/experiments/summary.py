@@ -131,7 +131,9 @@ def summarise(
         groups[(row["generator"], row["objects"])][cell].append(row)
     order = {g: i for i, g in enumerate(study.generators)}
     conditions = []
-    for (generator, objects), cells in sorted(groups.items(), key=lambda item: (order.get(item[0][0], 99), item[0])):
+    for (generator, objects), cells in sorted(
+        groups.items(), key=lambda item: (order.get(item[0][0], 99), item[0])
+    ):
         series = []
         for key in sorted(cells, key=lambda k: tuple("" if v is None else str(v) for v in k)):
             cell = dict(zip(("planner", *CELL), key))

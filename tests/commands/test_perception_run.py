@@ -48,7 +48,7 @@ def test_run_scene_plans_on_the_perceived_scene_and_reports_its_errors(tmp_path)
     # The legend says what the perception view draws: the fitted objects and the camera's points.
     assert "perceived (translucent): the target and obstacles fitted to the depth camera" in page
     assert "the depth camera&#x27;s points at the start" in page
-    assert "human-like planner on the depth camera&#x27;s view" in page  # the heading
+    assert "human-like planner with the sto low-level planner on the depth camera&#x27;s view" in page
     commands = recorded(page)
     for path in (b"/drake/perception/points", b"/drake/perception/objects/Target", b"/drake/robot_plan/path"):
         assert path in commands, path

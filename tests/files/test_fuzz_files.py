@@ -388,17 +388,18 @@ def _cheap_job(job):
     )
 
 
-RUN_SETTINGS = {"kind": "gen1", "seed": 10, "scenes": 2, "workers": 1, "progress": False}
+def _run(out) -> None:
+    """The cheap experiment (gen1 seeds 10 and 11, both initialisers) in ``out``, in this process."""
+    from job_support import run_experiment, settings
+
+    run_experiment(settings(scenes=2), out, job=_cheap_job)
 
 
 @functools.cache
 def _run_folder() -> dict[str, bytes]:
     """The records of a finished (cheap) experiment: results.csv, run.json, config.json."""
-    from hlp_drake.experiments import ExperimentSettings, run_experiment
-    from hlp_drake.systems import scenario_yamls
-
     with tempfile.TemporaryDirectory() as folder:
-        run_experiment(ExperimentSettings(**RUN_SETTINGS), folder, job=_cheap_job, scenario=scenario_yamls)
+        _run(folder)
         return {
             name: (Path(folder) / name).read_bytes() for name in ("results.csv", "run.json", "config.json")
         }
@@ -432,9 +433,7 @@ def damaged_run_folder(draw) -> dict[str, bytes]:
 
 
 def _check_resume(files: dict[str, bytes]) -> None:
-    from hlp_drake.experiments import ExperimentSettings, run_experiment
     from hlp_drake.experiments.results import COLUMNS, read_results
-    from hlp_drake.systems import scenario_yamls
 
     STATS["run folders damaged"] += 1
     with tempfile.TemporaryDirectory() as folder:
@@ -442,13 +441,13 @@ def _check_resume(files: dict[str, bytes]) -> None:
         for name, data in files.items():
             (out / name).write_bytes(data)
         try:
-            run_experiment(ExperimentSettings(**RUN_SETTINGS), out, job=_cheap_job, scenario=scenario_yamls)
+            _run(out)
         except HlpError as error:
             check_error(error)
             assert {name: (out / name).read_bytes() for name in files} == files  # left as it was
             STATS["run folders refused"] += 1
             return
-        rows = read_results(out / "results.csv", "gen1")  # resumed: every job's row, well-formed
+        rows = read_results(out / "results.csv", ("gen1",))  # resumed: every job's row, well-formed
         assert sorted((r["scene"], r["planner"]) for r in rows) == [
             (f"gen1-{seed}", planner) for seed in (10, 11) for planner in ("hlp", "sto")
         ]

@@ -7,7 +7,6 @@ quick-start line only the part after them runs, with this interpreter as ``.venv
 
 from __future__ import annotations
 
-import importlib.util
 import re
 import shlex
 import subprocess
@@ -76,14 +75,6 @@ def test_every_bash_block_runs(tmp_path):
     assert (tmp_path / "scene.png").stat().st_size > 10_000
 
 
-def _example(name: str):
-    """A script of ``examples/``, imported."""
-    spec = importlib.util.spec_from_file_location(name, REPO / "examples" / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_the_python_block_is_the_example_file_and_runs(tmp_path):
     (code,) = blocks("python")
     assert code == (REPO / "examples" / "compose_diagram.py").read_text()
@@ -97,21 +88,29 @@ def test_the_python_block_is_the_example_file_and_runs(tmp_path):
     assert re.fullmatch(r"after moving FailOnTouchObstacleShort: \d+ keypoints", lines[2])
 
 
-def test_the_yaml_blocks_load_as_a_scenario_and_a_scene(tmp_path):
+def test_the_yaml_blocks_load_as_a_scenario_a_scene_and_a_study(tmp_path):
+    from hlp_drake.experiments.study import load_study
     from hlp_drake.scene.io import load_scene
     from hlp_drake.systems.scenario import Scenario, load_scenario
 
-    robot_block, scenario_block, scene_block = sorted(
-        blocks("yaml"), key=lambda text: "arm_joints:" not in text and 1 + ("table:" in text)
-    )
-    assert robot_block == _example("own_robot").DESCRIPTION  # the description the example writes
-    scenario = load_scenario(data=scenario_block)
-    assert scenario.planner.kind == "hlp" and scenario.optimiser.samples == 8
+    def kind(text: str) -> str:
+        if "table:" in text:
+            return "scene"
+        return "study" if "generators:" in text else "scenario"
+
+    found = {kind(text): text for text in blocks("yaml")}
+    assert sorted(found) == ["scenario", "scene", "study"] and len(blocks("yaml")) == 3
+    scenario = load_scenario(data=found["scenario"])
+    assert scenario.planner.initial == "hlp" and scenario.low_level.samples == 8
     assert scenario.key == Scenario().key  # the README shows the defaults
     path = tmp_path / "example.yaml"
-    path.write_text(scene_block)
+    path.write_text(found["scene"])
     scene = load_scene(path)
     assert scene.name == "example" and [o.name for o in scene.obstacles] == ["box1"]
+    (tmp_path / "study.yaml").write_text(found["study"])
+    study = load_study(str(tmp_path / "study.yaml"))
+    assert study.robots == ("mobile_ur5", "panda", "iiwa14") and len(study.cells()) == 6
+    assert study.scenes == 100 and study.seed == 0  # as its comment says
 
 
 @pytest.mark.parametrize(

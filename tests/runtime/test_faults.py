@@ -24,20 +24,19 @@ from fault_support import (
     rollout_exiting,
     rollout_killing_its_worker_once,
 )
-from job_support import cheap_job
-from sto_support import on, short
+from job_support import cheap_job, settings
+from sto_support import on, short, spec
 from synthetic_dataset import write_dataset
 
 from hlp_drake import experiments
 from hlp_drake.commands.experiments import main as experiments_main
 from hlp_drake.commands.parsing import run_cli
 from hlp_drake.errors import ModelError
-from hlp_drake.experiments import ExperimentSettings
 from hlp_drake.experiments.executors import RETRIES
 from hlp_drake.files import atomic
 from hlp_drake.learners.bundled import BUNDLED_DIRECTORY
 from hlp_drake.learners.models import VERSION, DecisionModels
-from hlp_drake.systems import scenario_yamls
+from hlp_drake.systems import resolve_study
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
 from hlp_drake.systems.low_level.sto import pool as pool_module
 from hlp_drake.systems.low_level.sto.optimiser import optimise, sample_base_noise
@@ -82,15 +81,15 @@ def warnings(text: str) -> list[str]:
 def test_a_killed_rollout_worker_is_replaced_and_its_rollouts_run_again(scene, trajectories, capsys):
     base = short(ControlSequence.from_trajectory(trajectories["line"], 0.5), 1.0)
     config = on(scene)
-    noise = sample_base_noise(np.random.default_rng(0), base, config.optimiser.noise, 3)
+    noise = sample_base_noise(np.random.default_rng(0), base, config.low_level.noise, 3)
     sequences = [base.with_base_velocity(v) for v in noise]
     with RolloutPool(2) as pool:
-        undisturbed = pool.rollouts(config, sequences)
+        undisturbed = pool.rollouts(spec(config), sequences)
         assert warnings(capsys.readouterr().err) == []
         victim = next(iter(pool._executor._processes.values()))
         os.kill(victim.pid, signal.SIGKILL)  # as the out-of-memory killer would
-        disturbed = pool.rollouts(config, sequences)
-        again = pool.rollouts(config, sequences)  # the replaced workers go on serving
+        disturbed = pool.rollouts(spec(config), sequences)
+        again = pool.rollouts(spec(config), sequences)  # the replaced workers go on serving
     assert [comparable(o) for o in disturbed] == [comparable(o) for o in undisturbed]
     assert [comparable(o) for o in again] == [comparable(o) for o in undisturbed]
     (line,) = warnings(capsys.readouterr().err)
@@ -104,9 +103,11 @@ def test_workers_dying_again_and_again_end_the_optimisation_as_a_failure(
     config = on(scene, "planner: {low_level: {samples: 2, max_iterations: 3}}")
     initial = short(ControlSequence.from_trajectory(trajectories["line"], 0.5), 1.0)  # fails: too short
     with RolloutPool(2) as pool:
-        result = optimise(config, initial, pool)  # the initial rollout here, the iterations' on the workers
+        result = optimise(
+            spec(config), initial, pool
+        )  # the initial rollout here, the iterations' on the workers
         with pytest.raises(pool_module.WorkersLost):  # the pool stays given up
-            pool.rollouts(config, [initial, initial])
+            pool.rollouts(spec(config), [initial, initial])
     assert not result.success and result.iterations == 0 and result.rollouts == 1
     assert result.failure_reason == f"the rollout workers died {MAX_DEATHS} times in a row (exit status 3)"
     lines = warnings(capsys.readouterr().err)
@@ -151,7 +152,7 @@ GEN1 = ["gen1", "--scenes", "3", "--seed", "10", "--quiet"]  # scenes gen1-10 to
 
 def run_experiments(argv: list[str], job) -> int:
     """``python -m hlp_drake.experiments`` in this process, with ``job`` for the real planners."""
-    return run_cli(lambda args: experiments_main(args, job=job, scenario=scenario_yamls), argv)
+    return run_cli(lambda args: experiments_main(args, job=job, resolve=resolve_study), argv)
 
 
 @pytest.fixture(scope="module")
@@ -200,10 +201,10 @@ def test_an_experiment_job_whose_worker_keeps_dying_gets_a_failure_row(tmp_path,
     assert f"crashed: its worker process died {RETRIES + 1} times (signal 9)" in rows[VICTIM]
     assert ",false," in rows[VICTIM] and ",nan," in rows[VICTIM]
     summary = experiments.run_experiment(  # resumed: every row is there, nothing runs again
-        ExperimentSettings(kind="gen1", scenes=3, seed=10, workers=2, progress=False),
+        settings(workers=2),
         tmp_path,
         job=job_killing_its_worker,
-        scenario=scenario_yamls,
+        resolve=resolve_study,
     )
     assert summary["conditions"] and rows_of((tmp_path / "results.csv").read_text()) == rows
 

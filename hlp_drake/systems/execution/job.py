@@ -80,7 +80,9 @@ def _check_closed_loop(scenario: Scenario) -> None:
     """Refuse a closed loop whose low-level planner cannot re-plan (before any job runs)."""
     entry = low_level_entry(scenario.low_level.kind)
     if scenario.closed_loop.enabled and not entry.replans:
-        raise HlpError(f"closed-loop execution needs a low-level planner that re-plans; {entry.name} does not")
+        raise HlpError(
+            f"closed-loop execution needs a low-level planner that re-plans; {entry.name} does not"
+        )
 
 
 def _what_ran(cells, tables) -> WhatRan:

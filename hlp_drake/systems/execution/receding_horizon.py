@@ -163,7 +163,9 @@ class RecedingHorizonController(LeafSystem):
             {self.time_ticket(), self.abstract_state_ticket(self._record), self._state.ticket()},
         )
         self.DeclareInitializationUnrestrictedUpdateEvent(self._initialise)
-        self.DeclarePeriodicUnrestrictedUpdateEvent(closed_loop.replan_period, closed_loop.replan_period, self._replan)
+        self.DeclarePeriodicUnrestrictedUpdateEvent(
+            closed_loop.replan_period, closed_loop.replan_period, self._replan
+        )
 
     def record(self, root_context: Context) -> ControllerRecord:
         """The controller's state in the diagram's ``root_context``."""

@@ -79,7 +79,9 @@ class LowLevelResult:
 StoResult = LowLevelResult
 """The STO's name of ``LowLevelResult`` (kept for code written against it)."""
 
-EMPTY_RESULT = LowLevelResult(ControlSequence(np.array([0.0, 1.0]), np.zeros((2, 0))), None, False, "not planned")
+EMPTY_RESULT = LowLevelResult(
+    ControlSequence(np.array([0.0, 1.0]), np.zeros((2, 0))), None, False, "not planned"
+)
 """A placeholder result (an abstract port's model value; it commands no position)."""
 
 

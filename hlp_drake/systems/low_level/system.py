@@ -64,7 +64,9 @@ class LowLevelPlannerSystem(LeafSystem):
         self._trajectory = self.DeclareAbstractOutputPort(
             name="trajectory",
             alloc=lambda: AbstractValue.Make(PiecewisePolynomial()),
-            calc=lambda context, output: output.set_value(self._result.Eval(context).sequence.to_trajectory()),
+            calc=lambda context, output: output.set_value(
+                self._result.Eval(context).sequence.to_trajectory()
+            ),
             prerequisites_of_calc=ticket,
         )
 

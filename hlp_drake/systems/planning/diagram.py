@@ -120,7 +120,9 @@ def make_planning_diagram(
         builder.ConnectToSame(transfer.get_scene_input_port(), low_level.get_scene_input_port())
         builder.Connect(ik.get_keyframes_output_port(), low_level.get_keyframes_input_port())
         builder.Connect(ik.get_trajectory_output_port(), low_level.get_initial_trajectory_input_port())
-        builder.Connect(ik.get_alternative_trajectories_output_port(), low_level.get_alternatives_input_port())
+        builder.Connect(
+            ik.get_alternative_trajectories_output_port(), low_level.get_alternatives_input_port()
+        )
         builder.ExportOutput(low_level.get_trajectory_output_port(), "optimised_trajectory")
         builder.ExportOutput(low_level.get_result_output_port(), "optimisation")
     diagram = builder.Build()
@@ -154,7 +156,9 @@ class ObservedScenePlanner:
     measured state (its positions then velocities), as ``as_commanded`` commands a trajectory
     (the low-level planner's); None when there is no plan or a keypoint's IK fails."""
 
-    def __init__(self, planning: Diagram, as_commanded: Callable[[PiecewisePolynomial], ControlSequence]) -> None:
+    def __init__(
+        self, planning: Diagram, as_commanded: Callable[[PiecewisePolynomial], ControlSequence]
+    ) -> None:
         self._diagram = planning
         self._as_commanded = as_commanded
         self._solver = planning.GetSubsystemByName("keypoint_ik").solver

@@ -44,6 +44,7 @@ from hlp_drake.systems.world.scene_models import BodiesConfig, ContactConfig
 if TYPE_CHECKING:
     from hlp_drake.scene.model import Scene
 
+
 class KeypointIk(LeafSystem):
     """Solves IK for a plan's keypoints on ``scene``'s table from its start, and times a joint
     trajectory through them (see the module's docstring for the ports).
@@ -156,4 +157,10 @@ class KeypointIk(LeafSystem):
         output.set_value(tuple(self._solver.trajectory(plant_context, k) for k in solved if k.ok))
 
 
-__all__ = ["MIN_SPEED", "IkConfig", "Keyframes", "KeypointIk", "MotionConfig"]  # the settings: planning.config
+__all__ = [
+    "MIN_SPEED",
+    "IkConfig",
+    "Keyframes",
+    "KeypointIk",
+    "MotionConfig",
+]  # the settings: planning.config

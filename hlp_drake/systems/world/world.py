@@ -64,6 +64,7 @@ if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
     from hlp_drake.systems.world.uncertainty import WorldPerturbation
 
+
 def _set_robot_contact(
     plant: MultibodyPlant,
     scene_graph: SceneGraph,

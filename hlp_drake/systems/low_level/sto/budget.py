@@ -79,7 +79,9 @@ class Budget:
 class BudgetedRun:
     """One optimisation's rollouts and verifications, counted into its ``StoResult``."""
 
-    def __init__(self, spec: RolloutSpec, pool: RolloutPool, budget: Budget, start: RolloutStart | None) -> None:
+    def __init__(
+        self, spec: RolloutSpec, pool: RolloutPool, budget: Budget, start: RolloutStart | None
+    ) -> None:
         self.spec, self.pool, self.budget, self.start = spec, pool, budget, start
         self.rollouts = self.verifications = self.rejected = 0
         self.verify_s = 0.0
@@ -91,9 +93,7 @@ class BudgetedRun:
         if self._displaced is None:
             sto = self.spec.sto
             count = self.budget.displaced_checks if self.start is None else 0
-            scenes = displaced_scenes(
-                self.spec.scene, count, sto.displaced_sigma, sto.displaced_yaw_sigma
-            )
+            scenes = displaced_scenes(self.spec.scene, count, sto.displaced_sigma, sto.displaced_yaw_sigma)
             self._displaced = [replace(self.spec, scene=scene) for scene in scenes]
         return self._displaced
 

@@ -177,7 +177,9 @@ def _try_alternatives(
     result.costs.append(result.outcome.cost)
 
 
-def _budget_spent(run: BudgetedRun, result: LowLevelResult, budget: Budget, elapsed_next_s: float) -> str | None:
+def _budget_spent(
+    run: BudgetedRun, result: LowLevelResult, budget: Budget, elapsed_next_s: float
+) -> str | None:
     """What of the budget another iteration would overspend (``elapsed_next_s``: the time spent
     and the last iteration's), if anything."""
     per_iteration = budget.samples + (1 if run.spec.sto.update == "mppi" else 0)

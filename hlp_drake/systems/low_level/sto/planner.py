@@ -78,7 +78,9 @@ class StoPlanner:
             return [self.as_commanded(t) for t in problem.alternatives()]
 
         budget = Budget.of(self.config, perceived=self.perceived)
-        return optimise(self.spec(problem.scene), initial, self.pool, alternatives=alternatives, budget=budget)
+        return optimise(
+            self.spec(problem.scene), initial, self.pool, alternatives=alternatives, budget=budget
+        )
 
     def replan(
         self,

@@ -4,7 +4,7 @@
         [--config SCENARIO.yaml] [--workers 2] [--json OUT]
 
 Plans each seeded scene, solves IK and rolls the initial trajectory out once, as the optimiser's
-first rollout (``hlp_drake.systems.planning.diagram.first_rollout``: reduced model, rollout time step). Prints the
+first rollout (``hlp_drake.systems.low_level.sto.first_rollout``: reduced model, rollout time step). Prints the
 passes per object count and every failing scene with its reason. The optimiser stops at a passing
 first rollout, so this count decides most of the planning time; comparing two configurations
 (``--config`` with, say, ``motion: {closed_among_obstacles: false}``) shows what a planning or
@@ -32,12 +32,15 @@ def first_pass(kind: str, seed: int, objects: int | None, planner: str, config_y
     from dataclasses import replace
 
     from hlp_drake.learners.bundled import default_models
-    from hlp_drake.systems.planning.diagram import first_rollout
+    from hlp_drake.systems.low_level.sto.first_rollout import first_rollout
+    from hlp_drake.systems.planning.initialisers import initialiser_name
     from hlp_drake.systems.scenario import load_scenario
 
     scene = generate_scene(kind, seed, objects)
     settings = load_scenario(data=config_yaml)
-    scenario = replace(settings, scene=scene, planner=replace(settings.planner, kind=planner))
+    scenario = replace(
+        settings, scene=scene, planner=replace(settings.planner, initial=initialiser_name(planner))
+    )
     outcome = first_rollout(scenario, models=default_models())
     return {
         "scene": scene.name,
@@ -54,7 +57,9 @@ def main() -> None:
     parser.add_argument("--scenes", type=int, default=100)
     parser.add_argument("--seed", type=int, default=0, help="scene i has seed S + i")
     parser.add_argument("--objects", type=int, nargs="+", default=[5, 7, 9], help="gen2 object counts")
-    parser.add_argument("--planner", choices=("hlp", "sto"), default="hlp")
+    parser.add_argument(
+        "--planner", choices=("hlp", "line", "sto"), default="hlp", help="the initialiser (sto: line)"
+    )
     parser.add_argument("--config", type=Path, help="scenario settings YAML (default: the defaults)")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--json", type=Path, help="write the rows and counts here")

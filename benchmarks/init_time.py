@@ -35,6 +35,7 @@ from hlp_drake.learners.bundled import default_models
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.planning.diagram import make_planning_diagram
+from hlp_drake.systems.planning.initialisers import initialiser_name
 from hlp_drake.systems.planning.keyframes import Keyframes
 from hlp_drake.systems.scenario import Scenario, load_scenario
 from hlp_drake.systems.world.scene_source import SCENE_PORT
@@ -92,14 +93,16 @@ def main() -> None:
     parser.add_argument("--scenes", type=int, default=30, help="scenes per group")
     parser.add_argument("--seed", type=int, default=0, help="scene i has seed S + i")
     parser.add_argument("--objects", type=int, nargs="+", default=[5, 7, 9], help="gen2 object counts")
-    parser.add_argument("--planner", choices=("hlp", "sto"), default="hlp")
+    parser.add_argument(
+        "--planner", choices=("hlp", "line", "sto"), default="hlp", help="the initialiser (sto: line)"
+    )
     parser.add_argument("--repeat", type=int, default=3, help="solves per scene; its least time counts")
     parser.add_argument("--against-iterations", type=int, help="also solve with this ik.max_iterations")
     parser.add_argument("--json", type=Path, help="write the figures and rows here")
     parser.add_argument("--png", type=Path, help="box plot of the CPU times per group")
     args = parser.parse_args()
     settings = load_scenario()
-    settings = replace(settings, planner=replace(settings.planner, kind=args.planner))
+    settings = replace(settings, planner=replace(settings.planner, initial=initialiser_name(args.planner)))
     groups: dict[str, list[Scene]] = {
         "gen1": [generate_scene("gen1", args.seed + i) for i in range(args.scenes)],
         **{

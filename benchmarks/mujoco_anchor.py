@@ -4,7 +4,7 @@
 
 An outside anchor for the rollout cost ``sto.py`` measures: the throughput scene and its noisy 3 s
 sequences (``sto.throughput_sequences``) rolled out in MuJoCo at each ``--steps`` time step and in
-Drake on the execution model the optimiser rolls out on (``RolloutWorld(scenario)``, every object
+Drake on the execution model the optimiser rolls out on (``RolloutWorld``, every object
 awake) and on the execution model before issue 39 (``physics_models.MODELS["full_2ms"]``: 2 ms, the
 full contact geometry), the models interleaved in each of
 ``--repeats`` passes. CPU time (``time.process_time``, one core) per rollout and per simulated
@@ -67,6 +67,7 @@ from tqdm import tqdm
 
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
 from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld
+from hlp_drake.systems.low_level.sto.spec import RolloutSpec
 from hlp_drake.systems.scenario import Scenario
 from hlp_drake.systems.world.robot_description import MOBILE_UR5, models_directory
 from hlp_drake.systems.world.world import make_world_diagram, world_plant
@@ -458,9 +459,9 @@ class DrakeModel:
     """A ``RolloutWorld`` of the scenario."""
 
     def __init__(self, scenario: Scenario) -> None:
-        self.world = RolloutWorld(scenario)
+        self.world = RolloutWorld(RolloutSpec.of(scenario))
         self.object_start = self.world.object_positions()  # the initial state, before any rollout
-        self.time_step = self.world.scenario.plant.time_step
+        self.time_step = self.world.spec.model.plant.time_step
 
     def rollout(self, sequence: ControlSequence) -> Run:
         cpu = time.process_time()

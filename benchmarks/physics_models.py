@@ -42,6 +42,7 @@ from tqdm import tqdm
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
 from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld
+from hlp_drake.systems.low_level.sto.spec import RolloutSpec
 from hlp_drake.systems.scenario import Scenario
 
 FULL = "contact: {top_spheres: true, rim_spheres: 8, robot_self_contact: true}"
@@ -84,8 +85,8 @@ def _triples(count: int, scenes: int) -> list[tuple]:
 def _world(index: int, count: int, scenes: int, name: str) -> RolloutWorld:
     scene, _, _, settle = _triples(count, scenes)[index]
     settle_s = SETTLE_S if settle else 0.0
-    config = Scenario(scene=scene).updated(f"{MODELS[name]}\noptimiser: {{settle_s: {settle_s}}}")
-    return RolloutWorld(config)
+    config = Scenario(scene=scene).updated(f"{MODELS[name]}\nsuccess: {{settle_s: {settle_s}}}")
+    return RolloutWorld(RolloutSpec.of(config))
 
 
 def _entry(world: RolloutWorld, sequence) -> dict:
@@ -122,7 +123,7 @@ def _rest_task(kind: str, seed: int, names: tuple[str, ...]) -> dict:
     scene = generate_scene(kind, seed, 9 if kind == "gen2" else None)
     row = {"scene": scene.name}
     for name in names:
-        world = RolloutWorld(Scenario(scene=scene).updated(MODELS[name]))
+        world = RolloutWorld(RolloutSpec.of(Scenario(scene=scene).updated(MODELS[name])))
         start = world.start_positions
         outcome = world.rollout(ControlSequence(np.array([0.0, REST_S]), np.vstack([start, start])))
         positions = outcome.prediction.positions

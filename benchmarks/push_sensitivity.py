@@ -21,9 +21,10 @@ import time
 import numpy as np
 
 from hlp_drake.scene.generators import generate_scene
+from hlp_drake.systems.low_level.sto.first_rollout import initial_sequence
 from hlp_drake.systems.low_level.sto.pool import SceneRollouts
+from hlp_drake.systems.low_level.sto.spec import RolloutSpec
 from hlp_drake.systems.perception.system import perceive_world
-from hlp_drake.systems.planning.diagram import initial_sequence
 from hlp_drake.systems.scenario import Scenario
 from hlp_drake.systems.world.uncertainty import displaced_scenes
 
@@ -49,18 +50,20 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--seed", type=int, default=33)
     parser.add_argument("--objects", type=int, default=9)
-    parser.add_argument("--planner", choices=("hlp", "sto"), default="sto")
+    parser.add_argument(
+        "--planner", choices=("hlp", "line", "sto"), default="line", help="the initialiser (sto: line)"
+    )
     parser.add_argument("--csv")
     args = parser.parse_args()
     scene = generate_scene("gen2", args.seed, args.objects)
-    scenario = Scenario(scene=scene).updated(f"planner: {{kind: {args.planner}}}")
+    scenario = Scenario(scene=scene).updated(f"planner: {{initial: {args.planner}}}")
     sequence = initial_sequence(scenario)
     if sequence is None:
         sys.exit(f"{scene.name}: the {args.planner} planner gives no initial trajectory")
     rows = []
     for name, variant in variants(scene, scenario).items():
         started = time.perf_counter()
-        world = SceneRollouts(dataclasses.replace(scenario, scene=variant))
+        world = SceneRollouts(RolloutSpec.of(dataclasses.replace(scenario, scene=variant)))
         rolled, verified = world.rollout(sequence), world.verify(sequence)
         rows.append(
             {

@@ -34,10 +34,12 @@ from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import load_scene
 from hlp_drake.systems.execution.run import plan_and_execute
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
+from hlp_drake.systems.low_level.sto.first_rollout import initial_sequence
 from hlp_drake.systems.low_level.sto.optimiser import sample_base_noise
 from hlp_drake.systems.low_level.sto.pool import RolloutPool
 from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld
-from hlp_drake.systems.planning.diagram import initial_sequence
+from hlp_drake.systems.low_level.sto.spec import RolloutSpec
+from hlp_drake.systems.planning.initialisers import initialiser_name
 from hlp_drake.systems.scenario import Scenario
 
 DEFAULT_SCENE = Path(__file__).resolve().parents[1] / "hlp_drake" / "scenes" / "default.yaml"
@@ -55,20 +57,21 @@ def noisy(sequence: ControlSequence, config: Scenario, count: int, seed: int) ->
     rng = np.random.default_rng(seed)
     return [
         sequence.with_base_velocity(v)
-        for v in sample_base_noise(rng, sequence, config.optimiser.noise, count)
+        for v in sample_base_noise(rng, sequence, config.low_level.noise, count)
     ]
 
 
 def planned(scene, planner: str, data: str = "") -> Scenario:
-    """The default scenario on ``scene`` with ``planner`` and the YAML settings ``data``."""
-    return Scenario(scene=scene).updated(f"planner: {{kind: {planner}}}\n{data}")
+    """The default scenario on ``scene`` with the initialiser ``planner`` ("hlp"; "sto": the straight
+    line) and the YAML settings ``data``."""
+    return Scenario(scene=scene).updated(f"planner: {{initial: {initialiser_name(planner)}}}\n{data}")
 
 
 def throughput_sequences(count: int) -> tuple:
     """The throughput scene (gen2 seed 0, 9 obstacles), a configuration without settling, and
     ``count`` noisy copies of the first ``HORIZON`` s of its straight-line initial sequence."""
     scene = generate_scene("gen2", 0, 9)
-    config = planned(scene, "sto", "optimiser: {settle_s: 0.0}")
+    config = planned(scene, "sto", "success: {settle_s: 0.0}")
     base = truncated(initial_sequence(config), HORIZON)
     return scene, config, noisy(base, config, count, seed=1)
 
@@ -76,7 +79,7 @@ def throughput_sequences(count: int) -> tuple:
 def model_config(config: Scenario, step: float, reduced: bool) -> Scenario:
     """``config`` with the plant's time step ``step`` and the reduced model on or off."""
     return config.updated(
-        f"plant: {{time_step: {step}}}\noptimiser: {{reduced_model: {str(reduced).lower()}}}"
+        f"plant: {{time_step: {step}}}\nplanner: {{low_level: {{reduced_model: {str(reduced).lower()}}}}}"
     )
 
 
@@ -97,7 +100,7 @@ def throughput(count: int, steps: tuple[float, ...], repeats: int) -> dict:
     for repeat in range(repeats):
         for step in steps:
             for model in ("full", "reduced"):
-                cfg = model_config(config, step, model == "reduced")
+                cfg = RolloutSpec.of(model_config(config, step, model == "reduced"))
                 entry = result.setdefault(f"step_{step * 1000:g}ms", {}).setdefault(model, {})
                 for workers in (1, 2):
                     with RolloutPool(workers) as pool:
@@ -123,7 +126,7 @@ def throughput(count: int, steps: tuple[float, ...], repeats: int) -> dict:
                 ]
                 entry["same_costs_everywhere"] = all(run["costs"] == runs[0]["costs"] for run in runs)
     for step in steps:
-        world = RolloutWorld(model_config(config, step, False))
+        world = RolloutWorld(RolloutSpec.of(model_config(config, step, False)))
         world.rollout(sequences[0])
         walls = [world.rollout(s).wall_s for s in sequences[:4]]
         result.setdefault("real_time_factor", {})[f"{step * 1000:g}ms"] = HORIZON / float(np.median(walls))
@@ -172,8 +175,10 @@ def comparison(config: Scenario, seeds: int, out: Path) -> dict:
         for planner in ("hlp", "sto"):
             # A fresh pool: neither planner reuses the rollout worlds the other one built on this
             # scene (the pool's start-up is not in optimise_s).
-            scenario = replace(config, scene=scene, planner=replace(config.planner, kind=planner))
-            with RolloutPool(config.optimiser.workers) as pool:
+            scenario = replace(
+                config, scene=scene, planner=replace(config.planner, initial=initialiser_name(planner))
+            )
+            with RolloutPool(config.low_level.workers) as pool:
                 result = plan_and_execute(scenario, pool=pool)
                 rows.append(
                     {

@@ -103,5 +103,4 @@ def chain_first_rollout(scenario, human: HighLevelPlan):
     diagram.GetInputPort("scene").FixValue(context, scenario.scene)
     trajectory = diagram.GetOutputPort("trajectory").Eval(context)
     sequence = ControlSequence.from_trajectory(trajectory, scenario.low_level.step_duration)
-    spec = RolloutSpec(scenario.scene, scenario.world_model, scenario.low_level, scenario.success)
-    return SceneRollouts(spec).rollout(sequence)
+    return SceneRollouts(RolloutSpec.of(scenario)).rollout(sequence)

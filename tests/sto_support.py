@@ -23,7 +23,7 @@ def on(scene, data: str | None = None) -> Scenario:
 
 def spec(scenario: Scenario) -> RolloutSpec:
     """What the STO of ``scenario`` rolls out: its scene, world model, STO settings and success test."""
-    return RolloutSpec(scenario.scene, scenario.world_model, scenario.low_level, scenario.success)
+    return RolloutSpec.of(scenario)
 
 
 def sto(scene, settings: str = "") -> RolloutSpec:

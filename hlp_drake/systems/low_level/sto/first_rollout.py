@@ -48,8 +48,7 @@ def first_rollout(scenario: Scenario, *, models: DecisionModels | None = None) -
     sequence = initial_sequence(scenario, models=models)
     if sequence is None:
         return None
-    spec = RolloutSpec(scenario.scene, scenario.world_model, sto_config(scenario), scenario.success)
-    return SceneRollouts(spec).rollout(sequence)
+    return SceneRollouts(RolloutSpec.of(scenario)).rollout(sequence)
 
 
 __all__ = ["first_rollout", "initial_sequence", "sto_config"]

@@ -7,6 +7,7 @@ from __future__ import annotations
 import hashlib
 from dataclasses import dataclass, field, replace
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 from hlp_drake.config.typed_yaml import dump_typed, load_typed
 from hlp_drake.files.documents import parse_yaml
@@ -14,6 +15,9 @@ from hlp_drake.scene.model import Scene
 from hlp_drake.systems.low_level.sto.config import StoConfig
 from hlp_drake.systems.world.model import WorldModel, world_key
 from hlp_drake.systems.world.success import SuccessConfig
+
+if TYPE_CHECKING:
+    from hlp_drake.systems.scenario import Scenario
 
 
 @dataclass(frozen=True)
@@ -45,6 +49,14 @@ class RolloutSpec:
     def with_scene(self, scene: Scene) -> RolloutSpec:
         """This spec on ``scene`` (itself, with its computed key, when the scene is its own)."""
         return self if scene == self.scene else replace(self, scene=scene)
+
+    @classmethod
+    def of(cls, scenario: Scenario) -> RolloutSpec:
+        """What ``scenario``'s STO rolls out: its scene, world model, STO settings (its low-level
+        planner's, which must be the STO's) and success test."""
+        from hlp_drake.systems.low_level.sto.first_rollout import sto_config
+
+        return cls(scenario.scene, scenario.world_model, sto_config(scenario), scenario.success)
 
     @classmethod
     def from_yaml(cls, text: str) -> RolloutSpec:

@@ -88,7 +88,8 @@ def spread(groups: dict[str, dict[str, dict[str, float]]], key: str, statistic: 
     return max(values) / min(values)
 
 
-def main() -> None:
+def _parser() -> argparse.ArgumentParser:
+    """The command line of ``python benchmarks/init_time.py``."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenes", type=int, default=30, help="scenes per group")
     parser.add_argument("--seed", type=int, default=0, help="scene i has seed S + i")
@@ -100,17 +101,12 @@ def main() -> None:
     parser.add_argument("--against-iterations", type=int, help="also solve with this ik.max_iterations")
     parser.add_argument("--json", type=Path, help="write the figures and rows here")
     parser.add_argument("--png", type=Path, help="box plot of the CPU times per group")
-    args = parser.parse_args()
-    settings = load_scenario()
-    settings = replace(settings, planner=replace(settings.planner, initial=initialiser_name(args.planner)))
-    groups: dict[str, list[Scene]] = {
-        "gen1": [generate_scene("gen1", args.seed + i) for i in range(args.scenes)],
-        **{
-            f"gen2, {n} objects": [generate_scene("gen2", args.seed + i, n) for i in range(args.scenes)]
-            for n in args.objects
-        },
-    }
-    default_models()  # loaded before the first timed scene
+    return parser
+
+
+def time_groups(settings: Scenario, groups: dict[str, list[Scene]], args: argparse.Namespace) -> list[dict]:
+    """A row per scene of ``groups``: its times, keypoints and IK verdict (and, with
+    ``--against-iterations``, the second solve's times and whether its keyframes agree)."""
     rows = []
     progress = tqdm(total=sum(map(len, groups.values())), desc="plan + IK", unit="scene")
     for label, scenes in groups.items():
@@ -131,6 +127,11 @@ def main() -> None:
             rows.append(row)
             progress.update()
     progress.close()
+    return rows
+
+
+def summarise(groups: dict[str, list[Scene]], rows: list[dict], against: int | None) -> dict[str, dict]:
+    """The statistics of every group's rows (with ``against``: of the second solve's too)."""
     summary: dict[str, dict] = {}
     for label in groups:
         group = [r for r in rows if r["group"] == label]
@@ -142,16 +143,13 @@ def main() -> None:
             "keypoints": stats([r["keypoints"] for r in group]),
             "ik_ok": sum(r["ik_ok"] for r in group),
         }
-        if args.against_iterations is not None:
+        if against is not None:
             summary[label]["against_cpu_s"] = stats([r["against_cpu_s"] for r in group])
             summary[label]["same_keyframes"] = sum(r["same_keyframes"] for r in group)
-    figures = {
-        f"gen2 max/min of the {statistic} CPU s": spread(summary, "cpu_s", statistic)
-        for statistic in ("median", "mean")
-    } | {
-        f"gen2 max/min of the {statistic} plan CPU s": spread(summary, "plan_cpu_s", statistic)
-        for statistic in ("median", "mean")
-    }
+    return summary
+
+
+def print_summary(summary: dict[str, dict], figures: dict[str, float], args: argparse.Namespace) -> None:
     print(
         f"{args.planner} init (plan + IK) per scene, ms: median / mean / p95 CPU (wall median), "
         "of it the plan median / mean"
@@ -173,6 +171,41 @@ def main() -> None:
         print(line)
     for name, value in figures.items():
         print(f"  {name}: {value:.2f}")
+
+
+def plot(groups: dict[str, list[Scene]], rows: list[dict], title: str, path: Path) -> None:
+    """A box plot of the CPU times per group."""
+    figure, axes = new_figure(7.0, 4.0)
+    axes.boxplot([[r["cpu_s"] * 1e3 for r in rows if r["group"] == g] for g in groups])
+    axes.set_xticks(range(1, len(groups) + 1), list(groups))
+    axes.set_ylabel("plan + IK, CPU ms")
+    axes.set_yscale("log")
+    axes.set_title(title)
+    save_png(figure, path)
+
+
+def main() -> None:
+    args = _parser().parse_args()
+    settings = load_scenario()
+    settings = replace(settings, planner=replace(settings.planner, initial=initialiser_name(args.planner)))
+    groups: dict[str, list[Scene]] = {
+        "gen1": [generate_scene("gen1", args.seed + i) for i in range(args.scenes)],
+        **{
+            f"gen2, {n} objects": [generate_scene("gen2", args.seed + i, n) for i in range(args.scenes)]
+            for n in args.objects
+        },
+    }
+    default_models()  # loaded before the first timed scene
+    rows = time_groups(settings, groups, args)
+    summary = summarise(groups, rows, args.against_iterations)
+    figures = {
+        f"gen2 max/min of the {statistic} CPU s": spread(summary, "cpu_s", statistic)
+        for statistic in ("median", "mean")
+    } | {
+        f"gen2 max/min of the {statistic} plan CPU s": spread(summary, "plan_cpu_s", statistic)
+        for statistic in ("median", "mean")
+    }
+    print_summary(summary, figures, args)
     if args.json is not None:
         record = {
             "command": " ".join(["python benchmarks/init_time.py", *sys.argv[1:]]),
@@ -185,15 +218,8 @@ def main() -> None:
         }
         write_text_atomic(args.json, json.dumps(record, indent=1))
     if args.png is not None:
-        figure, axes = new_figure(7.0, 4.0)
-        axes.boxplot([[r["cpu_s"] * 1e3 for r in rows if r["group"] == g] for g in groups])
-        axes.set_xticks(range(1, len(groups) + 1), list(groups))
-        axes.set_ylabel("plan + IK, CPU ms")
-        axes.set_yscale("log")
-        axes.set_title(
-            f"{args.planner} initialisation per scene (ik.max_iterations {settings.ik.max_iterations})"
-        )
-        save_png(figure, args.png)
+        title = f"{args.planner} initialisation per scene (ik.max_iterations {settings.ik.max_iterations})"
+        plot(groups, rows, title, args.png)
 
 
 if __name__ == "__main__":

@@ -14,7 +14,7 @@ far each model's robot ends from the execution model's, and how far the objects 
 the robot holding its start pose.
 
 The MuJoCo model is converted from the finalized Drake plant of the scenario's world
-(``make_world_diagram``, ``mjcf_from_plant``): the same bodies, masses, inertias, joint tree and
+(``make_world_diagram``, ``mjcf.mjcf_from_plant``): the same bodies, masses, inertias, joint tree and
 limits, the same collision shapes (one geom per Drake collision geometry, support spheres included)
 and friction coefficients, the same collision filters, PD position actuators with Drake's gains and
 effort limits (the command ``q_d + kd / kp * v_d`` makes MuJoCo's ``kp (ctrl - q) - kv v`` Drake's
@@ -23,7 +23,7 @@ as an equality constraint. It is a comparable model, not an identical one: MuJoC
 keeps its default solver parameters (not Drake's point stiffness and dissipation), combines two
 friction coefficients by their maximum (Drake: 2 a b / (a + b)), integrates the actuators' stiffness
 explicitly (Drake's SAP: implicitly) and runs with its default solver settings, the ``implicitfast``
-integrator aside (``INTEGRATOR``).
+integrator aside (``mjcf.INTEGRATOR``).
 The Drake times include each rollout's state sampling and costing (MuJoCo's: computing the commands
 and the stepping loop). The optimiser's reduced model (objects asleep, ``SceneRollouts``) is not
 timed here.
@@ -35,33 +35,17 @@ from __future__ import annotations
 import argparse
 import importlib.metadata
 import json
-import math
 import os
 import platform
 import sys
 import time
-import xml.etree.ElementTree as ET
-from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
+from mjcf import INTEGRATOR, mjcf_from_plant, mujoco_names, mujoco_qpos, urdf_couplers
 from physics_models import MODELS
-from pydrake.geometry import (
-    Box,
-    Capsule,
-    Convex,
-    Cylinder,
-    Ellipsoid,
-    HalfSpace,
-    Mesh,
-    SceneGraphInspector,
-    Sphere,
-)
-from pydrake.math import RigidTransform
-from pydrake.multibody.plant import MultibodyPlant
-from pydrake.multibody.tree import BodyIndex, JointActuatorIndex, JointIndex, ModelInstanceIndex
 from sto import HORIZON, throughput_sequences
 from tqdm import tqdm
 
@@ -78,295 +62,9 @@ except ImportError:  # an optional extra: main() says so
     mujoco = None
 
 MISSING = "error: mujoco is not installed (pip install -e '.[bench]')"
-INTEGRATOR = "implicitfast"
-"""MuJoCo's default integrator (semi-implicit Euler) takes the actuators' damping explicitly: with
-Drake's gains the robot ends its sequences up to 0.6 (m or rad) off the last knot at 5 ms and
-diverges at 20 ms. ``implicitfast`` takes it implicitly (as SAP does)."""
 MOVED = 0.01
 """An object counts as moved when its centre ends more than this far from its start, m."""
 ROBOT_URDF = models_directory() / "robot" / "mobile_ur5.urdf"
-
-
-class Coupler(NamedTuple):
-    """A coupler constraint: ``follower = gear * leader + offset`` (joint names)."""
-
-    follower: str
-    leader: str
-    gear: float = 1.0
-    offset: float = 0.0
-
-
-def urdf_couplers(path: Path) -> list[Coupler]:
-    """The couplers of a URDF's ``<mimic>`` joints (Drake makes them coupler constraints, whose
-    parameters pydrake does not expose)."""
-    couplers = []
-    for joint in ET.parse(path).getroot().iter("joint"):
-        mimic = joint.find("mimic")
-        if mimic is not None:
-            couplers.append(
-                Coupler(
-                    follower=joint.get("name"),
-                    leader=mimic.get("joint"),
-                    gear=float(mimic.get("multiplier", 1.0)),
-                    offset=float(mimic.get("offset", 0.0)),
-                )
-            )
-    return couplers
-
-
-def _numbers(values) -> str:
-    return " ".join(f"{float(v):.12g}" for v in values)
-
-
-def _pose(element: ET.Element, X: RigidTransform) -> None:
-    """Set ``element``'s pos and quat attributes to ``X``."""
-    q = X.rotation().ToQuaternion()
-    element.set("pos", _numbers(X.translation()))
-    element.set("quat", _numbers([q.w(), q.x(), q.y(), q.z()]))
-
-
-def mujoco_names(plant: MultibodyPlant, kind: str) -> tuple[list, list[str]]:
-    """The plant's bodies or joints (``kind``) by index and their MuJoCo names: each one's own name,
-    or ``instance/name`` where two share it."""
-    if kind == "body":
-        elements = [plant.get_body(BodyIndex(i)) for i in range(plant.num_bodies())]
-    else:
-        elements = [plant.get_joint(JointIndex(i)) for i in range(plant.num_joints())]
-    names = [e.name() for e in elements]
-    return elements, [
-        n if names.count(n) == 1 else f"{plant.GetModelInstanceName(e.model_instance())}/{n}"
-        for n, e in zip(names, elements)
-    ]
-
-
-def _geom(
-    parent: ET.Element, assets: ET.Element, inspector: SceneGraphInspector, geometry, name: str
-) -> ET.Element:
-    """A MuJoCo geom for a Drake collision geometry (meshes: their convex hull, else their box)."""
-    shape = inspector.GetShape(geometry)
-    X = inspector.GetPoseInFrame(geometry)
-    geom = ET.SubElement(parent, "geom", name=name)
-    if isinstance(shape, Box):
-        geom.set("type", "box")
-        geom.set("size", _numbers(np.array([shape.width(), shape.depth(), shape.height()]) / 2))
-    elif isinstance(shape, Cylinder):
-        geom.set("type", "cylinder")
-        geom.set("size", _numbers([shape.radius(), shape.length() / 2]))
-    elif isinstance(shape, Capsule):
-        geom.set("type", "capsule")
-        geom.set("size", _numbers([shape.radius(), shape.length() / 2]))
-    elif isinstance(shape, Sphere):
-        geom.set("type", "sphere")
-        geom.set("size", _numbers([shape.radius()]))
-    elif isinstance(shape, Ellipsoid):
-        geom.set("type", "ellipsoid")
-        geom.set("size", _numbers([shape.a(), shape.b(), shape.c()]))
-    elif isinstance(shape, HalfSpace):
-        geom.set("type", "plane")
-        geom.set("size", "0 0 1")
-    elif isinstance(shape, Mesh | Convex):
-        try:
-            hull = inspector.GetConvexHull(geometry)
-        except RuntimeError:
-            hull = None
-        if hull is not None:
-            vertices = [hull.vertex(i) for i in range(hull.num_vertices())]
-            ET.SubElement(assets, "mesh", name=f"{name}_hull", vertex=_numbers(np.ravel(vertices)))
-            geom.set("type", "mesh")
-            geom.set("mesh", f"{name}_hull")
-        else:
-            box = inspector.GetObbInGeometryFrame(geometry)
-            geom.set("type", "box")
-            geom.set("size", _numbers(box.half_width()))
-            X = X @ box.pose()
-    else:
-        raise NotImplementedError(f"geometry {name!r}: no MuJoCo geom for {type(shape).__name__}")
-    _pose(geom, X)
-    friction = inspector.GetProximityProperties(geometry).GetPropertyOrDefault(
-        "material", "coulomb_friction", None
-    )
-    if friction is not None:  # MuJoCo's torsional and rolling defaults
-        geom.set("friction", f"{friction.dynamic_friction():.12g} 0.005 0.0001")
-    return geom
-
-
-def mjcf_from_plant(
-    plant: MultibodyPlant,
-    inspector: SceneGraphInspector,
-    *,
-    time_step: float,
-    couplers: Sequence[Coupler] = (),
-    gravity_compensated: tuple[ModelInstanceIndex, ...] = (),
-) -> str:
-    """MJCF of a finalized plant's bodies, joints, collision geometry, PD actuators and couplers.
-
-    Joints: weld (a fixed child body), revolute (hinge), prismatic (slide) and quaternion floating
-    (free, on a body of the world, at its default pose) ones, with their limits and damping; the
-    other positions: ``mujoco_qpos``. Every PD-controlled actuator becomes a position actuator with
-    Drake's gains and effort limit (see the module's docstring for its command); ``couplers`` name
-    joints by their MuJoCo names (``mujoco_names``). Contacts Drake filters are excluded (MuJoCo's
-    own parent filter is off). Bodies of ``gravity_compensated`` model instances get MuJoCo's
-    gravity compensation, applied through their joints' actuators.
-    """
-    bodies, body_names = mujoco_names(plant, "body")
-    joints, joint_names = mujoco_names(plant, "joint")
-    inboard = {int(j.child_body().index()): (j, name) for j, name in zip(joints, joint_names)}
-    children: dict[int, list[int]] = {}
-    for j in joints:
-        children.setdefault(int(j.parent_body().index()), []).append(int(j.child_body().index()))
-    actuated = {}
-    for i in range(plant.num_actuators()):
-        actuator = plant.get_joint_actuator(JointActuatorIndex(i))
-        actuated[int(actuator.joint().index())] = actuator
-    context = plant.CreateDefaultContext()
-    compensated = {int(i) for i in gravity_compensated}
-
-    root = ET.Element("mujoco", model="drake_plant")
-    ET.SubElement(root, "compiler", angle="radian", inertiafromgeom="false", autolimits="true")
-    option = ET.SubElement(
-        root,
-        "option",
-        timestep=f"{time_step:g}",
-        integrator=INTEGRATOR,
-        gravity=_numbers(plant.gravity_field().gravity_vector()),
-    )
-    ET.SubElement(option, "flag", filterparent="disable")
-    assets = ET.SubElement(root, "asset")
-    worldbody = ET.SubElement(root, "worldbody")
-    geometry_names = {}
-
-    def add_geoms(element: ET.Element, body) -> None:
-        for g in plant.GetCollisionGeometriesForBody(body):
-            name = inspector.GetName(g)
-            if name in geometry_names.values():
-                name = f"{body_names[int(body.index())]}/{name}"
-            geometry_names[g] = name
-            _geom(element, assets, inspector, g, name)
-
-    def add_body(parent: ET.Element, index: int) -> None:
-        body, (joint, joint_name) = bodies[index], inboard[index]
-        element = ET.SubElement(parent, "body", name=body_names[index])
-        kind = joint.type_name()
-        X_PF = joint.frame_on_parent().GetFixedPoseInBodyFrame()
-        X_CM = joint.frame_on_child().GetFixedPoseInBodyFrame()
-        if kind == "quaternion_floating":
-            if not joint.parent_body().index() == plant.world_body().index():
-                raise NotImplementedError(f"joint {joint_name!r}: a floating joint not on the world")
-            _pose(element, plant.EvalBodyPoseInWorld(context, body))
-            ET.SubElement(element, "freejoint", name=joint_name)
-        elif kind == "weld":
-            _pose(element, X_PF @ joint.X_FM() @ X_CM.inverse())
-        elif kind in ("revolute", "prismatic"):
-            _pose(element, X_PF @ X_CM.inverse())
-            axis = joint.revolute_axis() if kind == "revolute" else joint.translation_axis()
-            mj_joint = ET.SubElement(
-                element,
-                "joint",
-                name=joint_name,
-                type="hinge" if kind == "revolute" else "slide",
-                pos=_numbers(X_CM.translation()),
-                axis=_numbers(X_CM.rotation().matrix() @ axis),
-            )
-            low, high = joint.position_lower_limits()[0], joint.position_upper_limits()[0]
-            if np.isfinite(low) and np.isfinite(high):
-                mj_joint.set("range", _numbers([low, high]))
-            if joint.default_damping() > 0:
-                mj_joint.set("damping", f"{joint.default_damping():.12g}")
-            actuator = actuated.get(int(joint.index()))
-            if actuator is not None:
-                if actuator.default_reflected_inertia() > 0:
-                    mj_joint.set("armature", f"{actuator.default_reflected_inertia():.12g}")
-                if int(body.model_instance()) in compensated:
-                    mj_joint.set("actuatorgravcomp", "true")
-        else:
-            raise NotImplementedError(f"joint {joint_name!r}: no MuJoCo joint for a {kind} joint")
-        mass = body.default_mass()
-        if mass > 0:
-            inertia = body.default_spatial_inertia()
-            com = inertia.get_com()
-            I = inertia.Shift(com).CalcRotationalInertia().CopyToFullMatrix3()
-            ET.SubElement(
-                element,
-                "inertial",
-                pos=_numbers(com),
-                mass=f"{mass:.12g}",
-                fullinertia=_numbers([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]),
-            )
-        if int(body.model_instance()) in compensated:
-            element.set("gravcomp", "1")
-        add_geoms(element, body)
-        for child in children.get(index, []):
-            add_body(element, child)
-
-    add_geoms(worldbody, plant.world_body())
-    for child in children.get(int(plant.world_body().index()), []):
-        add_body(worldbody, child)
-
-    static = {int(b.index()) for b in bodies if plant.IsAnchored(b)}  # no contact among them in MuJoCo
-    excluded = ET.SubElement(root, "contact")
-    with_geometry = [b for b in bodies if plant.GetCollisionGeometriesForBody(b)]
-    for a, body_a in enumerate(with_geometry):
-        for body_b in with_geometry[a + 1 :]:
-            if {int(body_a.index()), int(body_b.index())} <= static:
-                continue
-            if all(
-                inspector.CollisionFiltered(ga, gb)
-                for ga in plant.GetCollisionGeometriesForBody(body_a)
-                for gb in plant.GetCollisionGeometriesForBody(body_b)
-            ):
-                ET.SubElement(
-                    excluded,
-                    "exclude",
-                    body1=body_names[int(body_a.index())],
-                    body2=body_names[int(body_b.index())],
-                )
-    actuators = ET.SubElement(root, "actuator")
-    for joint_index, actuator in sorted(actuated.items(), key=lambda item: int(item[1].index())):
-        if not actuator.has_controller():
-            raise NotImplementedError(f"actuator {actuator.name()!r} has no PD controller")
-        gains = actuator.get_controller_gains()
-        element = ET.SubElement(
-            actuators,
-            "position",
-            name=actuator.name(),
-            joint=joint_names[joint_index],
-            kp=f"{gains.p:.12g}",
-            kv=f"{gains.d:.12g}",
-        )
-        if math.isfinite(actuator.effort_limit()):
-            element.set("forcerange", _numbers([-actuator.effort_limit(), actuator.effort_limit()]))
-    if couplers:
-        equality = ET.SubElement(root, "equality")
-        for c in couplers:
-            ET.SubElement(
-                equality,
-                "joint",
-                joint1=c.follower,
-                joint2=c.leader,
-                polycoef=_numbers([c.offset, c.gear, 0, 0, 0]),
-            )
-    for element in (assets, excluded):
-        if not len(element):
-            root.remove(element)
-    ET.indent(root)
-    return ET.tostring(root, encoding="unicode")
-
-
-def mujoco_qpos(plant: MultibodyPlant, context, model) -> np.ndarray:
-    """MuJoCo's qpos of the plant's positions in ``context`` (a model from ``mjcf_from_plant``)."""
-    q = plant.GetPositions(context)
-    qpos = model.qpos0.copy()
-    joints, names = mujoco_names(plant, "joint")
-    for joint, name in zip(joints, names):
-        if joint.num_positions() == 0:
-            continue
-        address, start = model.jnt_qposadr[model.joint(name).id], joint.position_start()
-        if joint.type_name() == "quaternion_floating":  # Drake: qw qx qy qz x y z; MuJoCo: x y z qw qx qy qz
-            qpos[address : address + 3] = q[start + 4 : start + 7]
-            qpos[address + 3 : address + 7] = q[start : start + 4]
-        else:
-            qpos[address] = q[start]
-    return qpos
 
 
 class Run(NamedTuple):

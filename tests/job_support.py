@@ -16,6 +16,12 @@ from hlp_drake.experiments.runner import JobFunction, Labels, ResolvedCell
 from hlp_drake.experiments.study import Cell, load_study
 from hlp_drake.scene.generators import generate_scene
 
+REQUIRED_COLUMNS = ["scene", "objects", "planner", "success", "failure_reason", "init_s", "optimise_s"]
+REQUIRED_COLUMNS += ["total_s", "rollouts", "objects_moved", "objects_dropped"]
+"""The paper's columns, first in ``results.csv``."""
+OUTPUTS = ("results.csv", "config.json", "run.json", "summary.md", "summary.json", "success.png", "times.png")
+"""What a finished run folder holds."""
+
 
 def cheap_job(job: Job) -> dict:
     """A deterministic stand-in for plan_and_execute: outcome and times drawn from (scene, planner)."""

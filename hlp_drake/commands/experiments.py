@@ -32,10 +32,7 @@ from pathlib import Path
 from hlp_drake.commands.parsing import (
     MAX_SEED,
     MAX_WORKERS,
-    add_conditions,
-    add_perception,
-    add_planner_options,
-    add_robot_option,
+    add_run_conditions,
     add_verbosity,
     drake_logging,
     integer,
@@ -86,16 +83,13 @@ def _parser() -> argparse.ArgumentParser:
         metavar="S",
         help="scene i has seed S + i (default 0)",
     )
-    add_robot_option(parser, several=True)
+    add_run_conditions(parser, several=True)
     parser.add_argument(
         "--tables",
         metavar="NAME|FILE",
         help="generate the tables within this robot's reach instead of --robot's (e.g. --robot "
         "mobile_ur5 --tables panda: the mobile UR5 on the Panda's scenes)",
     )
-    add_planner_options(parser, several=True)
-    add_perception(parser, several=True)
-    add_conditions(parser, several=True)
     parser.add_argument(
         "--workers", type=integer(1, MAX_WORKERS), metavar="N", help="jobs at a time (default: one per core)"
     )

@@ -204,6 +204,16 @@ def add_conditions(parser: argparse.ArgumentParser, *, several: bool = False) ->
     )
 
 
+def add_run_conditions(parser: argparse.ArgumentParser, *, several: bool = False) -> None:
+    """The options that become a run's ``Conditions`` (``hlp_drake.systems.conditions``): ``--robot``,
+    ``--planner``, ``--low-level``, ``--perception``, ``--execution``, ``--uncertainty``;
+    ``several``: lists, an experiment's grid (``--uncertainty`` takes one seed either way)."""
+    add_robot_option(parser, several=several)
+    add_planner_options(parser, several=several)
+    add_perception(parser, several=several)
+    add_conditions(parser, several=several)
+
+
 def run_cli(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | None = None) -> int:
     """Run ``main(argv)``; print each problem of an ``HlpError`` as ``error: ...`` and return its
     ``exit_status`` (2, or 1 for a ``StorageError``: the run failed); a Ctrl-C prints "interrupted"

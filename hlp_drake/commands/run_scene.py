@@ -34,10 +34,7 @@ from collections.abc import Sequence
 from hlp_drake.commands.parsing import (
     MAX_SEED,
     MAX_WORKERS,
-    add_conditions,
-    add_perception,
-    add_planner_options,
-    add_robot_option,
+    add_run_conditions,
     add_verbosity,
     drake_logging,
     integer,
@@ -137,9 +134,7 @@ def _parser():
         metavar="K",
         help="number of obstacles of the generated scene (with --kind gen2 or unstructured)",
     )
-    add_planner_options(parser)
-    add_perception(parser)
-    add_robot_option(parser)
+    add_run_conditions(parser)
     parser.add_argument(
         "--config",
         metavar="SCENARIO.yaml",
@@ -156,7 +151,6 @@ def _parser():
     )
     parser.add_argument("--html", metavar="FILE", help="write a self-contained MeshCat recording of the run")
     parser.add_argument("--contact-forces", action="store_true", help="draw the contact forces in MeshCat")
-    add_conditions(parser)
     parser.add_argument("--json", metavar="FILE", help="write the result as JSON")
     add_verbosity(parser)
     return parser

@@ -17,6 +17,8 @@ import time
 
 import pytest
 from job_support import (
+    OUTPUTS,
+    REQUIRED_COLUMNS,
     assert_well_formed,
     cheap_job,
     never_called,
@@ -30,12 +32,6 @@ from hlp_drake.errors import StorageError
 from hlp_drake.experiments import Job, make_row
 from hlp_drake.experiments.results import COLUMNS, read_results, results_csv, write_durable
 from hlp_drake.systems.world.robot_description import MOBILE_UR5
-
-# fmt: off
-REQUIRED_COLUMNS = ["scene", "objects", "planner", "success", "failure_reason", "init_s", "optimise_s",
-                    "total_s", "rollouts", "objects_moved", "objects_dropped"]
-# fmt: on
-OUTPUTS = ("results.csv", "config.json", "run.json", "summary.md", "summary.json", "success.png", "times.png")
 
 
 class RecordingJob:

@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 from conftest import run_module
 from job_support import (
+    OUTPUTS,
     assert_well_formed,
     cheap_job,
     drake_info_job,
@@ -26,12 +27,6 @@ from hlp_drake.experiments import Job
 from hlp_drake.experiments.plots import plot_title
 from hlp_drake.experiments.results import COLUMNS, read_results
 from hlp_drake.systems.world.robot_description import MOBILE_UR5
-
-# fmt: off
-REQUIRED_COLUMNS = ["scene", "objects", "planner", "success", "failure_reason", "init_s", "optimise_s",
-                    "total_s", "rollouts", "objects_moved", "objects_dropped"]
-# fmt: on
-OUTPUTS = ("results.csv", "config.json", "run.json", "summary.md", "summary.json", "success.png", "times.png")
 
 
 def test_a_run_folder_of_an_earlier_version_is_refused_with_how_to_start_over(tmp_path, capsys):

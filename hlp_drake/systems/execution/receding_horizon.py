@@ -67,6 +67,21 @@ Initialiser = Callable[[Scene, np.ndarray], "ControlSequence | None"]
 """A fresh initial sequence for an observed scene from the robot's measured state (positions, velocities)."""
 
 
+RECORDED = (
+    "replans",
+    "on_track",
+    "rollouts",
+    "initialised",
+    "changed",
+    "reason",
+    "observations",
+    "observation_failures",
+    "observation_reason",
+    "budget_spent",
+)
+"""What a controller's record says in JSON (``ControllerRecord.to_dict``)."""
+
+
 @dataclass(frozen=True)
 class ControllerRecord:
     """The controller's state: the commanded ``sequence`` (started at simulated time ``t0``), the
@@ -93,18 +108,8 @@ class ControllerRecord:
     budget_spent: bool = False
 
     def to_dict(self) -> dict:
-        return {
-            "replans": self.replans,
-            "on_track": self.on_track,
-            "rollouts": self.rollouts,
-            "initialised": self.initialised,
-            "changed": self.changed,
-            "reason": self.reason,
-            "observations": self.observations,
-            "observation_failures": self.observation_failures,
-            "observation_reason": self.observation_reason,
-            "budget_spent": self.budget_spent,
-        }
+        """The counts and reasons as JSON-ready data (not the sequence, the predictions, the scenes)."""
+        return {name: getattr(self, name) for name in RECORDED}
 
 
 def remainder(sequence: ControlSequence, t: float) -> ControlSequence | None:

@@ -3,7 +3,7 @@ the closed loop, the experiments' rows, the JSON) whatever planner made it."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -57,23 +57,15 @@ class LowLevelResult:
     low_level: str = "sto"
 
     def to_dict(self) -> dict:
-        return {
-            "success": self.success,
-            "failure_reason": self.failure_reason,
-            "iterations": self.iterations,
-            "rollouts": self.rollouts,
-            "optimise_s": self.optimise_s,
-            "initial_cost": self.initial_cost,
-            "start": self.start,
-            "verifications": self.verifications,
-            "rejected": self.rejected,
-            "verify_s": self.verify_s,
-            "displaced_checks": self.displaced_checks,
-            "final_cost": self.outcome.cost if self.outcome is not None else None,
-            "cost_terms": dict(self.outcome.terms) if self.outcome is not None else {},
-            "costs": list(self.costs),
-            "low_level": self.low_level,
-        }
+        """The result as JSON-ready data: its counts, times and costs (not its motion)."""
+        record = {f.name: getattr(self, f.name) for f in fields(self) if f.name not in ("sequence", "outcome")}
+        outcome = self.outcome
+        record.update(
+            final_cost=None if outcome is None else outcome.cost,
+            cost_terms={} if outcome is None else dict(outcome.terms),
+            costs=list(self.costs),
+        )
+        return record
 
 
 StoResult = LowLevelResult

@@ -5,10 +5,10 @@ Input ports:
     ``alternatives`` (abstract, tuple of ``HighLevelPlan``; optional): other plans for it.
 
 Output ports (in Drake's cache, computed again only when their input changes):
-    ``keyframes`` (abstract, ``Keyframes``): per keypoint the robot's 11 positions, a success flag and
+    ``keyframes`` (abstract, ``Keyframes``): per keypoint the robot's positions, a success flag and
         a message naming the keypoint when its IK failed. When a keypoint of the plan fails, the first
         of ``alternatives`` whose IK succeeds takes its place (``Keyframes.candidate``).
-    ``trajectory`` (abstract, ``PiecewisePolynomial``): a first-order hold of the robot's 11 positions
+    ``trajectory`` (abstract, ``PiecewisePolynomial``): a first-order hold of the robot's positions
         from the start configuration through the successful keyframes (straight lines in joint space),
         timed by the scenario's ``motion``; the gripper closed among the obstacles if
         ``motion.closed_among_obstacles``.

@@ -30,12 +30,12 @@ class Keyframes:
 
     Attributes:
         keypoints: the plan's keypoints.
-        positions: (n, 11) robot positions per keypoint (for a failed keypoint: the solver's last
+        positions: (n, positions) the robot's positions per keypoint (for a failed keypoint: the solver's last
             iterate, not to be executed).
         success: per keypoint, whether its IK succeeded.
         messages: per keypoint, "" on success, else why it failed (naming the keypoint).
         tcp_positions: (n, 3) tcp positions of ``positions`` (forward kinematics).
-        start: the robot's 11 start positions.
+        start: the robot's start positions.
         problems: plan-level problems (no plan, wrong scene); empty normally.
         solve_time_s: wall-clock time of all the solves.
         candidate: 0 for the plan's own keyframes; k when a keypoint of the plan failed and these are

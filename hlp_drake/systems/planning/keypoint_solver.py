@@ -92,9 +92,7 @@ class KeypointSolver:
         self._ik = ik = ik or IkConfig()
         self._motion = motion or MotionConfig()
         self._model = PlanningModel(scene, robot=robot, contact=contact, bodies=bodies, with_objects=False)
-        plant, instance = self._model.plant, self._model.robot
-        self._plant = plant
-        self._robot = instance
+        self._plant, self._robot = plant, instance = self._model.plant, self._model.robot
         self._robot_description = description = robot
         self._tcp = plant.GetFrameByName(description.tcp_frame, instance)
         if plant.num_positions() != plant.num_positions(instance):
@@ -157,7 +155,7 @@ class KeypointSolver:
 
     @property
     def start(self) -> np.ndarray:
-        """The robot's 11 start positions."""
+        """The robot's start positions."""
         return self._start.copy()
 
     def tcp_position(self, plant_context: Context, q: np.ndarray) -> np.ndarray:
@@ -171,7 +169,7 @@ class KeypointSolver:
         """The keyframes of ``plan``, solved in ``plant_context`` (the plant's part of ``new_context()``).
 
         Args:
-            start: the robot's 11 positions at the plan's "start" keypoint (default: the start
+            start: the robot's positions at the plan's "start" keypoint (default: the start
                 configuration; the receding-horizon controller's plans start where the robot is).
         """
         first = self._start if start is None else np.asarray(start, dtype=float)

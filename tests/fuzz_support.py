@@ -63,6 +63,14 @@ def check_error(error: HlpError) -> None:
     assert all(len(line) <= MAX_LINE and "\n" not in line for line in error.problems), error.problems
 
 
+def flip_bytes(draw: Callable, data: bytes) -> bytes:
+    """``data`` with 1 to 8 drawn bytes set to drawn values."""
+    data = bytearray(data)
+    for _ in range(draw(st.integers(1, 8))):
+        data[draw(st.integers(0, len(data) - 1))] = draw(st.integers(0, 255))
+    return bytes(data)
+
+
 @contextlib.contextmanager
 def scene_file(case: tuple[str, str]) -> Iterator[Path]:
     """A temporary file ``scene<suffix>`` holding ``text`` (a ``scene_texts`` case), even invalid UTF-8."""

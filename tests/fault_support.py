@@ -1,6 +1,7 @@
 """Faults the tests inject into worker processes: module-level functions, so spawned workers (and
 dask's) can unpickle them. A fault that should happen once claims a marker file in the folder
-``FAULTS`` names (set before the workers start: they inherit the environment)."""
+``FAULTS`` names (set before the workers start: they inherit the environment): ``fault_markers``
+(a test module's fixture). ``warnings``: the warning lines of a command's stderr."""
 
 from __future__ import annotations
 
@@ -12,6 +13,19 @@ from job_support import cheap_job
 
 FAULTS = "HLP_TEST_FAULTS"
 """The environment variable naming the folder of the once-only faults' marker files."""
+
+
+def fault_markers(tmp_path, monkeypatch):
+    """The folder of the once-only faults' markers, named to the workers started from here on (the
+    ``faults`` fixture of the modules that inject them: ``pytest.fixture(fault_markers, name="faults")``)."""
+    folder = tmp_path / "faults"
+    folder.mkdir()
+    monkeypatch.setenv(FAULTS, str(folder))
+    return folder
+
+
+def warnings(text: str) -> list[str]:
+    return [line for line in text.splitlines() if line.startswith("warning:")]
 
 
 def first_time(name: str) -> bool:

@@ -58,7 +58,9 @@ class LowLevelResult:
 
     def to_dict(self) -> dict:
         """The result as JSON-ready data: its counts, times and costs (not its motion)."""
-        record = {f.name: getattr(self, f.name) for f in fields(self) if f.name not in ("sequence", "outcome")}
+        record = {
+            f.name: getattr(self, f.name) for f in fields(self) if f.name not in ("sequence", "outcome")
+        }
         outcome = self.outcome
         record.update(
             final_cost=None if outcome is None else outcome.cost,

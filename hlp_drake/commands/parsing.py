@@ -141,12 +141,13 @@ def add_planner_options(parser: argparse.ArgumentParser, *, several: bool = Fals
 
     many = {"nargs": "+"} if several else {}
     aliases = ", ".join(f"{alias}: {name}" for alias, name in ALIASES.items())
+    default = "the study's; gen1, gen2: both" if several else "the scenario's, hlp"
     parser.add_argument(
         "--planner",
         choices=(*INITIALISERS, *ALIASES),
         metavar="|".join((*INITIALISERS, *ALIASES)),
-        help="the initialiser: the human-like plan (hlp, the default) or the baseline's straight line "
-        f"(line; {aliases}, the paper's name of the baseline)",
+        help=f"the initialiser{'s' if several else ''}: the human-like plan (hlp) or the baseline's "
+        f"straight line (line; {aliases}, the paper's name of the baseline); default: {default}",
         **many,
     )
     parser.add_argument(

@@ -182,7 +182,7 @@ def fmt(value) -> str:
 def arm_for(name: str, above_mount: float) -> tuple[Arm, float]:
     """A model for maps with the tcp ``above_mount`` over the arm's mount, and the tcp's height."""
     if name == "ur5":
-        from hlp_drake.systems.world.robot import MOUNT_HEIGHT as mount
+        from make_mobile_ur5 import MOUNT_HEIGHT as mount
     else:
         mount = TALL
     arm = Arm(name, mount, table_top=mount + above_mount - CLEARANCE)

@@ -95,12 +95,15 @@ class Arm:
         """Add the robot to ``plant``, set ``axis`` (its pedestal's or riser's, in the world's xy) and
         ``mount``; return the names of the arm's joints."""
         if self.name == "ur5":
-            from hlp_drake.systems.world.robot import ARM_JOINTS, ARM_MOUNT, add_robot
+            from make_mobile_ur5 import ARM_MOUNT_XYZ
 
-            add_robot(plant)
-            self.axis = np.array(ARM_MOUNT[:2])
-            self.mount = ARM_MOUNT[2]
-            return ARM_JOINTS
+            from hlp_drake.systems.world.robot import add_robot
+            from hlp_drake.systems.world.robot_description import MOBILE_UR5
+
+            add_robot(plant, MOBILE_UR5)
+            self.axis = np.array(ARM_MOUNT_XYZ[:2])
+            self.mount = ARM_MOUNT_XYZ[2]
+            return MOBILE_UR5.arm_joints
         from pydrake.multibody.parsing import Parser
 
         text = make_arms.panda_urdf(mount) if self.name == "panda" else make_arms.iiwa14_urdf(mount)

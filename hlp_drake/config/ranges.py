@@ -139,6 +139,8 @@ class First:
 
 PositiveFloat = Annotated[float, Positive()]
 NonNegativeFloat = Annotated[float, Positive(zero_ok=True)]
+PERIOD = Positive(MIN_PERIOD, MAX_DURATION)
+"""A control step, sampling or re-planning period, s."""
 
 
 @dataclass(frozen=True)
@@ -227,6 +229,7 @@ __all__ = [
     "MAX_TIME_STEP",
     "MIN_PERIOD",
     "MIN_TIME_STEP",
+    "PERIOD",
     "Between",
     "Check",
     "Count",

@@ -48,9 +48,10 @@ from hlp_drake.planner.config import PlannerConfig
 from hlp_drake.scene.io import default_scene
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.validation import scene_problems
+from hlp_drake.systems.execution.closed_loop import ClosedLoopConfig
 from hlp_drake.systems.execution.command import GraspConfig
 from hlp_drake.systems.low_level.protocol import LowLevelConfig
-from hlp_drake.systems.low_level.sto.config import ClosedLoopConfig, StoConfig
+from hlp_drake.systems.low_level.sto.config import StoConfig
 from hlp_drake.systems.perception.cameras import MAX_CAMERAS, PerceptionConfig, camera_pose
 from hlp_drake.systems.planning.config import DEFAULT_ALTERNATIVES, IkConfig, MotionConfig
 from hlp_drake.systems.planning.initialisers import ALIASES, INITIALISERS

@@ -28,7 +28,7 @@ if TYPE_CHECKING:
     from hlp_drake.systems.execution.command import ClosedLoopCommand, OpenLoopCommand
     from hlp_drake.systems.execution.result import ExecutionResult
     from hlp_drake.systems.execution.run import RunListener
-    from hlp_drake.systems.low_level.sto.cost import FinalState
+    from hlp_drake.systems.low_level.outcome import FinalState
     from hlp_drake.systems.scenario import Scenario
 
 MOVED_TOLERANCE = 0.01  # m: an object displaced further than this counts as moved

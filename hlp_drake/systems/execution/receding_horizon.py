@@ -48,9 +48,8 @@ from pydrake.systems.framework import Context, LeafSystem, State
 
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
+from hlp_drake.systems.low_level.outcome import Prediction, RolloutStart
 from hlp_drake.systems.low_level.result import EMPTY_RESULT, LowLevelResult
-from hlp_drake.systems.low_level.sto.cost import Prediction
-from hlp_drake.systems.low_level.sto.rollout_world import RolloutStart
 from hlp_drake.systems.perception.accuracy import largest_displacement
 from hlp_drake.systems.perception.perception import Perception
 from hlp_drake.systems.world.scene_source import declare_scene_input_port, scene_input
@@ -58,7 +57,7 @@ from hlp_drake.systems.world.scene_source import declare_scene_input_port, scene
 if TYPE_CHECKING:
     from pydrake.multibody.plant import MultibodyPlant
 
-    from hlp_drake.systems.low_level.sto.config import ClosedLoopConfig
+    from hlp_drake.systems.execution.closed_loop import ClosedLoopConfig
     from hlp_drake.systems.low_level.sto.planner import StoPlanner
 
 MIN_REMAINDER = 1.0e-3

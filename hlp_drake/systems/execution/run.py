@@ -42,8 +42,8 @@ if TYPE_CHECKING:
     from pydrake.trajectories import PiecewisePolynomial
 
     from hlp_drake.learners.models import DecisionModels
+    from hlp_drake.systems.low_level.outcome import FinalState
     from hlp_drake.systems.low_level.result import LowLevelResult
-    from hlp_drake.systems.low_level.sto.cost import FinalState
     from hlp_drake.systems.low_level.sto.pool import RolloutPool
     from hlp_drake.systems.perception.perception import Perception
     from hlp_drake.systems.scenario import Scenario

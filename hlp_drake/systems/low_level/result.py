@@ -11,7 +11,7 @@ import numpy as np
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
 
 if TYPE_CHECKING:
-    from hlp_drake.systems.low_level.sto.cost import RolloutOutcome
+    from hlp_drake.systems.low_level.outcome import RolloutOutcome
 
 
 @dataclass

@@ -14,7 +14,7 @@ from hlp_drake.errors import HlpError
 from hlp_drake.scene.io import load_scene
 from hlp_drake.systems.execution.receding_horizon import remainder
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
-from hlp_drake.systems.low_level.sto.cost import Prediction, RolloutOutcome
+from hlp_drake.systems.low_level.outcome import Prediction, RolloutOutcome
 from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld
 from hlp_drake.systems.planning.diagram import ObservedScenePlanner, make_planning_diagram
 from hlp_drake.systems.scenario import Scenario

@@ -14,8 +14,8 @@ from sto_support import spec
 from hlp_drake.commands.run_scene import DEFAULT_SCENE
 from hlp_drake.scene.io import load_scene
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
+from hlp_drake.systems.low_level.outcome import Prediction, RolloutOutcome
 from hlp_drake.systems.low_level.result import LowLevelResult
-from hlp_drake.systems.low_level.sto.cost import Prediction, RolloutOutcome
 from hlp_drake.systems.low_level.sto.pool import RolloutPool
 from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld
 from hlp_drake.systems.perception.cameras import CameraConfig, PerceptionConfig

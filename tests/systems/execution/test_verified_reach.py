@@ -15,9 +15,10 @@ from hlp_drake.commands.run_scene import DEFAULT_SCENE
 from hlp_drake.scene.io import load_scene
 from hlp_drake.systems.execution.run import plan_and_execute, verified_reach
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
+from hlp_drake.systems.low_level.outcome import RolloutStart
 from hlp_drake.systems.low_level.result import LowLevelResult
 from hlp_drake.systems.low_level.sto.pool import RolloutPool, SceneRollouts
-from hlp_drake.systems.low_level.sto.rollout_world import RolloutStart, RolloutWorld
+from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld
 from hlp_drake.systems.scenario import Scenario
 from hlp_drake.systems.world.model import world_key
 from hlp_drake.systems.world.world import add_position_trajectory, make_world_diagram, world_plant

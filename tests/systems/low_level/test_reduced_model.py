@@ -8,8 +8,9 @@ import pytest
 from sto_support import on, short, spec
 
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
+from hlp_drake.systems.low_level.outcome import RolloutStart
 from hlp_drake.systems.low_level.sto.pool import SceneRollouts
-from hlp_drake.systems.low_level.sto.rollout_world import RolloutStart, RolloutWorld
+from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld
 from hlp_drake.systems.low_level.sto.sampler import OBJECT, ROBOT, TABLE, contact_summary
 from hlp_drake.systems.low_level.sto.sleep import ProximityContext, Sweep
 

@@ -9,8 +9,8 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
+from hlp_drake.systems.low_level.outcome import RolloutOutcome
 from hlp_drake.systems.low_level.sto.config import PERCEIVED_CHECKS, StoConfig
-from hlp_drake.systems.low_level.sto.cost import RolloutOutcome
 from hlp_drake.systems.low_level.sto.pool import RolloutPool
 from hlp_drake.systems.world.uncertainty import displaced_scenes
 
@@ -18,7 +18,7 @@ MAX_ALTERNATIVES = 100
 """Alternatives an optimisation tries at most (``Budget.of``): all the initialiser offers."""
 
 if TYPE_CHECKING:
-    from hlp_drake.systems.low_level.sto.rollout_world import RolloutStart
+    from hlp_drake.systems.low_level.outcome import RolloutStart
     from hlp_drake.systems.low_level.sto.spec import RolloutSpec
 
 

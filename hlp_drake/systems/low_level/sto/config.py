@@ -1,5 +1,5 @@
 """``StoConfig``: every setting of the stochastic trajectory optimiser, the low-level planner ``sto``
-(a ``Scenario``'s ``planner.low_level`` with ``kind: sto``); ``ClosedLoopConfig``: its closed loop.
+(a ``Scenario``'s ``planner.low_level`` with ``kind: sto``).
 
 In a scenario file it sits under ``planner: {low_level: ...}``::
 
@@ -20,7 +20,7 @@ from typing import Annotated, Literal
 
 from hlp_drake.config.ranges import (
     MAX_DURATION,
-    MIN_PERIOD,
+    PERIOD,
     Count,
     NonNegativeFloat,
     Positive,
@@ -32,8 +32,6 @@ from hlp_drake.systems.low_level.protocol import LowLevelConfig
 
 MAX_WORKERS = 64
 """Most rollout processes."""
-PERIOD = Positive(MIN_PERIOD, MAX_DURATION)
-"""A control step, sampling or re-planning period, s."""
 FRACTION = Rule(lambda v: 0.0 <= v <= 1.0, "{where} must be in [0, 1], got {value}")
 UPDATES = ("greedy", "mppi")
 PERCEIVED_CHECKS = 2
@@ -177,30 +175,3 @@ class StoConfig(LowLevelConfig):
         if not margin > clearance:
             return []
         return [f"{where}.weld_margin ({margin}) must not exceed {where}.weld_clearance ({clearance})"]
-
-
-@dataclass(frozen=True)
-class ClosedLoopConfig:
-    """The receding-horizon controller of closed-loop execution (``receding_horizon``).
-
-    Attributes:
-        enabled: execute closed loop (``--execution closed``); False plays the optimised sequence.
-        replan_period: simulated time between two re-optimisations, s.
-        iterations, rollouts: the budget of each re-optimisation (its iterations and rollouts).
-        replan_distance: an object this far from where the current plan's rollout put it has
-            "moved far": the controller asks for a new initial sequence (the planner's, on the
-            observed scene) and optimises from it, the remainder of the current one its alternative, m.
-        track_distance: while every observed object is within this of where the initial sequence's
-            verification on the execution model had it, that verified sequence is on track and is
-            kept without re-optimising (0: always re-optimise), m.
-        max_rollouts: the re-optimisations' rollouts in all, so an execution the controller cannot
-            rescue ends: once spent, the commanded sequence plays to its end without re-optimising.
-    """
-
-    enabled: bool = False
-    replan_period: Annotated[float, PERIOD] = 0.5
-    iterations: Annotated[int, Count(0, 10_000)] = 1
-    rollouts: Annotated[int, Count(1, 1_000_000)] = 9
-    replan_distance: PositiveFloat = 0.05
-    track_distance: NonNegativeFloat = 0.005
-    max_rollouts: Annotated[int, Count(1, 100_000_000)] = 300

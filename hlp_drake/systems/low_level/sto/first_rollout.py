@@ -15,7 +15,7 @@ from hlp_drake.systems.world.scene_source import SCENE_PORT
 
 if TYPE_CHECKING:
     from hlp_drake.learners.models import DecisionModels
-    from hlp_drake.systems.low_level.sto.cost import RolloutOutcome
+    from hlp_drake.systems.low_level.outcome import RolloutOutcome
     from hlp_drake.systems.scenario import Scenario
 
 

@@ -30,15 +30,15 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
+from hlp_drake.systems.low_level.outcome import RolloutOutcome
 from hlp_drake.systems.low_level.result import LowLevelResult
 from hlp_drake.systems.low_level.sto.budget import Budget, BudgetedRun
 from hlp_drake.systems.low_level.sto.config import BaseNoise, StoConfig
-from hlp_drake.systems.low_level.sto.cost import RolloutOutcome
 from hlp_drake.systems.low_level.sto.planar_noise import planar_shift
 from hlp_drake.systems.low_level.sto.pool import RolloutPool, WorkersLost
 
 if TYPE_CHECKING:
-    from hlp_drake.systems.low_level.sto.rollout_world import RolloutStart
+    from hlp_drake.systems.low_level.outcome import RolloutStart
     from hlp_drake.systems.low_level.sto.spec import RolloutSpec
 
 

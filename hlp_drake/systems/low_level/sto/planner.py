@@ -25,8 +25,8 @@ if TYPE_CHECKING:
     from pydrake.trajectories import PiecewisePolynomial
 
     from hlp_drake.scene.model import Scene
+    from hlp_drake.systems.low_level.outcome import RolloutStart
     from hlp_drake.systems.low_level.sto.pool import RolloutPool
-    from hlp_drake.systems.low_level.sto.rollout_world import RolloutStart
 
 
 class StoPlanner:

@@ -33,8 +33,9 @@ from hlp_drake.runtime.processes import (
     worker_pool,
 )
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
-from hlp_drake.systems.low_level.sto.cost import RolloutOutcome, RolloutSamples
-from hlp_drake.systems.low_level.sto.rollout_world import RolloutStart, RolloutWorld, timed_rollout
+from hlp_drake.systems.low_level.outcome import RolloutOutcome, RolloutStart
+from hlp_drake.systems.low_level.sto.cost import RolloutSamples
+from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld, timed_rollout
 from hlp_drake.systems.low_level.sto.sampler import sample_rollout
 from hlp_drake.systems.low_level.sto.sleep import AWAKE, SleepSchedule, Sweep
 from hlp_drake.systems.low_level.sto.spec import RolloutSpec

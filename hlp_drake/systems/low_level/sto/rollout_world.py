@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Iterable
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from functools import cached_property
 from typing import TYPE_CHECKING
 
@@ -26,13 +26,8 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
-from hlp_drake.systems.low_level.sto.cost import (
-    FinalState,
-    Prediction,
-    RolloutOutcome,
-    RolloutSamples,
-    rollout_cost,
-)
+from hlp_drake.systems.low_level.outcome import FinalState, Prediction, RolloutOutcome, RolloutStart
+from hlp_drake.systems.low_level.sto.cost import RolloutSamples, rollout_cost
 from hlp_drake.systems.low_level.sto.sampler import (
     OBJECT,
     OTHER,
@@ -51,15 +46,6 @@ from hlp_drake.systems.world.world import add_position_trajectory, world_diagram
 
 if TYPE_CHECKING:
     from hlp_drake.systems.low_level.sto.spec import RolloutSpec
-
-
-@dataclass(frozen=True)
-class RolloutStart:
-    """A rollout's start other than the scene's: the given model instances' positions and velocities
-    (by name: the robot's and objects'; any other starts as in the scene) at time 0, in
-    ``RolloutWorld.states()``' form (positions then velocities)."""
-
-    states: dict[str, np.ndarray]
 
 
 class RolloutWorld:

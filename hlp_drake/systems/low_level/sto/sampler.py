@@ -32,7 +32,8 @@ from hlp_drake.systems.low_level.sto.config import StoConfig
 from hlp_drake.systems.low_level.sto.cost import RolloutSamples
 
 if TYPE_CHECKING:
-    from hlp_drake.systems.low_level.sto.rollout_world import RolloutStart, RolloutWorld
+    from hlp_drake.systems.low_level.outcome import RolloutStart
+    from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld
     from hlp_drake.systems.low_level.sto.sleep import SleepSchedule
 
 

@@ -3,9 +3,9 @@
     hlp-drake COMMAND [ARGS ...]      (or: python -m hlp_drake COMMAND [ARGS ...])
 
 Commands (each takes --help; the same as python -m hlp_drake.MODULE):
-    run-scene     plan a scene, optimise it with the STO and run it in Drake (python -m hlp_drake.run_scene)
+    run-scene     plan a scene (initialiser, low-level planner) and run it in Drake (python -m hlp_drake.run_scene)
     scene         generate, validate and draw scene files (python -m hlp_drake.scene)
-    experiments   the paper's Generalization I and II experiments, Tables II and III (python -m hlp_drake.experiments)
+    experiments   a study of scenes under conditions (bundled: gen1, gen2: Tables II, III) (python -m hlp_drake.experiments)
     train         train the decision models on the VR dataset (python -m hlp_drake.train)
     evaluate      the cross-subject evaluation, Table I (python -m hlp_drake.evaluate)
     segment       segment the VR demonstrations into per-row decisions (python -m hlp_drake.segment)

@@ -23,7 +23,8 @@ from functools import partial
 
 from tqdm import tqdm
 
-from hlp_drake.commands.parsing import MAX_SEED, MAX_WORKERS, Parser, add_quiet, integer, make_parser
+from hlp_drake.commands.parsing import MAX_WORKERS, Parser, add_quiet, integer, make_parser
+from hlp_drake.config.ranges import MAX_SEED
 from hlp_drake.dataset.dataset import Dataset
 from hlp_drake.dataset.records import STRUCTURED, UNSTRUCTURED, category_of
 from hlp_drake.errors import HlpError

@@ -30,7 +30,6 @@ from dataclasses import replace
 from pathlib import Path
 
 from hlp_drake.commands.parsing import (
-    MAX_SEED,
     MAX_WORKERS,
     add_run_conditions,
     add_verbosity,
@@ -38,6 +37,8 @@ from hlp_drake.commands.parsing import (
     integer,
     make_parser,
 )
+from hlp_drake.config.ranges import MAX_SEED, config_problems
+from hlp_drake.errors import HlpError
 from hlp_drake.experiments.executors import EXECUTORS
 from hlp_drake.experiments.experiment import CONFIG, DERIVED, RESULTS, RUN, ExperimentSettings, run_experiment
 from hlp_drake.experiments.runner import JobFunction, StudyResolver
@@ -127,7 +128,22 @@ def study_of(args: argparse.Namespace) -> Study:
     }
     if args.uncertainty is not None:
         changes["model_error"] = (args.uncertainty,)
-    return replace(study, **changes) if changes else study
+    if not changes:
+        return study
+    study = replace(study, **changes)
+    problems = config_problems(study)  # the file's own settings passed: these are the options'
+    if problems:
+        raise HlpError(*(_as_option(problem) for problem in problems))
+    return study
+
+
+def _as_option(problem: str) -> str:
+    """``problem`` of a ``Study`` field named after the option that set it."""
+    options = {field: option for option, field in OVERRIDES.items()} | {"model_error": "uncertainty"}
+    field = problem.split(":")[0].split(" ")[0]
+    if field not in options:
+        return problem
+    return f"--{options[field].replace('_', '-')}{problem[len(field) :]}"
 
 
 def main(

@@ -24,7 +24,6 @@ from hlp_drake.models import SHIPPED_ROBOTS
 from hlp_drake.runtime.processes import Terminated, terminations_raised
 from hlp_drake.systems.names import EXECUTIONS, PERCEPTION_SOURCES
 
-EXIT_USER_ERROR = 2
 EXIT_TERMINATED = 143  # 128 + SIGTERM
 
 
@@ -78,8 +77,6 @@ def make_parser(prog: str, doc: str | None, **kwargs) -> Parser:
     return parser
 
 
-MAX_SEED = 2**32 - 1
-"""Largest seed (numpy's seeds are non-negative)."""
 MAX_WORKERS = 64
 """Most worker processes a command starts."""
 

@@ -32,7 +32,6 @@ import time
 from collections.abc import Sequence
 
 from hlp_drake.commands.parsing import (
-    MAX_SEED,
     MAX_WORKERS,
     add_run_conditions,
     add_verbosity,
@@ -40,6 +39,7 @@ from hlp_drake.commands.parsing import (
     integer,
     make_parser,
 )
+from hlp_drake.config.ranges import MAX_SEED
 from hlp_drake.config.what_ran import WhatRan
 from hlp_drake.errors import InstallError
 from hlp_drake.files.atomic import check_writable, write_text_atomic

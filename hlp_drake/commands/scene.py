@@ -10,7 +10,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from hlp_drake.commands.parsing import MAX_SEED, add_robot_option, integer, make_parser
+from hlp_drake.commands.parsing import add_robot_option, integer, make_parser
+from hlp_drake.config.ranges import MAX_SEED
 from hlp_drake.files.atomic import check_writable
 from hlp_drake.scene.generators import KINDS, MAX_GENERATED, generate_scene
 from hlp_drake.scene.io import load_scene, save_scene

@@ -30,6 +30,8 @@ from typing import Annotated, Any
 
 from hlp_drake.config.typed_yaml import join_path
 
+MAX_SEED = 2**32 - 1
+"""Seeds lie in [0, MAX_SEED] (numpy's seeds are non-negative)."""
 MAX_SETTING = 1e9
 """Largest value of any number in the settings (a stiffness of 1e6 N/m is typical)."""
 MAX_TIME_STEP = 0.01

@@ -32,10 +32,11 @@ COMMON_NOTES = [
     (
         "Times are planning times per scene in seconds, means over all scenes of the condition (successes "
         "and failures): init = high-level plan + keypoint IK (plan_s + ik_s), optimisation = the low-level "
-        "planner (the stochastic trajectory optimiser), total = init + optimisation. The simulated execution "
-        "(execute_s in results.csv) is excluded. Verification = the optimiser's checks of a passing rollout "
-        "on the execution model (verify_s, part of optimisation); the ratio without it compares the search "
-        "alone."
+        "planner (the paper's: the stochastic trajectory optimiser), total = init + optimisation. The simulated "
+        "execution (execute_s in results.csv) is excluded. Verification = the low-level planner's checks of a "
+        "passing rollout on the execution model (verify_s, part of optimisation); the ratio without it "
+        "compares the search alone. The paper's figures are shown for its conditions only: the STO, open "
+        "loop, true scene, no model error."
     ),
     (
         "Success % is followed by its 95 % Wilson interval; success = the target in the gripper's pre-grasp "
@@ -62,11 +63,18 @@ NOTES = {
 }
 
 
-def paper_figures(generator: str, objects: int, planner: str) -> PaperFigures:
-    """The paper's figures of ``planner`` (``hlp`` or ``sto``) in ``generator``'s condition of
-    ``objects`` obstacles (all None where the paper has none)."""
+PAPER_CELL = {"low_level": "sto", "execution": "open", "perception": "truth", "model_error": None}
+"""What the paper ran: the STO, open loop, on the true scene, without model error."""
+
+
+def paper_figures(generator: str, objects: int, cell: dict[str, object]) -> PaperFigures:
+    """The paper's figures of a series (``cell``: its ``planner`` label, ``hlp`` or ``sto``, and its
+    axes) in ``generator``'s condition of ``objects`` obstacles (all None where the paper has none,
+    or the series is not run as the paper ran it, ``PAPER_CELL``)."""
+    if any(cell.get(axis) != value for axis, value in PAPER_CELL.items()):
+        return PaperFigures()
     table = PAPER.get((generator, None if generator == "gen1" else objects), {})
-    return table.get(planner, PaperFigures())
+    return table.get(str(cell["planner"]), PaperFigures())
 
 
 def notes(generators: tuple[str, ...]) -> list[str]:
@@ -74,4 +82,4 @@ def notes(generators: tuple[str, ...]) -> list[str]:
     return [*COMMON_NOTES, *(note for g in generators for note in NOTES.get(g, []))]
 
 
-__all__ = ["PAPER", "PaperFigures", "notes", "paper_figures"]
+__all__ = ["PAPER", "PAPER_CELL", "PaperFigures", "notes", "paper_figures"]

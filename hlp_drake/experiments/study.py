@@ -20,7 +20,7 @@ from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 from typing import Annotated, Any
 
-from hlp_drake.config.ranges import Count, config_problems
+from hlp_drake.config.ranges import MAX_SEED, Count, config_problems
 from hlp_drake.config.typed_yaml import load_typed
 from hlp_drake.errors import HlpError
 from hlp_drake.files.documents import parse_yaml, read_document
@@ -28,7 +28,6 @@ from hlp_drake.scene.constants import KINDS, MAX_GENERATED
 
 STUDIES = Path(__file__).resolve().parent / "studies"
 """The bundled studies, ``NAME.yaml``."""
-MAX_SEED = 2**32 - 1
 MAX_SCENES = 100_000
 FIXED_COUNT_KINDS = ("vr", "gen1")
 """Generators whose scenes always have the same number of obstacles (``objects`` does not apply)."""
@@ -105,6 +104,19 @@ class Study:
             for value in getattr(self, axis)
             if value not in names
         ]
+        from hlp_drake.models import SHIPPED_ROBOTS
+
+        for axis, values in (("robots", self.robots), ("tables", (self.tables,) if self.tables else ())):
+            problems += [
+                f"{prefix}{axis}: unknown robot {value!r} (shipped: {', '.join(SHIPPED_ROBOTS)}; or a .yaml "
+                "description file)"
+                for value in values
+                if value not in SHIPPED_ROBOTS and not value.endswith((".yaml", ".yml"))
+            ]
+        if any(not 0 <= seed <= MAX_SEED for seed in self.model_error):
+            problems.append(
+                f"{prefix}model_error: each seed between 0 and {MAX_SEED}, got {list(self.model_error)}"
+            )
         if not self.generators:
             problems.append(f"{prefix}generators: give at least one")
         if any(not 1 <= count <= MAX_GENERATED for count in self.objects):

@@ -34,10 +34,10 @@ CELL = ("robot", "initial", "low_level", "execution", "perception", "model_error
 
 
 def condition_label(generator: str, objects: int, generators: tuple[str, ...]) -> str:
-    label = f"Gen I ({objects} objects)" if generator == "gen1" else f"{objects} objects"
-    if generator != "gen1" and len(generators) > 1:
-        label = f"{generator}, {label}"
-    return label
+    """A condition's name: the generator (one study of several) and the object count."""
+    if len(generators) > 1:
+        return f"{generator}, {objects} objects"
+    return f"Gen I ({objects} objects)" if generator == "gen1" else f"{objects} objects"
 
 
 def wilson_interval(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
@@ -137,8 +137,7 @@ def summarise(
         series = []
         for key in sorted(cells, key=lambda k: tuple("" if v is None else str(v) for v in k)):
             cell = dict(zip(("planner", *CELL), key))
-            paper = paper_figures(generator, objects, cell["planner"])
-            stats = planner_stats(cells[key], paper if cell["low_level"] == "sto" else PaperFigures())
+            stats = planner_stats(cells[key], paper_figures(generator, objects, cell))
             series.append({"label": series_label(cell, varying), "cell": cell, "stats": stats})
         conditions.append(
             {
@@ -202,17 +201,18 @@ def summary_markdown(summary: dict[str, Any]) -> str:
     ]
     for condition in summary["conditions"]:
         lines += _table_rows(condition)
-    lines += [
-        "",
-        "| condition | mean total times | ratio | the ratio without verification | the paper's ratio |",
-        "|---|---|---:|---:|---:|",
-    ]
-    for condition in summary["conditions"]:
-        for ratio in condition["ratios"]:
-            lines.append(
-                f"| {condition['condition']} | {ratio['of']} | {_number(ratio['total'], 3)} | "
-                f"{_number(ratio['total_without_verification'], 3)} | {_number(ratio['paper'], 3)} |"
-            )
+    ratios = [(c["condition"], ratio) for c in summary["conditions"] for ratio in c["ratios"]]
+    if ratios:  # a study without both initialisers has none
+        lines += [
+            "",
+            "| condition | mean total times | ratio | the ratio without verification | the paper's ratio |",
+            "|---|---|---:|---:|---:|",
+        ]
+        lines += [
+            f"| {condition} | {ratio['of']} | {_number(ratio['total'], 3)} | "
+            f"{_number(ratio['total_without_verification'], 3)} | {_number(ratio['paper'], 3)} |"
+            for condition, ratio in ratios
+        ]
     lines += [
         "",
         "| condition | planner | rollouts (mean) | verification s (mean) | rollout passed, execution failed |",

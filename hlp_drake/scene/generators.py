@@ -26,6 +26,7 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
+from hlp_drake.config.ranges import MAX_SEED
 from hlp_drake.errors import SceneError
 from hlp_drake.files.documents import brief
 from hlp_drake.scene.constants import KINDS, MAX_GENERATED
@@ -72,8 +73,6 @@ class RobotSceneRanges:
 GEN1 = RobotSceneRanges()
 DECIMALS = 4  # generated values are rounded to 0.1 mm / 0.1 mrad so files read cleanly
 MAX_PLACEMENT_ATTEMPTS = 2000
-MAX_SEED = 2**32 - 1
-"""Seeds lie in [0, MAX_SEED] (numpy's seeds are non-negative)."""
 
 
 def _rounded(value: float) -> float:

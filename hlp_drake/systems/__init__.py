@@ -54,6 +54,7 @@ __all__ = [
     "Prediction",
     "PushRules",
     "RecedingHorizonController",
+    "ReplanningPlanner",
     "RobotDescription",
     "RobotPlanTransfer",
     "RolloutOutcome",
@@ -140,6 +141,7 @@ __getattr__, __dir__ = lazy_exports(
             "LowLevelContext",
             "LowLevelPlanner",
             "LowLevelProblem",
+            "ReplanningPlanner",
         ),
         "hlp_drake.systems.low_level.registry": (
             "LOW_LEVEL_PLANNERS",

@@ -158,7 +158,7 @@ class Scenario:
         """Refuse settings that cannot be used (the scene is checked on its own, ``validate_scene``).
 
         Raises:
-            HlpError: one line per problem (``config_problems``), e.g. "optimiser.samples must be
+            HlpError: one line per problem (``config_problems``), e.g. "planner.low_level.samples must be
                 between 1 and 1000, got 0".
         """
         if not _LOADING.get():

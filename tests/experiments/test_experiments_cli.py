@@ -77,6 +77,27 @@ def test_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, capsys, argv)
     assert err.startswith("error: ") and err.count("\n") == 1 and not out.exists()
 
 
+@pytest.mark.parametrize(
+    ("lines", "expected"),
+    [
+        ("robots: [nosuch]", "robots: unknown robot 'nosuch' (shipped: mobile_ur5"),
+        ("tables: nosuch", "tables: unknown robot 'nosuch'"),
+        ("model_error: [-3]", "model_error: each seed between 0 and"),
+        ("low_level: [astar]", "low_level: unknown 'astar' (known: sto"),
+        ("initialisers: [rrt]", "initialisers: unknown 'rrt'"),
+        ("scenes: 0", "scenes"),
+    ],
+)
+def test_a_bad_study_file_is_one_line_naming_the_file_and_field(tmp_path, capsys, lines, expected):
+    study = tmp_path / "study.yaml"
+    study.write_text(f"name: t\ngenerators: [gen1]\n{lines}\n")
+    out = tmp_path / "out"
+    assert run_cli(lambda a: main(a, job=never_called), [str(study), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: {study}: ") and expected in err and err.count("\n") == 1
+    assert not out.exists()
+
+
 def _bad_row(text: str, field: str, value: str) -> str:
     """``text`` (a results.csv) with ``field`` of its first row set to ``value``."""
     lines = text.splitlines()
@@ -331,4 +352,4 @@ def test_another_robots_tables_are_the_runs_scenes_and_part_of_its_identity(tmp_
     resumed = [*argv, "--tables", "panda"]  # all rows kept: nothing runs again
     assert run_cli(lambda a: main(a, job=never_called), resumed) == 0
     assert run_cli(lambda a: main(a, job=job), [*argv, "--tables", "no_such_robot"]) == 2
-    assert capsys.readouterr().err.strip().startswith("error: --tables: robot 'no_such_robot'")
+    assert capsys.readouterr().err.strip().startswith("error: --tables: unknown robot 'no_such_robot'")

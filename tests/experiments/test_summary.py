@@ -131,6 +131,21 @@ def test_a_grid_of_robots_and_low_level_planners_gets_a_series_per_cell_and_a_ra
     assert summary["table"] == "grid"
 
 
+def test_the_paper_is_beside_its_own_conditions_only_and_a_study_of_one_initialiser_has_no_ratios():
+    rows = [_row(i, "hlp", "hlp", execution=execution) for i in range(2) for execution in ("open", "closed")]
+    rows += [_row(i, "hlp", "hlp", generator="gen2", objects=5, scene=f"gen2-5-{i}") for i in range(2)]
+    study = Study(
+        name="mixed", generators=("gen1", "gen2"), initialisers=("hlp",), execution=("open", "closed")
+    )
+    summary = summarise(study, rows)
+    assert [c["condition"] for c in summary["conditions"]] == ["gen1, 6 objects", "gen2, 5 objects"]
+    papers = {s["label"]: s["stats"]["paper"]["success_pct"] for s in summary["conditions"][0]["series"]}
+    assert papers == {"HLP, closed": None, "HLP, open": 94.0}  # the paper ran open loop only
+    assert all(c["ratios"] == [] for c in summary["conditions"])
+    markdown = summary_markdown(summary)
+    assert "| gen1, 6 objects | HLP, open | 2 |" in markdown and "mean total times" not in markdown
+
+
 def test_a_bars_value_label_stays_clear_of_the_papers_diamond_at_its_top(monkeypatch, tmp_path):
     """Ours 96 %, the paper's 93 %: the diamond sits near the bar's top, the value at half height."""
     from hlp_drake.experiments import plots

@@ -20,11 +20,10 @@ import numpy as np
 from pydrake.geometry import Meshcat
 from pydrake.systems.framework import Diagram, DiagramBuilder
 
-from hlp_drake.errors import HlpError
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.execution.receding_horizon import RecedingHorizonController
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
-from hlp_drake.systems.low_level.registry import LOW_LEVEL_PLANNERS, low_level_entry
+from hlp_drake.systems.low_level.registry import check_closed_loop
 from hlp_drake.systems.low_level.sto.pool import RolloutPool
 from hlp_drake.systems.perception.system import ScenePerception, add_scene_perception
 from hlp_drake.systems.planning.diagram import ObservedScenePlanner, low_level_planner, make_planning_diagram
@@ -97,13 +96,7 @@ def make_execution_diagram(
         HlpError: closed loop with a low-level planner that cannot re-plan.
     """
     closed = scenario.closed_loop.enabled
-    entry = low_level_entry(scenario.low_level.kind)
-    if closed and not entry.replans:
-        replanners = ", ".join(n for n, e in LOW_LEVEL_PLANNERS.items() if e.replans)
-        raise HlpError(
-            f"closed-loop execution re-plans from the measured state, which the low-level planner "
-            f"{entry.name} cannot (one that can: {replanners})"
-        )
+    check_closed_loop(scenario.low_level.kind, closed=closed)
     camera = scenario.perception.source == "camera"
     watching = camera and closed  # cameras in the executed world, re-perceived at re-plans
     error = execution_model_error(scenario)

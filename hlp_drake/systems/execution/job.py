@@ -16,10 +16,10 @@ from hlp_drake.errors import HlpError
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.systems.conditions import Conditions, rollout_workers
 from hlp_drake.systems.execution.run import plan_and_execute
-from hlp_drake.systems.low_level.registry import low_level_entry
+from hlp_drake.systems.low_level.registry import check_closed_loop
 from hlp_drake.systems.low_level.sto.pool import RolloutPool
 from hlp_drake.systems.planning.initialisers import planner_label
-from hlp_drake.systems.scenario import Scenario, load_scenario
+from hlp_drake.systems.scenario import load_scenario
 from hlp_drake.systems.world.robot_description import load_robot
 from hlp_drake.systems.world.simulation import simulation_failure
 
@@ -61,7 +61,7 @@ def resolve_study(study: Study, config_yaml: str | None, *, single_process_rollo
     cells = []
     for cell in study.cells():
         applied = conditions(cell).applied(scenario)
-        _check_closed_loop(applied)
+        check_closed_loop(applied.low_level.kind, closed=applied.closed_loop.enabled)
         labels = Labels(
             robot=applied.robot.name,
             initial=applied.planner.initial,
@@ -74,15 +74,6 @@ def resolve_study(study: Study, config_yaml: str | None, *, single_process_rollo
         workers = 1 if single_process_rollouts else None  # jobs side by side: no nested pools
         cells.append(ResolvedCell(cell, labels, (tables or applied.robot).workspace, workers))
     return ResolvedStudy(scenario.yaml, tuple(cells), _what_ran(cells, tables))
-
-
-def _check_closed_loop(scenario: Scenario) -> None:
-    """Refuse a closed loop whose low-level planner cannot re-plan (before any job runs)."""
-    entry = low_level_entry(scenario.low_level.kind)
-    if scenario.closed_loop.enabled and not entry.replans:
-        raise HlpError(
-            f"closed-loop execution needs a low-level planner that re-plans; {entry.name} does not"
-        )
 
 
 def _what_ran(cells, tables) -> WhatRan:

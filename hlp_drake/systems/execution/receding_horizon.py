@@ -1,4 +1,4 @@
-"""``RecedingHorizonController``: closed-loop execution, the low-level planner (the STO) re-run on the
+"""``RecedingHorizonController``: closed-loop execution, a low-level planner that re-plans (the STO) re-run on the
 measured state.
 
 Input ports:
@@ -19,7 +19,7 @@ Output port:
 Every ``closed_loop.replan_period`` s of simulated time while its sequence lasts (a periodic
 unrestricted update: the simulation waits for it), the controller reads the measured state and the
 observed scene, cuts its commanded sequence there (the warm start: its remainder, starting where the
-robot is commanded now) and re-plans from the measured state (``StoPlanner.replan``, ``RolloutStart``;
+robot is commanded now) and re-plans from the measured state (``ReplanningPlanner.replan``, e.g. the STO; ``RolloutStart``;
 objects not measured start at rest where the observed scene has them) with the budget of
 ``closed_loop.iterations`` and ``closed_loop.rollouts`` (and within ``closed_loop.max_rollouts`` in
 all: once those are spent, no more re-optimisation); the result's sequence is commanded from then
@@ -58,7 +58,7 @@ if TYPE_CHECKING:
     from pydrake.multibody.plant import MultibodyPlant
 
     from hlp_drake.systems.execution.closed_loop import ClosedLoopConfig
-    from hlp_drake.systems.low_level.sto.planner import StoPlanner
+    from hlp_drake.systems.low_level.protocol import ReplanningPlanner
 
 MIN_REMAINDER = 1.0e-3
 """A sequence with less than this left (s) is not re-optimised."""
@@ -128,7 +128,7 @@ class RecedingHorizonController(LeafSystem):
 
     Args:
         plant: the world's plant (to split its state by model instance; not simulated here).
-        planner: the low-level planner that re-plans (``StoPlanner``: its pool is the caller's).
+        planner: the low-level planner that re-plans (``ReplanningPlanner``, e.g. ``StoPlanner``).
         closed_loop: the controller's settings (a ``Scenario``'s ``closed_loop``).
         robot: the robot's model instance name.
         objects: the objects measured on ``state`` (none when the scene is perceived by cameras:
@@ -140,7 +140,7 @@ class RecedingHorizonController(LeafSystem):
         self,
         plant: MultibodyPlant,
         *,
-        planner: StoPlanner,
+        planner: ReplanningPlanner,
         closed_loop: ClosedLoopConfig,
         robot: str,
         objects: tuple[str, ...] = (),

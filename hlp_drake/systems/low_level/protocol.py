@@ -23,6 +23,7 @@ if TYPE_CHECKING:
 
     from hlp_drake.scene.model import Scene
     from hlp_drake.systems.low_level.control_sequence import ControlSequence
+    from hlp_drake.systems.low_level.outcome import RolloutStart
     from hlp_drake.systems.low_level.result import LowLevelResult
     from hlp_drake.systems.low_level.sto.pool import RolloutPool
     from hlp_drake.systems.planning.keyframes import Keyframes
@@ -110,4 +111,24 @@ class LowLevelPlanner(Protocol):
         ...
 
 
-__all__ = ["LowLevelConfig", "LowLevelContext", "LowLevelPlanner", "LowLevelProblem"]
+class ReplanningPlanner(LowLevelPlanner, Protocol):
+    """A low-level planner that re-plans from a measured state (its registry entry ``replans``):
+    what the closed loop (``RecedingHorizonController``) runs."""
+
+    def replan(
+        self,
+        scene: Scene,
+        initial: ControlSequence,
+        *,
+        start: RolloutStart,
+        iterations: int,
+        rollouts: int,
+        attempt: int,
+        alternatives: Callable[[], Sequence[ControlSequence]] | None = None,
+    ) -> LowLevelResult:
+        """Re-plan ``initial`` on ``scene`` from the measured ``start`` with ``iterations`` of
+        ``rollouts`` (its ``attempt``-th re-plan), trying the first of ``alternatives`` if it fails."""
+        ...
+
+
+__all__ = ["LowLevelConfig", "LowLevelContext", "LowLevelPlanner", "LowLevelProblem", "ReplanningPlanner"]

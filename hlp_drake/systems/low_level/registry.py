@@ -80,6 +80,21 @@ def low_level_entry(name: str) -> LowLevelEntry:
     return entry
 
 
+def check_closed_loop(name: str, *, closed: bool) -> None:
+    """Refuse a closed loop (``closed``) with the planner named ``name`` when it cannot re-plan.
+
+    Raises:
+        HlpError: it cannot (the message names those that can).
+    """
+    entry = low_level_entry(name)
+    if closed and not entry.replans:
+        replanners = ", ".join(n for n, e in LOW_LEVEL_PLANNERS.items() if e.replans)
+        raise HlpError(
+            f"closed-loop execution re-plans from the measured state, which the low-level planner "
+            f"{entry.name} cannot (one that can: {replanners})"
+        )
+
+
 register_low_level(
     LowLevelEntry(
         "sto",
@@ -91,4 +106,10 @@ register_low_level(
     )
 )
 
-__all__ = ["LOW_LEVEL_PLANNERS", "LowLevelEntry", "low_level_entry", "register_low_level"]
+__all__ = [
+    "LOW_LEVEL_PLANNERS",
+    "LowLevelEntry",
+    "check_closed_loop",
+    "low_level_entry",
+    "register_low_level",
+]

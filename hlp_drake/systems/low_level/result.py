@@ -37,7 +37,7 @@ class LowLevelResult:
         rejected: of those, how many failed there.
         verify_s: wall-clock time of the verifications, s (part of ``optimise_s``).
         displaced_checks: simulations in worlds with the objects displaced.
-        low_level: the planner's name (its registry name).
+        low_level: the planner's name (its registry name; empty when no planner ran).
     """
 
     sequence: ControlSequence
@@ -54,7 +54,7 @@ class LowLevelResult:
     rejected: int = 0
     verify_s: float = 0.0
     displaced_checks: int = 0
-    low_level: str = "sto"
+    low_level: str = ""
 
     def to_dict(self) -> dict:
         """The result as JSON-ready data: its counts, times and costs (not its motion)."""

@@ -43,8 +43,7 @@ from pydrake.multibody.tree import ModelInstanceIndex
 from pydrake.systems.framework import Context, DiagramBuilder, LeafSystem
 from pydrake.systems.sensors import CameraInfo, ImageDepth32F, RgbdSensor
 
-from hlp_drake.config.ranges import Between, First, Rule
-from hlp_drake.scene.generators import MAX_SEED
+from hlp_drake.config.ranges import MAX_SEED, Between, First, Rule
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.validation import name_problem
 from hlp_drake.systems.names import PERCEPTION_SOURCES

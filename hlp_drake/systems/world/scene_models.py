@@ -41,7 +41,6 @@ TABLE_NAME = "table"
 TABLE_COLOR = np.array([0.55, 0.40, 0.25, 1.0])
 TARGET_COLOR = np.array([0.85, 0.15, 0.15, 1.0])
 OBSTACLE_COLOR = np.array([0.25, 0.45, 0.80, 1.0])
-SPHERE_COLOR = np.array([0.1, 0.1, 0.1, 1.0])
 RIM_SPHERES = Rule(
     lambda v: not (v < 0 or v in (1, 2) or v > 64), "{where} must be 0 or between 3 and 64, got {value}"
 )

@@ -12,7 +12,6 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import replace
-from typing import TYPE_CHECKING
 
 from pydrake.common.value import AbstractValue
 from pydrake.math import RigidTransform
@@ -20,9 +19,6 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context, InputPort, LeafSystem
 
 from hlp_drake.scene.model import Scene, SceneObject, Table
-
-if TYPE_CHECKING:
-    from hlp_drake.systems.scenario import Scenario
 
 SCENE_PORT = "scene"
 MODEL_SCENE = Scene(
@@ -49,11 +45,6 @@ def scene_input(port: InputPort, context: Context) -> Scene:
         system = port.get_system()
         raise RuntimeError(f"{system.get_name() or type(system).__name__}: connect or fix its 'scene' input")
     return port.Eval(context)
-
-
-def with_scene(scenario: Scenario, scene: Scene) -> Scenario:
-    """``scenario`` planning on ``scene`` (``scenario`` itself, and its computed key, when the scene is its own)."""
-    return scenario if scene == scenario.scene else replace(scenario, scene=scene)
 
 
 class SceneFromPlant(LeafSystem):

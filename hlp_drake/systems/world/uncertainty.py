@@ -18,8 +18,7 @@ from typing import Annotated
 
 import numpy as np
 
-from hlp_drake.config.ranges import Between, Rule
-from hlp_drake.scene.generators import MAX_SEED
+from hlp_drake.config.ranges import MAX_SEED, Between, Rule
 from hlp_drake.scene.model import Scene, SceneObject
 from hlp_drake.scene.validation import scene_problems
 

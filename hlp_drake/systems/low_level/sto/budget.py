@@ -77,7 +77,7 @@ class Budget:
 
 
 class BudgetedRun:
-    """One optimisation's rollouts and verifications, counted into its ``StoResult``."""
+    """One optimisation's rollouts and verifications, counted into its ``LowLevelResult``."""
 
     def __init__(
         self, spec: RolloutSpec, pool: RolloutPool, budget: Budget, start: RolloutStart | None

@@ -20,6 +20,7 @@ from typing import Annotated, Literal
 
 from hlp_drake.config.ranges import (
     MAX_DURATION,
+    MAX_SEED,
     PERIOD,
     Count,
     NonNegativeFloat,
@@ -27,13 +28,11 @@ from hlp_drake.config.ranges import (
     PositiveFloat,
     Rule,
 )
-from hlp_drake.scene.generators import MAX_SEED
 from hlp_drake.systems.low_level.protocol import LowLevelConfig
 
 MAX_WORKERS = 64
 """Most rollout processes."""
 FRACTION = Rule(lambda v: 0.0 <= v <= 1.0, "{where} must be in [0, 1], got {value}")
-UPDATES = ("greedy", "mppi")
 PERCEIVED_CHECKS = 2
 """``StoConfig.displaced_checks`` when it is None and the scene is perceived (``perception.source:
 camera``): the 100-scene Table III at 9 objects, docs/perception.md."""

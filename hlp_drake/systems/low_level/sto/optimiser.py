@@ -18,7 +18,7 @@ rollout fails and the planner has alternatives (the HLP's next candidate plans),
 out once each before the first iteration; a successful one ends the optimisation (the best-ranked
 first), else the cheapest of them all becomes the current sequence.
 
-Its Drake block is ``StochasticTrajectoryOptimiser`` (``hlp_drake.systems.low_level.sto.system``).
+Its Drake block is ``StochasticTrajectoryOptimiser`` (``hlp_drake.systems.low_level.system``).
 """
 
 from __future__ import annotations
@@ -98,9 +98,10 @@ def optimise(
             False,
             f"the robot starts in collision with {', '.join(collisions)}",
             optimise_s=time.perf_counter() - started,
+            low_level=StoConfig.kind,
         )
     run = BudgetedRun(spec, pool, budget, start)
-    result = LowLevelResult(initial, None, False, "not optimised")
+    result = LowLevelResult(initial, None, False, "not optimised", low_level=StoConfig.kind)
     try:
         _search(run, result, alternatives, progress, budget, started)
     except WorkersLost as error:  # the pool gave up on its dead workers: this optimisation failed

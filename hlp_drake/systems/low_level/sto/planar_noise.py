@@ -20,8 +20,6 @@ from hlp_drake.systems.world.start_pose import kinematic_robot
 
 DAMPING = 1e-2
 """Damping of the least-squares inverse of the tcp's Jacobian (near singular postures stay bounded)."""
-PLANAR_ROWS = (2, 3, 4)
-"""Rows of a spatial velocity (wx, wy, wz, vx, vy, vz) that the planar noise drives: wz, vx, vy."""
 
 
 def planar_maps(robot: RobotDescription, knots: np.ndarray) -> np.ndarray:

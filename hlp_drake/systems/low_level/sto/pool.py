@@ -42,7 +42,7 @@ from hlp_drake.systems.low_level.sto.spec import RolloutSpec
 
 WORLDS_KEPT = 4
 """Specs whose rollout worlds a pool (or a worker process) keeps: a scene and the displaced
-copies of it that ``optimiser.displaced_checks`` verifies on (each world built on first use)."""
+copies of it that ``planner.low_level.displaced_checks`` verifies on (each world built on first use)."""
 MAX_DEATHS = 3
 """Worker deaths in a row (no batch finished between them) after which a pool gives up."""
 
@@ -238,7 +238,7 @@ class RolloutPool:
 
 # ``SceneRollouts``: the rollouts of one spec on its execution model.
 #
-# The reduced model (``optimiser.reduced_model``, off by default): most of a rollout's time goes to the
+# The reduced model (``planner.low_level.reduced_model``, off by default): most of a rollout's time goes to the
 # contact problem, which every resting object joins with its contact points on the table. An object
 # nothing has come near stays at rest, so until then it can as well sleep (its joint locked;
 # ``sleep_schedule``, ``rollout_sampler``); one that has come to rest again goes back to sleep. Every
@@ -267,9 +267,9 @@ class SceneRollouts:
         return self.full.start_collisions
 
     def sleep_schedule(self, sequence: ControlSequence, start: RolloutStart | None = None) -> SleepSchedule:
-        """When ``sequence``'s commanded motion first comes within ``optimiser.weld_clearance`` of each
+        """When ``sequence``'s commanded motion first comes within ``planner.low_level.weld_clearance`` of each
         object (from ``start``'s object poses, if given), the objects sleeping until
-        ``optimiser.weld_lookahead`` before (never with the reduced model off: ``AWAKE``)."""
+        ``planner.low_level.weld_lookahead`` before (never with the reduced model off: ``AWAKE``)."""
         sto = self.spec.sto
         if self._sweep is None:
             return AWAKE

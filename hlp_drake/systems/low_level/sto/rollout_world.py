@@ -3,7 +3,7 @@
 The world is ``world_diagram`` of the spec's scene and world model: the execution model itself (its plant, contact
 geometry and settling), with a C++ ``TrajectorySource`` driving the robot; the initial context is
 kept. A rollout swaps the source's trajectory, resets the context (or sets a given start state) and
-simulates, Python only reading the state (``Reading``) every ``optimiser.sample_period``. Objects
+simulates, Python only reading the state (``Reading``) every ``planner.low_level.sample_period``. Objects
 may be put to sleep (their floating joints locked in the context: they neither move nor cost the
 contact solver a degree of freedom) and woken again, at any pose (the reduced model,
 ``rollout_sampler``). A rollout from the scene's start with every object awake keeps its end state

@@ -5,14 +5,14 @@ no degrees of freedom to the contact problem, which is where most of a rollout's
 (resting objects' table contacts). At every sample the rollout
 
 * wakes, from the previous sample on, every sleeping object that the robot or an awake object that
-  has moved came within ``optimiser.weld_margin`` (plus the largest motion of a body since the
+  has moved came within ``planner.low_level.weld_margin`` (plus the largest motion of a body since the
   previous sample) of: until then nothing can have touched it, so it would have stayed at rest
   anyway;
-* wakes the objects the commanded motion comes within ``optimiser.weld_clearance`` of in the next
-  ``optimiser.weld_lookahead`` s (``SleepSchedule``);
-* puts back to sleep the awake objects that have come to rest (slower than ``optimiser.sleep_speed``
+* wakes the objects the commanded motion comes within ``planner.low_level.weld_clearance`` of in the next
+  ``planner.low_level.weld_lookahead`` s (``SleepSchedule``);
+* puts back to sleep the awake objects that have come to rest (slower than ``planner.low_level.sleep_speed``
   at this sample and the previous one), with neither the robot nor a moving object within
-  ``optimiser.weld_clearance`` (SceneGraph's distances), nor an object that stays awake within
+  ``planner.low_level.weld_clearance`` (SceneGraph's distances), nor an object that stays awake within
   twice the margin (resting objects in contact sleep together), and the commanded motion not
   about to come near: e.g. an obstacle pushed aside and left there once the robot has gone.
 

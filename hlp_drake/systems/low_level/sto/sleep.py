@@ -2,7 +2,7 @@
 
 A rollout starts with the objects asleep (their joints locked) that the robot's collision geometry,
 following the commanded motion (``Sweep.approach_times``), does not come within
-``optimiser.weld_clearance`` of in the next ``optimiser.weld_lookahead`` seconds, and wakes each
+``planner.low_level.weld_clearance`` of in the next ``planner.low_level.weld_lookahead`` seconds, and wakes each
 that long before the motion comes near it. Between, ``rollout_sampler`` wakes an object anything
 comes near and puts objects that have come to rest back to sleep.
 """

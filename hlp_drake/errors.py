@@ -37,6 +37,11 @@ class HlpError(Exception):
         super().__init__("; ".join(self.problems))
 
 
+class FormerName(FutureWarning):
+    """A setting read by its former name: it still works; the message names where it is now (the
+    command line shows it as one ``note:`` line)."""
+
+
 class SceneError(HlpError):
     """A scene file or Scene object is malformed or physically impossible."""
 

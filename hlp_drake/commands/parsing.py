@@ -13,13 +13,14 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from contextvars import ContextVar
 from typing import NoReturn
 
 from hlp_drake import DRAKE_LOG, __version__
-from hlp_drake.errors import HlpError
+from hlp_drake.errors import FormerName, HlpError
 from hlp_drake.models import SHIPPED_ROBOTS
 from hlp_drake.runtime.processes import Terminated, terminations_raised
 from hlp_drake.systems.names import EXECUTIONS, PERCEPTION_SOURCES
@@ -212,12 +213,26 @@ def add_run_conditions(parser: argparse.ArgumentParser, *, several: bool = False
     add_conditions(parser, several=several)
 
 
+def _shown_as_note(show: Callable[..., None]) -> Callable[..., None]:
+    """``show`` (``warnings.showwarning``), but a ``FormerName`` is one ``note:`` line on stderr."""
+
+    def shown(message, category, *args, **kwargs) -> None:
+        if issubclass(category, FormerName):
+            print(f"note: {message}", file=sys.stderr)
+        else:
+            show(message, category, *args, **kwargs)
+
+    return shown
+
+
 def run_cli(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | None = None) -> int:
     """Run ``main(argv)``; print each problem of an ``HlpError`` as ``error: ...`` and return its
     ``exit_status`` (2, or 1 for a ``StorageError``: the run failed); a Ctrl-C prints "interrupted"
     and returns 130, a SIGTERM "terminated" and 143 (its workers stopped)."""
     try:
-        with terminations_raised():
+        with terminations_raised(), warnings.catch_warnings():
+            warnings.simplefilter("once", FormerName)
+            warnings.showwarning = _shown_as_note(warnings.showwarning)
             return main(argv)
     except HlpError as error:
         for problem in error.problems:

@@ -16,6 +16,7 @@ from typing import TextIO
 from tqdm import tqdm
 
 from hlp_drake.runtime.terminal import is_terminal
+from hlp_drake.systems.low_level.registry import LowLevelEntry, low_level_entry
 
 
 def object_name(name: str, true_names: Mapping[str, str | None] | None = None) -> str:
@@ -54,6 +55,7 @@ class ProgressListener:
         self._bar: tqdm | None = None
         self._shown = 0.0
         self._optimising = False  # the bar counts rollouts (not the closed loop's, during the execution)
+        self._entry: LowLevelEntry | None = None  # the low-level planner running
 
     def _line(self, text: str) -> None:
         print(text, flush=True)
@@ -107,8 +109,9 @@ class ProgressListener:
             f"trajectory ({seconds:.2f} s){failed}"
         )
 
-    def optimising(self) -> None:
-        self._open(desc="optimise", unit="rollout")
+    def optimising(self, low_level: str) -> None:
+        self._entry = low_level_entry(low_level)
+        self._open(desc=self._entry.step, unit="rollout")
         self._optimising = True
 
     def rollout(self, outcome) -> None:
@@ -120,10 +123,10 @@ class ProgressListener:
         self.close()
         self._optimising = False
         verdict = "success" if result.success else f"no success ({result.failure_reason})"
-        self._line(
-            f"optimise: {verdict} after {result.iterations} iterations, {result.rollouts} rollouts "
-            f"({result.optimise_s:.1f} s)"
-        )
+        entry = self._entry
+        spent = f" after {result.iterations} iterations, {result.rollouts} rollouts"
+        spent = spent if entry is None or entry.rolls_out else ""
+        self._line(f"{entry.step if entry else 'low-level'}: {verdict}{spent} ({result.optimise_s:.1f} s)")
 
     def executing(self, duration: float) -> None:
         self._line(f"execute: up to {duration:.1f} s simulated (reach, settle, grasp and lift)")

@@ -28,8 +28,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Annotated, Any
 
-from hlp_drake.config.typed_yaml import join_path
-
 MAX_SEED = 2**32 - 1
 """Seeds lie in [0, MAX_SEED] (numpy's seeds are non-negative)."""
 MAX_SETTING = 1e9
@@ -44,6 +42,11 @@ MIN_PERIOD = 1e-3
 """s: the shortest control step, sampling and re-planning period (each one is work per period)."""
 MAX_DURATION = 60.0
 """s: the longest segment, settling, grasp phase or period: the simulated time of a run stays bounded."""
+
+
+def join_path(where: str, name: str) -> str:
+    """The path of the field ``name`` below ``where`` ("" at the top), as messages name it."""
+    return f"{where}.{name}" if where else name
 
 
 class Check:

@@ -27,6 +27,7 @@ from typing import Any, Literal, TypeVar
 
 import yaml
 
+from hlp_drake.config.ranges import join_path
 from hlp_drake.errors import HlpError
 from hlp_drake.files.documents import brief
 
@@ -125,11 +126,6 @@ def _scalar_problem(kind: Any, value: Any) -> str | None:
     if kind is float and not (abs(value) <= MAX_FLOAT):  # also refuses nan
         return f"expected a finite number, got {brief(value)}"
     return None
-
-
-def join_path(where: str, name: str) -> str:
-    """The path of the field ``name`` below ``where`` ("" at the top), as messages name it."""
-    return f"{where}.{name}" if where else name
 
 
 def _variant_problems(

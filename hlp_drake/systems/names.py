@@ -1,9 +1,13 @@
-"""The names a command line and a study take for the run's settings, importing nothing: where the
+"""The names a command line and a study take for the run's settings, importing nothing else: where the
 planners' scene comes from (``perception.source``) and how the motion is executed. The initialisers'
 and the low-level planners' names are their registries' (``planning.initialisers``,
 ``low_level.registry``)."""
 
-PERCEPTION_SOURCES = ("truth", "camera")
+from typing import Literal, get_args
+
+PerceptionSource = Literal["truth", "camera"]
+"""A ``perception.source``."""
+PERCEPTION_SOURCES: tuple[str, ...] = get_args(PerceptionSource)
 """``truth``: the plant's body poses; ``camera``: what the world's cameras see."""
 EXECUTIONS = ("open", "closed")
 """``open``: play the planned motion; ``closed``: the receding-horizon controller re-plans it."""

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import contextvars
 import hashlib
+import warnings
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
@@ -42,7 +43,7 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 
 from hlp_drake.config.ranges import Count, Rule, config_problems
 from hlp_drake.config.typed_yaml import dump_typed, load_typed
-from hlp_drake.errors import HlpError
+from hlp_drake.errors import FormerName, HlpError
 from hlp_drake.files.documents import parse_yaml, read_document
 from hlp_drake.planner.config import PlannerConfig
 from hlp_drake.scene.io import default_scene
@@ -216,10 +217,28 @@ class Scenario:
         return load_scenario(data=data, defaults=self, where=where)
 
 
+FORMER_NAMES = {
+    "optimiser": "optimiser is now planner.low_level (its settle_s and cost.pregrasp_margin: success)",
+    "planner.kind": "planner.kind is now planner.initial",
+}
+"""The scenario's former names that ``legacy`` reads, and where they are now."""
+
+
+def _given(document: dict, dotted: str) -> bool:
+    """Whether ``document`` has the setting ``dotted`` (e.g. ``planner.kind``)."""
+    section: Any = document
+    for name in dotted.split("."):
+        if not isinstance(section, dict) or name not in section:
+            return False
+        section = section[name]
+    return True
+
+
 def legacy(document: Any, where: str) -> Any:
     """``document`` (a parsed scenario) with its former spellings in their places: ``optimiser: {...}``
     is ``planner.low_level: {kind: sto, ...}`` (its ``alternatives``: ``planner.alternatives``),
     ``planner.kind`` is ``planner.initial``, and the initialiser ``sto`` is ``line`` (``ALIASES``).
+    A former name (``FORMER_NAMES``) is read with a ``FormerName`` warning saying where it is now.
 
     Raises:
         HlpError: a setting given in both spellings (one line, naming ``where``).
@@ -227,6 +246,9 @@ def legacy(document: Any, where: str) -> Any:
     if not isinstance(document, dict) or not isinstance(document.get("planner", {}), dict):
         return document  # the typed check says what is wrong
     document, planner = dict(document), dict(document.get("planner") or {})
+    former = [now for old, now in FORMER_NAMES.items() if _given(document, old)]
+    if former:
+        warnings.warn(f"{where}: read by former names: {'; '.join(former)}", FormerName, stacklevel=2)
 
     def move(section: dict, old: str, new: str, value: Any) -> None:
         if new in section:

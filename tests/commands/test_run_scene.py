@@ -251,7 +251,7 @@ def test_progress_bars_only_on_a_terminal():
 
     for stream, bars in ((io.StringIO(), False), (Terminal(), True)):
         listener = ProgressListener(stream=stream)
-        listener.optimising()
+        listener.optimising("sto")
         listener.rollout(SimpleNamespace(cost=1.0))
         listener.executing(1.0)
         listener.simulated(0.5)
@@ -259,7 +259,7 @@ def test_progress_bars_only_on_a_terminal():
         assert ("\r" in stream.getvalue()) == bars
     quiet = Terminal()
     listener = ProgressListener(quiet=True, stream=quiet)
-    listener.optimising()
+    listener.optimising("sto")
     listener.close()
     assert quiet.getvalue() == ""
 

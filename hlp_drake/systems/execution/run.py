@@ -29,6 +29,7 @@ from hlp_drake.systems.execution.diagram import (
 from hlp_drake.systems.execution.meshcat_view import PLAN_LIFT, draw_perception, draw_plan, frame_table
 from hlp_drake.systems.execution.reach import execute_reach
 from hlp_drake.systems.execution.result import ExecutionResult, true_names
+from hlp_drake.systems.low_level.registry import low_level_entry
 from hlp_drake.systems.perception.accuracy import perception_record
 from hlp_drake.systems.perception.system import perceive_world
 from hlp_drake.systems.planning.diagram import low_level_planner
@@ -208,7 +209,7 @@ def _low_level(handles, simulator, listener, result, trajectory):
     executed for inspection only) and its result (None if it did not run); fills ``result``."""
     if result.failure_reason is not None:
         return low_level_planner(handles.planning).as_commanded(trajectory), None
-    listener.optimising()
+    listener.optimising(result.low_level)
     context = handles.planning.GetMyContextFromRoot(simulator.get_mutable_context())
     optimisation: LowLevelResult = handles.planning.GetOutputPort("optimisation").Eval(context)
     listener.optimised(optimisation)
@@ -216,7 +217,8 @@ def _low_level(handles, simulator, listener, result, trajectory):
     result.optimisation = optimisation.to_dict()
     result.timings["optimise_s"] = optimisation.optimise_s
     if not optimisation.success and handles.execution == "open":  # closed: the controller may rescue it
-        result.failure_reason = f"the optimiser found no solution: {optimisation.failure_reason}"
+        planner = low_level_entry(optimisation.low_level or result.low_level).noun
+        result.failure_reason = f"{planner} found no solution: {optimisation.failure_reason}"
     return optimisation.sequence, optimisation
 
 
@@ -263,11 +265,12 @@ class RunListener:
     def solved(self, keyframes: Keyframes, trajectory: PiecewisePolynomial, seconds: float) -> None:
         """The robot plan's keyframes (IK) and the initial trajectory are ready."""
 
-    def optimising(self) -> None:
-        """The optimiser starts (its rollouts arrive through the pool's ``on_rollout``)."""
+    def optimising(self, low_level: str) -> None:
+        """The low-level planner ``low_level`` (its registry name) starts (a planner that rolls out:
+        its rollouts arrive through the pool's ``on_rollout``)."""
 
     def optimised(self, result: LowLevelResult) -> None:
-        """The optimiser is done."""
+        """The low-level planner is done."""
 
     def executing(self, duration: float) -> None:
         """The execution starts: ``duration`` simulated seconds (reach, settling, grasp)."""

@@ -39,6 +39,8 @@ class LowLevelEntry:
         about: one line on what it is.
         rolls_out: it simulates in a rollout pool (``RolloutPool``), whose size is its ``workers``.
         replans: it re-plans from a measured state (``replan``): closed-loop execution can use it.
+        step: what the progress line calls its run ("": its name; the STO's: "optimise").
+        called: what a failure calls it ("" : "the low-level planner NAME"; the STO's: "the optimiser").
     """
 
     name: str
@@ -47,6 +49,17 @@ class LowLevelEntry:
     about: str
     rolls_out: bool = False
     replans: bool = False
+    step: str = ""
+    called: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.step:
+            object.__setattr__(self, "step", self.name)
+
+    @property
+    def noun(self) -> str:
+        """What a failure calls it (``called``, or "the low-level planner NAME")."""
+        return self.called or f"the low-level planner {self.name}"
 
     def config_class(self) -> type[LowLevelConfig]:
         return _resolve(self.config)
@@ -103,6 +116,8 @@ register_low_level(
         "the physics-based stochastic trajectory optimiser (the paper's): rollouts with contact",
         rolls_out=True,
         replans=True,
+        step="optimise",
+        called="the optimiser",
     )
 )
 

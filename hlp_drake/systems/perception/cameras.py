@@ -46,7 +46,7 @@ from pydrake.systems.sensors import CameraInfo, ImageDepth32F, RgbdSensor
 from hlp_drake.config.ranges import MAX_SEED, Between, First, Rule
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.validation import name_problem
-from hlp_drake.systems.names import PERCEPTION_SOURCES
+from hlp_drake.systems.names import PERCEPTION_SOURCES, PerceptionSource
 from hlp_drake.systems.world.scene_models import SceneModels
 
 RENDERER = "vtk"
@@ -280,7 +280,7 @@ class PerceptionConfig:
         seed: seed of the RANSAC fit.
     """
 
-    source: Annotated[Literal["truth", "camera"], SOURCE] = "truth"
+    source: Annotated[PerceptionSource, SOURCE] = "truth"
     cameras: Annotated[tuple[CameraConfig, ...], First(MAX_CAMERAS)] = field(
         default_factory=lambda: (CameraConfig(),)
     )

@@ -24,10 +24,12 @@ from hlp_drake.systems.low_level.system import LowLevelPlannerSystem
 
 @dataclass(frozen=True)
 class AsPlannedConfig(LowLevelConfig):
-    """The settings of ``as_planned``: the control step its trajectory is sampled at, s."""
+    """The settings of ``as_planned``: the control step its trajectory is sampled at, s; whether it
+    accepts the trajectory."""
 
     kind: Literal["as_planned"] = "as_planned"
     step: float = 0.5
+    accept: bool = True
 
 
 class AsPlanned:
@@ -42,7 +44,10 @@ class AsPlanned:
         return ControlSequence.from_trajectory(trajectory, self.config.step)
 
     def plan(self, problem: LowLevelProblem) -> LowLevelResult:
-        return LowLevelResult(self.as_commanded(problem.initial), None, True, None, low_level=self.kind)
+        reason = None if self.config.accept else "refused by its settings"
+        return LowLevelResult(
+            self.as_commanded(problem.initial), None, reason is None, reason, low_level=self.kind
+        )
 
 
 @pytest.fixture
@@ -75,6 +80,7 @@ def test_the_planner_runs_through_run_scenes_code_path(as_planned, tmp_path, cap
     status = run_cli(command_main("run-scene"), ["--low-level", "as_planned", "--quiet", "--json", str(out)])
     printed = capsys.readouterr().out
     assert "low-level planner as_planned" in printed and "rollout workers" not in printed  # no pool
+    assert "as_planned: success (" in printed and "iterations" not in printed  # it does not roll out
     report = json.loads(out.read_text())
     assert (report["initial"], report["low_level"], report["planner"]) == (
         "hlp",
@@ -85,6 +91,13 @@ def test_the_planner_runs_through_run_scenes_code_path(as_planned, tmp_path, cap
     assert status == (0 if report["success"] else 1) and report["success"], report["failure_reason"]
     assert run_cli(command_main("run-scene"), ["--low-level", "as_planned", "--execution", "closed"]) == 2
     assert "closed-loop execution re-plans from the measured state" in capsys.readouterr().err
+    config = tmp_path / "refuse.yaml"
+    config.write_text("planner:\n  low_level:\n    kind: as_planned\n    accept: false\n")
+    argv = ["--config", str(config), "--quiet", "--json", str(out)]
+    assert run_cli(command_main("run-scene"), argv) == 1
+    assert json.loads(out.read_text())["failure_reason"] == (
+        "the low-level planner as_planned found no solution: refused by its settings"
+    )
 
 
 def test_the_planner_runs_through_a_two_scene_experiment_grid(as_planned, tmp_path, capsys):

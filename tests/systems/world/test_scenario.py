@@ -9,7 +9,8 @@ from typing import Literal
 
 import pytest
 
-from hlp_drake.errors import HlpError
+from hlp_drake.commands.parsing import run_cli
+from hlp_drake.errors import FormerName, HlpError
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.systems.conditions import Conditions
 from hlp_drake.systems.low_level.protocol import LowLevelConfig
@@ -227,10 +228,13 @@ def test_the_low_level_section_is_a_tagged_union_of_the_registered_planners_sett
 
 
 def test_the_former_spellings_are_read_in_their_new_places():
-    former = load_scenario(
-        data="planner: {kind: sto}\noptimiser: {samples: 3, alternatives: 1, settle_s: 0.5,"
-        " cost: {pregrasp_margin: 0.02, goal_weight: 100.0}}"
-    )
+    with pytest.warns(
+        FormerName, match="optimiser is now planner.low_level.*planner.kind is now planner.initial"
+    ):
+        former = load_scenario(
+            data="planner: {kind: sto}\noptimiser: {samples: 3, alternatives: 1, settle_s: 0.5,"
+            " cost: {pregrasp_margin: 0.02, goal_weight: 100.0}}"
+        )
     assert former.planner.initial == "line" and former.planner.alternatives == 1
     assert former.low_level == StoConfig(samples=3, cost=replace(StoConfig().cost, goal_weight=100.0))
     assert (former.success.settle_s, former.success.pregrasp_margin) == (0.5, 0.02)
@@ -240,8 +244,21 @@ def test_the_former_spellings_are_read_in_their_new_places():
         "optimiser: {samples: 3}\nplanner: {low_level: {samples: 4}}",
         "optimiser: {settle_s: 0.5}\nsuccess: {settle_s: 0.4}",
     ):
-        with pytest.raises(HlpError, match="given twice"):
+        with pytest.raises(HlpError, match="given twice"), pytest.warns(FormerName):
             load_scenario(data=both)
+
+
+def test_a_former_name_on_the_command_line_is_one_note_line_once(capsys):
+    def main(argv) -> int:
+        for _ in range(2):
+            load_scenario(data="optimiser: {samples: 3}", where="old.yaml")
+        return 0
+
+    assert run_cli(main, []) == 0
+    assert capsys.readouterr().err == (
+        "note: old.yaml: read by former names: optimiser is now planner.low_level (its settle_s and "
+        "cost.pregrasp_margin: success)\n"
+    )
 
 
 def test_conditions_lay_the_command_lines_settings_over_a_scenario(sketch):

@@ -194,20 +194,27 @@ ARMS = (PANDA, IIWA)
 
 
 @dataclass
-class Robot:
-    spec: ArmSpec
+class BuiltRobot:
+    """A robot's diagram: its plant, scene graph and model instance."""
+
     diagram: Diagram
     plant: MultibodyPlant
     scene_graph: SceneGraph
     instance: ModelInstanceIndex
 
     def contexts(self):
+        """(the diagram's, the plant's and the scene graph's) default contexts."""
         context = self.diagram.CreateDefaultContext()
         return (
             context,
             self.plant.GetMyContextFromRoot(context),
             self.scene_graph.GetMyContextFromRoot(context),
         )
+
+
+@dataclass
+class Robot(BuiltRobot):
+    spec: ArmSpec | None = None
 
     def frame(self, name: str):
         return self.plant.GetFrameByName(name, self.instance)
@@ -235,4 +242,4 @@ def build(spec: ArmSpec, *, gravity: bool = True, actuation: np.ndarray | None =
     if actuation is not None:
         source = builder.AddSystem(ConstantVectorSource(actuation))
         builder.Connect(source.get_output_port(), plant.get_actuation_input_port())
-    return Robot(spec, builder.Build(), plant, scene_graph, instance)
+    return Robot(builder.Build(), plant, scene_graph, instance, spec=spec)

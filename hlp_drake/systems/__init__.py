@@ -54,6 +54,7 @@ __all__ = [
     "Prediction",
     "PushRules",
     "RecedingHorizonController",
+    "ReplanProblem",
     "ReplanningPlanner",
     "RobotDescription",
     "RobotPlanTransfer",
@@ -141,6 +142,7 @@ __getattr__, __dir__ = lazy_exports(
             "LowLevelContext",
             "LowLevelPlanner",
             "LowLevelProblem",
+            "ReplanProblem",
             "ReplanningPlanner",
         ),
         "hlp_drake.systems.low_level.registry": (

@@ -1,5 +1,5 @@
-"""``RecedingHorizonController``: closed-loop execution, a low-level planner that re-plans (the STO) re-run on the
-measured state.
+"""``RecedingHorizonController``: closed-loop execution, a low-level planner that re-plans (the STO)
+re-run on the measured state.
 
 Input ports:
     ``state``: the plant's whole state (the world's ``state`` output): the robot's state, and the
@@ -19,8 +19,9 @@ Output port:
 Every ``closed_loop.replan_period`` s of simulated time while its sequence lasts (a periodic
 unrestricted update: the simulation waits for it), the controller reads the measured state and the
 observed scene, cuts its commanded sequence there (the warm start: its remainder, starting where the
-robot is commanded now) and re-plans from the measured state (``ReplanningPlanner.replan``, e.g. the STO; ``RolloutStart``;
-objects not measured start at rest where the observed scene has them) with the budget of
+robot is commanded now) and re-plans from the measured state (``ReplanningPlanner.replan`` of a
+``ReplanProblem``, e.g. the STO's; ``RolloutStart``: objects not measured start at rest where the
+observed scene has them) with the budget of
 ``closed_loop.iterations`` and ``closed_loop.rollouts`` (and within ``closed_loop.max_rollouts`` in
 all: once those are spent, no more re-optimisation); the result's sequence is commanded from then
 on (the optimiser's acceptance is monotone: the remainder unless a candidate is cheaper or passes;
@@ -49,6 +50,7 @@ from pydrake.systems.framework import Context, LeafSystem, State
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
 from hlp_drake.systems.low_level.outcome import Prediction, RolloutStart
+from hlp_drake.systems.low_level.protocol import ReplanProblem
 from hlp_drake.systems.low_level.result import EMPTY_RESULT, LowLevelResult
 from hlp_drake.systems.perception.accuracy import largest_displacement
 from hlp_drake.systems.perception.perception import Perception
@@ -253,7 +255,7 @@ class RecedingHorizonController(LeafSystem):
             fresh = self._initialiser(record.observed, states[self._robot_name])
             if fresh is not None:
                 initial, alternatives, initialised = fresh, (lambda: [rest]), True
-        result = self._planner.replan(
+        problem = ReplanProblem(
             scene,
             initial,
             start=RolloutStart(states),
@@ -262,6 +264,7 @@ class RecedingHorizonController(LeafSystem):
             attempt=record.replans,
             alternatives=alternatives if initialised and left > 1 else None,
         )
+        result = self._planner.replan(problem)
         prediction = None if result.outcome is None else result.outcome.prediction
         state.get_mutable_abstract_state(int(self._record)).set_value(
             replace(

@@ -95,6 +95,29 @@ class LowLevelProblem:
     alternatives: Callable[[], Sequence[PiecewisePolynomial]] = tuple
 
 
+@dataclass(frozen=True)
+class ReplanProblem:
+    """One re-plan from a measured state (the closed loop's).
+
+    Attributes:
+        scene: the scene as observed now.
+        initial: the sequence to improve (the warm start: the rest of the commanded one).
+        start: the measured state to plan from.
+        iterations: the re-plan's iteration budget.
+        rollouts: its rollout budget.
+        attempt: which re-plan this is (0, 1, ...): a seed for its random choices.
+        alternatives: other sequences to try (the first) if ``initial`` fails; None: none.
+    """
+
+    scene: Scene
+    initial: ControlSequence
+    start: RolloutStart
+    iterations: int
+    rollouts: int
+    attempt: int
+    alternatives: Callable[[], Sequence[ControlSequence]] | None = None
+
+
 class LowLevelPlanner(Protocol):
     """A low-level planner: made by its registry entry from its settings and a ``LowLevelContext``."""
 
@@ -115,20 +138,16 @@ class ReplanningPlanner(LowLevelPlanner, Protocol):
     """A low-level planner that re-plans from a measured state (its registry entry ``replans``):
     what the closed loop (``RecedingHorizonController``) runs."""
 
-    def replan(
-        self,
-        scene: Scene,
-        initial: ControlSequence,
-        *,
-        start: RolloutStart,
-        iterations: int,
-        rollouts: int,
-        attempt: int,
-        alternatives: Callable[[], Sequence[ControlSequence]] | None = None,
-    ) -> LowLevelResult:
-        """Re-plan ``initial`` on ``scene`` from the measured ``start`` with ``iterations`` of
-        ``rollouts`` (its ``attempt``-th re-plan), trying the first of ``alternatives`` if it fails."""
+    def replan(self, problem: ReplanProblem) -> LowLevelResult:
+        """The commanded motion from ``problem``'s measured state on, within its budget."""
         ...
 
 
-__all__ = ["LowLevelConfig", "LowLevelContext", "LowLevelPlanner", "LowLevelProblem", "ReplanningPlanner"]
+__all__ = [
+    "LowLevelConfig",
+    "LowLevelContext",
+    "LowLevelPlanner",
+    "LowLevelProblem",
+    "ReplanProblem",
+    "ReplanningPlanner",
+]

@@ -6,12 +6,12 @@ import importlib.util
 import math
 import subprocess
 import sys
-from dataclasses import dataclass
 
 import numpy as np
 import pytest
+from arm_support import BuiltRobot as Robot
 from conftest import REPO
-from pydrake.geometry import Box, Capsule, Cylinder, Role, SceneGraph, Sphere
+from pydrake.geometry import Box, Capsule, Cylinder, Role, Sphere
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import (
@@ -19,9 +19,8 @@ from pydrake.multibody.plant import (
     DiscreteContactApproximation,
     MultibodyPlant,
 )
-from pydrake.multibody.tree import ModelInstanceIndex
 from pydrake.systems.analysis import Simulator
-from pydrake.systems.framework import Diagram, DiagramBuilder
+from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
 from hlp_drake.systems.world.robot import add_robot, robot_joint_limits, set_robot_positions
@@ -92,22 +91,6 @@ def dh_forward_kinematics(q) -> np.ndarray:
             ]
         )
     return pose
-
-
-@dataclass
-class Robot:
-    diagram: Diagram
-    plant: MultibodyPlant
-    scene_graph: SceneGraph
-    instance: ModelInstanceIndex
-
-    def contexts(self):
-        context = self.diagram.CreateDefaultContext()
-        return (
-            context,
-            self.plant.GetMyContextFromRoot(context),
-            self.scene_graph.GetMyContextFromRoot(context),
-        )
 
 
 def build_robot(*, gravity: bool = True, actuation: np.ndarray | None = None) -> Robot:

@@ -8,11 +8,10 @@ with a smaller budget: the receding-horizon controller's closed loop.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
-from hlp_drake.systems.low_level.protocol import LowLevelContext, LowLevelProblem
+from hlp_drake.systems.low_level.protocol import LowLevelContext, LowLevelProblem, ReplanProblem
 from hlp_drake.systems.low_level.result import LowLevelResult, held, unplanned
 from hlp_drake.systems.low_level.sto.budget import Budget
 from hlp_drake.systems.low_level.sto.config import StoConfig
@@ -25,7 +24,6 @@ if TYPE_CHECKING:
     from pydrake.trajectories import PiecewisePolynomial
 
     from hlp_drake.scene.model import Scene
-    from hlp_drake.systems.low_level.outcome import RolloutStart
     from hlp_drake.systems.low_level.sto.pool import RolloutPool
 
 
@@ -82,29 +80,20 @@ class StoPlanner:
             self.spec(problem.scene), initial, self.pool, alternatives=alternatives, budget=budget
         )
 
-    def replan(
-        self,
-        scene: Scene,
-        initial: ControlSequence,
-        *,
-        start: RolloutStart,
-        iterations: int,
-        rollouts: int,
-        attempt: int,
-        alternatives: Callable[[], Sequence[ControlSequence]] | None = None,
-    ) -> LowLevelResult:
-        """Re-optimise ``initial`` on ``scene`` from the measured ``start``, with ``iterations`` and
-        ``rollouts`` (its ``attempt``-th re-plan: the noise's seed), trying ``alternatives`` (the first
-        of them; None: none) if its rollout fails; no verification (the execution goes on from there)."""
+    def replan(self, problem: ReplanProblem) -> LowLevelResult:
+        """Re-optimise ``problem.initial`` from its measured ``start`` with its budget (its
+        ``attempt``: the noise's seed), trying the first of its ``alternatives`` if the rollout
+        fails; no verification (the execution goes on from there)."""
         budget = Budget(
             self.config.samples,
-            iterations,
-            rollouts,
-            alternatives=0 if alternatives is None else 1,
-            seed=self.config.seed + 1 + attempt,
+            problem.iterations,
+            problem.rollouts,
+            alternatives=0 if problem.alternatives is None else 1,
+            seed=self.config.seed + 1 + problem.attempt,
         )
+        spec, alternatives = self.spec(problem.scene), problem.alternatives
         return optimise(
-            self.spec(scene), initial, self.pool, budget=budget, start=start, alternatives=alternatives
+            spec, problem.initial, self.pool, budget=budget, start=problem.start, alternatives=alternatives
         )
 
 

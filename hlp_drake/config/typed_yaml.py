@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import hashlib
 import types
 import typing
 from typing import Any, Literal, TypeVar
@@ -294,3 +295,18 @@ class _Dumper(yaml.SafeDumper):
 def dump_typed(value: Any) -> str:
     """``value`` (a schema instance) as YAML text that ``load_typed`` reads back to an equal value."""
     return yaml.dump(_plain(type(value), value), Dumper=_Dumper, default_flow_style=None, sort_keys=False)
+
+
+class Documented:
+    """A frozen schema dataclass's YAML text (``yaml``, ``dump_typed``) and its digest (``key``: equal
+    for equal values), each computed once."""
+
+    @functools.cached_property
+    def yaml(self) -> str:
+        """The value as YAML text that ``load_typed`` reads back (computed once)."""
+        return dump_typed(self)
+
+    @functools.cached_property
+    def key(self) -> str:
+        """A digest of ``yaml``: equal for equal values (computed once)."""
+        return hashlib.sha256(self.yaml.encode()).hexdigest()

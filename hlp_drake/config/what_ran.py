@@ -44,6 +44,33 @@ def distinct(values: Iterable[Any]) -> tuple[Any, ...]:
 
 
 @dataclass(frozen=True)
+class Labels:
+    """One run's values as rows name them: the robot's name, the initialiser, the low-level
+    planner, their pair's name (``planner``: the paper's ``hlp``/``sto`` for the STO), the
+    execution mode, the perception source and the model error's seed (None: none)."""
+
+    robot: str
+    initial: str
+    low_level: str
+    planner: str
+    execution: str
+    perception: str
+    model_error: int | None
+
+
+AXES = {
+    "robots": "robot",
+    "planners": "planner",
+    "initials": "initial",
+    "low_levels": "low_level",
+    "executions": "execution",
+    "model_errors": "model_error",
+    "perceptions": "perception",
+}
+"""Each axis of ``WhatRan`` and the ``Labels`` field it collects."""
+
+
+@dataclass(frozen=True)
 class WhatRan:
     """What a run ran (see the module's docstring); every axis a tuple of its values."""
 
@@ -57,6 +84,15 @@ class WhatRan:
     scenario_file: str | None = None
     tables: str | None = None
     """The robot whose reach the generated tables were kept within, if not the run's own (None)."""
+
+    @classmethod
+    def of(
+        cls, labels: Iterable[Labels], *, scenario_file: str | None = None, tables: str | None = None
+    ) -> WhatRan:
+        """What runs of ``labels`` ran (each axis its distinct values, in order)."""
+        labels = list(labels)
+        axes = {axis: distinct(getattr(x, name) for x in labels) for axis, name in AXES.items()}
+        return cls(**axes, scenario_file=scenario_file, tables=tables)
 
     def line(self) -> str:
         """``robot mobile_ur5, initialiser hlp, low-level planner sto, execution open, model error
@@ -102,4 +138,4 @@ class WhatRan:
         return cls(**axes, **{k: record.get(k) for k in ("scenario_file", "tables") if k in known})
 
 
-__all__ = ["BUILT_IN_SCENARIO", "WhatRan", "distinct"]
+__all__ = ["BUILT_IN_SCENARIO", "Labels", "WhatRan", "distinct"]

@@ -58,7 +58,7 @@ COLUMNS = (
 KEY_COLUMNS = ("scene", "objects", "robot", "initial", "low_level", "execution", "perception", "model_error")
 """A row's identity (``row_key``)."""
 CELL_COLUMNS = ("robot", "initial", "low_level", "planner", "execution", "perception", "model_error")
-"""A row's cell of the grid, as ``hlp_drake.experiments.runner.Labels`` names it."""
+"""A row's cell of the grid, as ``hlp_drake.config.what_ran.Labels`` names it."""
 BOOL_COLUMNS = frozenset({"success", "passed_then_failed"})
 FLOAT_COLUMNS = frozenset({"init_s", "optimise_s", "total_s", "verify_s", "execute_s"})
 TEXT_COLUMNS = frozenset({"scene", "planner", "failure_reason", *AXIS_COLUMNS} - {"model_error"})

@@ -14,7 +14,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from hlp_drake.config.what_ran import WhatRan
+from hlp_drake.config.what_ran import Labels, WhatRan
 from hlp_drake.errors import SceneError
 from hlp_drake.experiments.study import Cell, Study
 from hlp_drake.scene.generators import generate_scene
@@ -23,22 +23,6 @@ from hlp_drake.scene.workspace import Workspace
 
 Row = dict[str, Any]
 """One ``results.csv`` row: the columns of ``hlp_drake.experiments.results.COLUMNS``."""
-
-
-@dataclass(frozen=True)
-class Labels:
-    """A cell's values as its rows name them (the scenario's own where the cell leaves an axis):
-    the robot's name, the initialiser, the low-level planner, their pair's name (``planner``:
-    the paper's ``hlp``/``sto`` for the STO), the execution mode, the perception source and the
-    model error's seed (None: none)."""
-
-    robot: str
-    initial: str
-    low_level: str
-    planner: str
-    execution: str
-    perception: str
-    model_error: int | None
 
 
 @dataclass(frozen=True)

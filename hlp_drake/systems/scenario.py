@@ -32,7 +32,6 @@ The former spellings ``planner: {kind: ...}`` and ``optimiser: {...}`` are read 
 from __future__ import annotations
 
 import contextvars
-import hashlib
 import warnings
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -42,7 +41,7 @@ from typing import Annotated, Any
 from pydrake.multibody.plant import MultibodyPlantConfig
 
 from hlp_drake.config.ranges import Count, Rule, config_problems
-from hlp_drake.config.typed_yaml import dump_typed, load_typed
+from hlp_drake.config.typed_yaml import Documented, load_typed
 from hlp_drake.errors import FormerName, HlpError
 from hlp_drake.files.documents import parse_yaml, read_document
 from hlp_drake.planner.config import PlannerConfig
@@ -112,7 +111,7 @@ class PlannerChoiceConfig:
 
 
 @dataclass(frozen=True)
-class Scenario:
+class Scenario(Documented):
     """Everything a run depends on (see the module's docstring). Frozen: derive variants with
     ``updated`` (YAML text) or ``dataclasses.replace``. Checked when made: settings out of range
     raise ``HlpError`` (one line each).
@@ -201,16 +200,6 @@ class Scenario:
     def low_level(self) -> LowLevelConfig:
         """The low-level planner's settings (``planner.low_level``)."""
         return self.planner.low_level
-
-    @cached_property
-    def yaml(self) -> str:
-        """The scenario as YAML text that ``load_scenario(data=...)`` reads back (computed once)."""
-        return dump_typed(self)
-
-    @cached_property
-    def key(self) -> str:
-        """A digest of ``yaml``: equal for equal scenarios (computed once)."""
-        return hashlib.sha256(self.yaml.encode()).hexdigest()
 
     def updated(self, data: str, *, where: str = "overrides") -> Scenario:
         """This scenario with the YAML text ``data`` laid over it (see ``load_scenario``)."""

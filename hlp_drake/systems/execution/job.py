@@ -11,14 +11,14 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from hlp_drake.config.what_ran import WhatRan, distinct
+from hlp_drake.config.what_ran import WhatRan
 from hlp_drake.errors import HlpError
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.systems.conditions import Conditions, rollout_workers
+from hlp_drake.systems.execution.result import labels_of
 from hlp_drake.systems.execution.run import plan_and_execute
 from hlp_drake.systems.low_level.registry import check_closed_loop
 from hlp_drake.systems.low_level.sto.pool import RolloutPool
-from hlp_drake.systems.planning.initialisers import planner_label
 from hlp_drake.systems.scenario import load_scenario
 from hlp_drake.systems.world.robot_description import load_robot
 from hlp_drake.systems.world.simulation import simulation_failure
@@ -51,7 +51,7 @@ def resolve_study(study: Study, config_yaml: str | None, *, single_process_rollo
         HlpError: the scenario, a cell (an unknown robot, a camera source without a camera, a closed
             loop with a low-level planner that cannot re-plan) or the tables' robot is invalid.
     """
-    from hlp_drake.experiments.runner import Labels, ResolvedCell, ResolvedStudy
+    from hlp_drake.experiments.runner import ResolvedCell, ResolvedStudy
 
     scenario = load_scenario(data=config_yaml, where="--config")
     try:
@@ -59,35 +59,13 @@ def resolve_study(study: Study, config_yaml: str | None, *, single_process_rollo
     except HlpError as error:
         raise HlpError(f"--tables: {error}") from None
     cells = []
+    workers = 1 if single_process_rollouts else None  # jobs side by side: no nested pools
     for cell in study.cells():
         applied = conditions(cell).applied(scenario)
         check_closed_loop(applied.low_level.kind, closed=applied.closed_loop.enabled)
-        labels = Labels(
-            robot=applied.robot.name,
-            initial=applied.planner.initial,
-            low_level=applied.low_level.kind,
-            planner=planner_label(applied.planner.initial, applied.low_level.kind),
-            execution="closed" if applied.closed_loop.enabled else "open",
-            perception=applied.perception.source,
-            model_error=applied.uncertainty.seed if applied.uncertainty.enabled else None,
-        )
-        workers = 1 if single_process_rollouts else None  # jobs side by side: no nested pools
-        cells.append(ResolvedCell(cell, labels, (tables or applied.robot).workspace, workers))
-    return ResolvedStudy(scenario.yaml, tuple(cells), _what_ran(cells, tables))
-
-
-def _what_ran(cells, tables) -> WhatRan:
-    labels = [c.labels for c in cells]
-    return WhatRan(
-        robots=distinct(x.robot for x in labels),
-        planners=distinct(x.planner for x in labels),
-        initials=distinct(x.initial for x in labels),
-        low_levels=distinct(x.low_level for x in labels),
-        executions=distinct(x.execution for x in labels),
-        model_errors=distinct(x.model_error for x in labels),
-        perceptions=distinct(x.perception for x in labels),
-        tables=None if tables is None else tables.name,
-    )
+        cells.append(ResolvedCell(cell, labels_of(applied), (tables or applied.robot).workspace, workers))
+    ran = WhatRan.of((c.labels for c in cells), tables=None if tables is None else tables.name)
+    return ResolvedStudy(scenario.yaml, tuple(cells), ran)
 
 
 def run_job(job: Job) -> Row:

@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from hlp_drake.config.what_ran import WhatRan
+from hlp_drake.config.what_ran import Labels, WhatRan
 from hlp_drake.planner import HighLevelPlan
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.perception.accuracy import match_objects
@@ -18,21 +18,25 @@ if TYPE_CHECKING:
     from hlp_drake.systems.scenario import Scenario
 
 
-def what_ran(scenario: Scenario, scenario_file: str | None = None) -> WhatRan:
-    """What a run of ``scenario`` (read from ``scenario_file``; None: the built-in default) runs: its
-    robot, initialiser, low-level planner, execution mode, model error's seed, perception source."""
-    uncertainty = scenario.uncertainty
+def labels_of(scenario: Scenario) -> Labels:
+    """What a run of ``scenario`` is called in rows and headers: its robot, initialiser, low-level
+    planner (and their pair's name), execution mode, perception source and model error's seed."""
     initial, low_level = scenario.planner.initial, scenario.low_level.kind
-    return WhatRan(
-        robots=(scenario.robot.name,),
-        planners=(planner_label(initial, low_level),),
-        initials=(initial,),
-        low_levels=(low_level,),
-        executions=("closed" if scenario.closed_loop.enabled else "open",),
-        model_errors=(uncertainty.seed if uncertainty.enabled else None,),
-        perceptions=(scenario.perception.source,),
-        scenario_file=scenario_file,
+    return Labels(
+        robot=scenario.robot.name,
+        initial=initial,
+        low_level=low_level,
+        planner=planner_label(initial, low_level),
+        execution="closed" if scenario.closed_loop.enabled else "open",
+        perception=scenario.perception.source,
+        model_error=scenario.uncertainty.seed if scenario.uncertainty.enabled else None,
     )
+
+
+def what_ran(scenario: Scenario, scenario_file: str | None = None) -> WhatRan:
+    """What a run of ``scenario`` (read from ``scenario_file``; None: the built-in default) runs
+    (``labels_of``)."""
+    return WhatRan.of([labels_of(scenario)], scenario_file=scenario_file)
 
 
 @dataclass

@@ -28,12 +28,11 @@ from hlp_drake.systems.execution.diagram import (
 )
 from hlp_drake.systems.execution.meshcat_view import PLAN_LIFT, draw_perception, draw_plan, frame_table
 from hlp_drake.systems.execution.reach import execute_reach
-from hlp_drake.systems.execution.result import ExecutionResult, true_names
+from hlp_drake.systems.execution.result import ExecutionResult, labels_of, true_names
 from hlp_drake.systems.low_level.registry import low_level_entry
 from hlp_drake.systems.perception.accuracy import perception_record
 from hlp_drake.systems.perception.system import perceive_world
 from hlp_drake.systems.planning.diagram import low_level_planner
-from hlp_drake.systems.planning.initialisers import planner_label
 from hlp_drake.systems.planning.keyframes import Keyframes
 from hlp_drake.systems.world.model import world_key
 from hlp_drake.systems.world.scene_source import SCENE_PORT
@@ -185,10 +184,11 @@ def _plan(handles, scenario, simulator, listener, started, perception, perceive_
     robot_plan = planning.GetOutputPort("robot_plan").Eval(context)
     if keyframes.candidate:  # the plan's IK failed; an alternative's keypoints are run and drawn
         robot_plan = replace(robot_plan, keypoints=keyframes.keypoints)
-    initial, low_level = scenario.planner.initial, scenario.low_level.kind
-    label = planner_label(initial, low_level)
-    result = ExecutionResult(label, scenario.scene, plan, keyframes, robot_plan, execution=handles.execution)
-    result.initial, result.low_level = initial, low_level
+    labels = labels_of(scenario)
+    result = ExecutionResult(
+        labels.planner, scenario.scene, plan, keyframes, robot_plan, execution=handles.execution
+    )
+    result.initial, result.low_level = labels.initial, labels.low_level
     result.actuated_dofs = len(scenario.robot.actuated_joints)
     result.timings = {"plan_s": plan_s, "ik_s": solved - planned, "optimise_s": 0.0}
     result.true_names = names

@@ -4,12 +4,11 @@ worker process the spec as YAML text (``yaml``, read back by ``from_yaml``)."""
 
 from __future__ import annotations
 
-import hashlib
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import TYPE_CHECKING
 
-from hlp_drake.config.typed_yaml import dump_typed, load_typed
+from hlp_drake.config.typed_yaml import Documented, load_typed
 from hlp_drake.files.documents import parse_yaml
 from hlp_drake.scene.model import Scene
 from hlp_drake.systems.low_level.sto.config import StoConfig
@@ -21,7 +20,7 @@ if TYPE_CHECKING:
 
 
 @dataclass(frozen=True)
-class RolloutSpec:
+class RolloutSpec(Documented):
     """``scene`` in the world ``model``, rolled out as ``sto`` says (its sampling, cost and reduced
     model) and judged by the ``success`` test. A rollout is a pure function of its spec, its start
     and its sequence."""
@@ -30,16 +29,6 @@ class RolloutSpec:
     model: WorldModel
     sto: StoConfig
     success: SuccessConfig = field(default_factory=SuccessConfig)
-
-    @cached_property
-    def yaml(self) -> str:
-        """The spec as YAML text (computed once)."""
-        return dump_typed(self)
-
-    @cached_property
-    def key(self) -> str:
-        """A digest of ``yaml``: equal for equal specs (computed once)."""
-        return hashlib.sha256(self.yaml.encode()).hexdigest()
 
     @cached_property
     def world_key(self) -> str:

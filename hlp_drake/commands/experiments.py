@@ -56,6 +56,7 @@ OVERRIDES = {
     "low_level": "low_level",
     "execution": "execution",
     "perception": "perception",
+    "world": "world",
     "tables": "tables",
 }
 """The options that replace a study's settings: option -> ``Study`` field."""

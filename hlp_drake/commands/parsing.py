@@ -23,7 +23,7 @@ from hlp_drake import DRAKE_LOG, __version__
 from hlp_drake.errors import FormerName, HlpError
 from hlp_drake.models import SHIPPED_ROBOTS
 from hlp_drake.runtime.processes import Terminated, terminations_raised
-from hlp_drake.systems.names import EXECUTIONS, PERCEPTION_SOURCES
+from hlp_drake.systems.names import EXECUTIONS, PERCEPTION_SOURCES, WORLDS
 
 EXIT_TERMINATED = 143  # 128 + SIGTERM
 
@@ -183,8 +183,9 @@ def add_perception(parser: argparse.ArgumentParser, *, several: bool = False) ->
 
 
 def add_conditions(parser: argparse.ArgumentParser, *, several: bool = False) -> None:
-    """``--execution open|closed`` and ``--uncertainty [SEED]`` (``Scenario.closed_loop``,
-    ``Scenario.uncertainty``; applied by ``hlp_drake.systems.Conditions``)."""
+    """``--execution open|closed``, ``--uncertainty [SEED]`` and ``--world model|reference``
+    (``Scenario.closed_loop``, ``Scenario.uncertainty``, ``Scenario.world``; applied by
+    ``hlp_drake.systems.Conditions``)."""
     parser.add_argument(
         "--execution",
         choices=EXECUTIONS,
@@ -200,6 +201,14 @@ def add_conditions(parser: argparse.ArgumentParser, *, several: bool = False) ->
         metavar="SEED",
         help="execute in a world with seeded model error the planners do not know of (object poses, "
         "masses, friction: the scenario's uncertainty); SEED defaults to 0",
+    )
+    parser.add_argument(
+        "--world",
+        choices=WORLDS,
+        help="what the robot acts in and the run is judged in: reference (finer physics than the "
+        "planner's model: 1 ms steps, the full contact geometry) or model (the planner's own model; "
+        "the execution replays its accepted rollout); default: the scenario's, reference",
+        **({"nargs": "+"} if several else {}),
     )
 
 

@@ -51,18 +51,32 @@ INITIALISER_NAMES = {"hlp": "human-like", "line": "straight-line"}
 """The initialisers as the recording's heading names them."""
 
 
+MODEL_VERDICTS = {None: "no motion planned", True: "accepted", False: "not accepted"}
+"""The planner's own verdict in its model, as the verdict line says it."""
+
+
+def model_verdict(result) -> str:
+    """The low-level planner's verdict in its own model, beside the world's (a false accept named)."""
+    said = MODEL_VERDICTS[result.model_success]
+    return f"{said}: a false accept" if result.false_accept else said
+
+
 def verdict(result) -> str:
-    """The verdict line: whether the reach succeeded (the paper's success, which sets the exit status),
-    and beside it whether the grasp held."""
+    """The verdict line: whether the reach succeeded in the world that judged it (the paper's success,
+    which sets the exit status), the planner's own verdict in its model, and whether the grasp held."""
     grasp = {None: "not attempted", True: "held", False: "did not hold"}[result.grasp_held]
     if result.grasp_failure is not None:
         grasp = f"did not hold ({result.grasp_failure})"
+    world = f"in the {result.world} world"
     reach = (
-        "reach success (the paper's criterion, exit status 0)"
+        f"reach success {world} (the paper's criterion, exit status 0)"
         if result.success
-        else f"reach failure: {result.failure_reason} (exit status 1)"
+        else f"reach failure {world}: {result.failure_reason} (exit status 1)"
     )
-    return f"verdict: {reach}; grasp {grasp} (reported, not part of success)"
+    return (
+        f"verdict: {reach}; the planner's model: {model_verdict(result)}; grasp {grasp} "
+        "(reported, not part of success)"
+    )
 
 
 def exit_status(result) -> int:
@@ -74,6 +88,7 @@ def recording_title(result, ran: WhatRan) -> str:
     """The recording's heading: the scene, the initialiser, the low-level planner and perception, and
     the verdict in short."""
     reach = "reach success" if result.success else f"reach failure: {result.failure_reason}"
+    reach += f" in the {result.world} world (the planner's model: {model_verdict(result)})"
     held = {None: "", True: ", grasp held", False: ", grasp did not hold"}[result.grasp_held]
     planners = " and ".join(INITIALISER_NAMES.get(p, p) for p in ran.initials)
     planners += f" planner with the {' and '.join(ran.low_levels)} low-level planner"
@@ -209,6 +224,7 @@ def _scenario(args):
         execution=args.execution,
         uncertainty=args.uncertainty,
         perception=args.perception,
+        world=args.world,
         workers=args.workers,
     )
     scenario = conditions.applied(base, scene=scene)

@@ -7,7 +7,7 @@ scenario file (None: the built-in default scenario) and, for an experiment on an
 tables (``--tables``), that robot. ``line()`` is the text a person reads; ``to_dict()`` the keys of
 ``run_scene``'s JSON and of the experiments' ``run.json`` and ``summary.json``: an axis with one
 value under its singular key (``robot``, ``planner``, ``initial``, ``low_level``, ``execution``,
-``model_error_seed``, ``perception_source``), several under the plural.
+``model_error_seed``, ``perception_source``, ``world``), several under the plural.
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ KEYS = {
     "executions": ("execution", "executions"),
     "model_errors": ("model_error_seed", "model_error_seeds"),
     "perceptions": ("perception_source", "perception_sources"),
+    "worlds": ("world", "worlds"),
 }
 """Each axis's JSON keys: (one value, several)."""
 WORDS = {
@@ -35,6 +36,7 @@ WORDS = {
     "executions": "execution",
     "model_errors": "model error",
     "perceptions": "perception",
+    "worlds": "world",
 }
 
 
@@ -47,7 +49,8 @@ def distinct(values: Iterable[Any]) -> tuple[Any, ...]:
 class Labels:
     """One run's values as rows name them: the robot's name, the initialiser, the low-level
     planner, their pair's name (``planner``: the paper's ``hlp``/``sto`` for the STO), the
-    execution mode, the perception source and the model error's seed (None: none)."""
+    execution mode, the perception source, the model error's seed (None: none) and the world the run
+    is judged in."""
 
     robot: str
     initial: str
@@ -56,6 +59,7 @@ class Labels:
     execution: str
     perception: str
     model_error: int | None
+    world: str = "reference"
 
 
 AXES = {
@@ -66,6 +70,7 @@ AXES = {
     "executions": "execution",
     "model_errors": "model_error",
     "perceptions": "perception",
+    "worlds": "world",
 }
 """Each axis of ``WhatRan`` and the ``Labels`` field it collects."""
 
@@ -81,6 +86,7 @@ class WhatRan:
     executions: tuple[str, ...]
     model_errors: tuple[int | None, ...]
     perceptions: tuple[str, ...]
+    worlds: tuple[str, ...] = ()
     scenario_file: str | None = None
     tables: str | None = None
     """The robot whose reach the generated tables were kept within, if not the run's own (None)."""
@@ -108,7 +114,9 @@ class WhatRan:
                 for v in getattr(self, axis)
             ]
             plural = (
-                "s" if len(values) > 1 and axis not in ("model_errors", "executions", "perceptions") else ""
+                "s"
+                if len(values) > 1 and axis not in ("model_errors", "executions", "perceptions", "worlds")
+                else ""
             )
             parts.append(f"{word}{plural} {' and '.join(map(str, values))}")
         parts.append(f"scenario {self.scenario_file or BUILT_IN_SCENARIO}")

@@ -2,13 +2,15 @@
 
 Columns (in this order): the paper's ``scene, objects, planner, success, failure_reason, init_s,
 optimise_s, total_s, rollouts, objects_moved, objects_dropped``, then ``seed, iterations,
-verifications, rejected, verify_s, passed_then_failed, replans, replan_rollouts, execute_s``, then
-the cell's axes ``generator, robot, initial, low_level, execution, perception, model_error``
+verifications, rejected, verify_s, model_success, false_accept, replans, replan_rollouts, execute_s``,
+then the cell's axes ``generator, robot, initial, low_level, execution, perception, model_error,
+world``
 (``planner`` names the initialiser and low-level planner pair: the paper's ``hlp`` and ``sto`` for
 the STO; ``rollouts`` counts the low-level planner's rollouts, ``verifications`` its checks on the
 execution model, of which ``rejected`` failed there, ``verify_s`` the seconds they took, part of
-``optimise_s``; ``passed_then_failed``: the low-level planner accepted a motion and the execution
-failed; ``replans`` and ``replan_rollouts``: the closed-loop controller's; ``model_error``: the
+``optimise_s``; ``success`` is the verdict of the ``world`` the motion was executed in (``reference``
+or the planner's own ``model``), ``model_success`` the low-level planner's own (it accepted a motion),
+``false_accept`` the model accepted and the world failed; ``replans`` and ``replan_rollouts``: the closed-loop controller's; ``model_error``: the
 seed of the world's model error, empty for none). Times are seconds; ``init_s`` = plan + IK,
 ``total_s`` = init + low-level planning (the simulated execution, ``execute_s``, is excluded);
 ``objects_moved`` and ``objects_dropped`` are counts. Booleans are ``true``/``false``; a missing
@@ -30,7 +32,16 @@ from hlp_drake.experiments.runner import Row
 from hlp_drake.files.atomic import atomic_path
 from hlp_drake.files.documents import read_bytes
 
-AXIS_COLUMNS = ("generator", "robot", "initial", "low_level", "execution", "perception", "model_error")
+AXIS_COLUMNS = (
+    "generator",
+    "robot",
+    "initial",
+    "low_level",
+    "execution",
+    "perception",
+    "model_error",
+    "world",
+)
 """The grid's axes, as rows name them."""
 COLUMNS = (
     "scene",
@@ -49,17 +60,28 @@ COLUMNS = (
     "verifications",
     "rejected",
     "verify_s",
-    "passed_then_failed",
+    "model_success",
+    "false_accept",
     "replans",
     "replan_rollouts",
     "execute_s",
     *AXIS_COLUMNS,
 )
-KEY_COLUMNS = ("scene", "objects", "robot", "initial", "low_level", "execution", "perception", "model_error")
+KEY_COLUMNS = (
+    "scene",
+    "objects",
+    "robot",
+    "initial",
+    "low_level",
+    "execution",
+    "perception",
+    "model_error",
+    "world",
+)
 """A row's identity (``row_key``)."""
-CELL_COLUMNS = ("robot", "initial", "low_level", "planner", "execution", "perception", "model_error")
+CELL_COLUMNS = ("robot", "initial", "low_level", "planner", "execution", "perception", "model_error", "world")
 """A row's cell of the grid, as ``hlp_drake.config.what_ran.Labels`` names it."""
-BOOL_COLUMNS = frozenset({"success", "passed_then_failed"})
+BOOL_COLUMNS = frozenset({"success", "model_success", "false_accept"})
 FLOAT_COLUMNS = frozenset({"init_s", "optimise_s", "total_s", "verify_s", "execute_s"})
 TEXT_COLUMNS = frozenset({"scene", "planner", "failure_reason", *AXIS_COLUMNS} - {"model_error"})
 INT_COLUMNS = frozenset(COLUMNS) - BOOL_COLUMNS - FLOAT_COLUMNS - TEXT_COLUMNS - {"model_error"}

@@ -68,6 +68,7 @@ class Job:
             labels.execution,
             labels.perception,
             labels.model_error,
+            labels.world,
         )
 
     def make_scene(self) -> Scene:
@@ -153,7 +154,7 @@ def make_row(
     verifications: int = 0,
     rejected: int = 0,
     verify_s: float = 0.0,
-    passed_then_failed: bool = False,
+    model_success: bool = False,
     replans: int = 0,
     replan_rollouts: int = 0,
 ) -> Row:
@@ -178,7 +179,8 @@ def make_row(
         "verifications": int(verifications),
         "rejected": int(rejected),
         "verify_s": verify_s,
-        "passed_then_failed": bool(passed_then_failed),
+        "model_success": bool(model_success),
+        "false_accept": bool(model_success) and not success,
         "replans": int(replans),
         "replan_rollouts": int(replan_rollouts),
         "execute_s": execute_s,
@@ -189,6 +191,7 @@ def make_row(
         "execution": labels.execution,
         "perception": labels.perception,
         "model_error": labels.model_error,
+        "world": labels.world,
     }
 
 

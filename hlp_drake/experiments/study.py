@@ -1,8 +1,8 @@
 """``Study``: an experiment as data, a grid of conditions each run on the same seeded scenes.
 
 A study names its scene generators and object counts, how many scenes and from which seed, and the
-axes of its grid: robots, initialisers, low-level planners, execution modes, perception sources and
-model-error seeds. An axis left empty is the scenario's own setting (one cell). Every (scene, cell)
+axes of its grid: robots, initialisers, low-level planners, execution modes, perception sources,
+model-error seeds and the worlds the runs are judged in. An axis left empty is the scenario's own setting (one cell). Every (scene, cell)
 is one job, one row of ``results.csv``; the summary, the plots and resuming work on any grid. The
 paper's Tables II and III are the bundled studies ``gen1`` and ``gen2`` (``studies/*.yaml``)::
 
@@ -31,7 +31,7 @@ STUDIES = Path(__file__).resolve().parent / "studies"
 MAX_SCENES = 100_000
 FIXED_COUNT_KINDS = ("vr", "gen1")
 """Generators whose scenes always have the same number of obstacles (``objects`` does not apply)."""
-AXES = ("robots", "initialisers", "low_level", "execution", "perception", "model_error")
+AXES = ("robots", "initialisers", "low_level", "execution", "perception", "model_error", "world")
 """The grid's axes, in the order of a cell's fields."""
 
 
@@ -45,6 +45,7 @@ class Cell:
     execution: str | None = None
     perception: str | None = None
     model_error: int | None = None
+    world: str | None = None
 
 
 @dataclass(frozen=True)
@@ -66,6 +67,8 @@ class Study:
         perception: ``truth``, ``camera`` ([]: the scenario's).
         model_error: seeds of the model error the world has and the planners do not know of ([]:
             the scenario's).
+        world: what the robot acts in and the runs are judged in: ``reference``, ``model`` ([]: the
+            scenario's, reference).
         tables: generate the tables within this robot's reach instead of each robot's own (a name
             or a description file; "": each robot's own): the same scenes for every robot.
     """
@@ -82,12 +85,13 @@ class Study:
     execution: tuple[str, ...] = ()
     perception: tuple[str, ...] = ()
     model_error: tuple[int, ...] = ()
+    world: tuple[str, ...] = ()
     tables: str = ""
 
     def problems(self, where: str = "") -> list[str]:
         """What cannot run, one line each (the names are checked against their registries)."""
         from hlp_drake.systems.low_level.registry import LOW_LEVEL_PLANNERS
-        from hlp_drake.systems.names import EXECUTIONS, PERCEPTION_SOURCES
+        from hlp_drake.systems.names import EXECUTIONS, PERCEPTION_SOURCES, WORLDS
         from hlp_drake.systems.planning.initialisers import ALIASES, INITIALISERS
 
         prefix = f"{where}." if where else ""
@@ -97,6 +101,7 @@ class Study:
             "low_level": tuple(LOW_LEVEL_PLANNERS),
             "execution": EXECUTIONS,
             "perception": PERCEPTION_SOURCES,
+            "world": WORLDS,
         }
         problems = [
             f"{prefix}{axis}: unknown {value!r} (known: {', '.join(names)})"

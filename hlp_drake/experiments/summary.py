@@ -29,7 +29,7 @@ PLANNER_LABELS = {"hlp": "HLP", "sto": "STO (straight line)"}
 """The paper's planners as the tables name them."""
 TIMES = ("init_s", "optimise_s", "total_s")
 TIME_LABELS = {"init_s": "init", "optimise_s": "optimisation", "total_s": "total"}
-CELL = ("robot", "initial", "low_level", "execution", "perception", "model_error")
+CELL = ("robot", "initial", "low_level", "execution", "perception", "model_error", "world")
 """The columns of a row's cell (a series)."""
 
 
@@ -77,7 +77,8 @@ def planner_stats(rows: list[Row], paper: PaperFigures) -> dict[str, Any]:
     }
     stats.update({column: _mean(row[column] for row in rows) for column in (*TIMES, "verify_s", "execute_s")})
     stats["rollouts_mean"] = _mean(row.get("rollouts", 0) for row in rows)
-    stats["passed_then_failed"] = sum(bool(row.get("passed_then_failed")) for row in rows)
+    stats["model_accepts"] = sum(bool(row.get("model_success")) for row in rows)
+    stats["false_accepts"] = sum(bool(row.get("false_accept")) for row in rows)
     stats["paper"] = asdict(paper)
     return stats
 
@@ -215,15 +216,17 @@ def summary_markdown(summary: dict[str, Any]) -> str:
         ]
     lines += [
         "",
-        "| condition | planner | rollouts (mean) | verification s (mean) | rollout passed, execution failed |",
-        "|---|---|---:|---:|---:|",
+        "| condition | planner | world | rollouts (mean) | verification s (mean) | model accepted "
+        + "| false accepts (model accepted, world failed) |",
+        "|---|---|---|---:|---:|---:|---:|",
     ]
     for condition in summary["conditions"]:
         for series in condition["series"]:
             stats = series["stats"]
             lines.append(
-                f"| {condition['condition']} | {series['label']} | {_number(stats['rollouts_mean'], 1)} | "
-                f"{_number(stats['verify_s'])} | {stats['passed_then_failed']} of {stats['n']} |"
+                f"| {condition['condition']} | {series['label']} | {series['cell']['world']} | "
+                f"{_number(stats['rollouts_mean'], 1)} | {_number(stats['verify_s'])} | "
+                f"{stats['model_accepts']} of {stats['n']} | {stats['false_accepts']} of {stats['model_accepts']} |"
             )
     lines += ["", "Notes:", ""] + [f"- {note}" for note in summary["notes"]]
     return "\n".join(lines) + "\n"

@@ -30,6 +30,7 @@ class Conditions:
         execution: "open" (play the planned motion) or "closed" (the receding-horizon controller).
         uncertainty: the seed of the model error the world has and the planners do not know of.
         perception: "truth" (the plant's poses) or "camera" (the cameras' perception).
+        world: what the robot acts in and the run is judged in: "reference" or "model" (``WorldConfig``).
         workers: rollout processes of a low-level planner that rolls out (others ignore it).
     """
 
@@ -39,6 +40,7 @@ class Conditions:
     execution: str | None = None
     uncertainty: int | None = None
     perception: str | None = None
+    world: str | None = None
     workers: int | None = None
 
     def applied(self, scenario: Scenario, *, scene: Scene | None = None) -> Scenario:
@@ -60,6 +62,8 @@ class Conditions:
             changes["uncertainty"] = replace(scenario.uncertainty, enabled=True, seed=int(self.uncertainty))
         if self.perception is not None:
             changes["perception"] = replace(scenario.perception, source=self.perception)
+        if self.world is not None and self.world != scenario.world.kind:
+            changes["world"] = replace(scenario.world, kind=self.world)
         return replace(scenario, **changes) if changes else scenario  # checked as it is made
 
     def _planner(self, scenario: Scenario):

@@ -21,7 +21,8 @@ whole)::
       initial: hlp                  # hlp (human-like) or line (the straight line; sto: its alias)
       low_level: {kind: sto, samples: 8, max_iterations: 20}   # the STO's settings
     robot: {name: panda, ...}       # the robot (RobotDescription; --robot NAME reads a shipped one)
-    plant: {time_step: 0.01}        # Drake's MultibodyPlantConfig
+    plant: {time_step: 0.01}        # Drake's MultibodyPlantConfig: the planner's model
+    world: reference                # what the robot acts in and is judged in (or model)
     controller: {arm: {kp: 2000.0, kd: 150.0}}
 
 The former spellings ``planner: {kind: ...}`` and ``optimiser: {...}`` are read as
@@ -55,6 +56,7 @@ from hlp_drake.systems.low_level.sto.config import StoConfig
 from hlp_drake.systems.perception.cameras import MAX_CAMERAS, PerceptionConfig, camera_pose
 from hlp_drake.systems.planning.config import DEFAULT_ALTERNATIVES, IkConfig, MotionConfig
 from hlp_drake.systems.planning.initialisers import ALIASES, INITIALISERS
+from hlp_drake.systems.world.judge import WorldConfig, world_section
 from hlp_drake.systems.world.model import WorldModel
 from hlp_drake.systems.world.robot_description import (
     MOBILE_UR5,
@@ -136,6 +138,8 @@ class Scenario(Documented):
         closed_loop: the receding-horizon controller of ``--execution closed`` (a low-level planner
             that re-plans, the STO).
         uncertainty: the seeded model error of ``--uncertainty`` (``model_error``).
+        world: what the robot acts in and the run is judged in (``WorldConfig``; ``--world``):
+            ``reference`` (finer physics than the planner's model) or ``model`` (the planner's own).
     """
 
     scene: Scene = field(default_factory=default_scene)
@@ -153,6 +157,7 @@ class Scenario(Documented):
     perception: PerceptionConfig = field(default_factory=PerceptionConfig)
     closed_loop: ClosedLoopConfig = field(default_factory=ClosedLoopConfig)
     uncertainty: UncertaintyConfig = field(default_factory=UncertaintyConfig)
+    world: WorldConfig = field(default_factory=WorldConfig)
 
     def __post_init__(self) -> None:
         """Refuse settings that cannot be used (the scene is checked on its own, ``validate_scene``).
@@ -192,9 +197,15 @@ class Scenario(Documented):
 
     @cached_property
     def world_model(self) -> WorldModel:
-        """What its world is made of besides the scene: the robot, plant, contact, bodies, controller
-        and start pose (``ik``) sections (computed once)."""
+        """The planner's model of the world besides the scene: the robot, plant, contact, bodies,
+        controller and start pose (``ik``) sections (computed once)."""
         return WorldModel(self.robot, self.plant, self.contact, self.bodies, self.controller, self.ik)
+
+    @cached_property
+    def executed_model(self) -> WorldModel:
+        """What the robot acts in: ``world_model`` with the ``world`` section's physics (itself with
+        ``world: model``)."""
+        return self.world.of(self.world_model)
 
     @property
     def low_level(self) -> LowLevelConfig:
@@ -232,6 +243,8 @@ def legacy(document: Any, where: str) -> Any:
     Raises:
         HlpError: a setting given in both spellings (one line, naming ``where``).
     """
+    if isinstance(document, dict) and "world" in document:
+        document = {**document, "world": world_section(document["world"])}
     if not isinstance(document, dict) or not isinstance(document.get("planner", {}), dict):
         return document  # the typed check says what is wrong
     document, planner = dict(document), dict(document.get("planner") or {})

@@ -63,7 +63,7 @@ def test_run_scene_with_a_camera_that_sees_no_table_fails_with_the_reason(tmp_pa
     result = run_module("hlp_drake.run_scene", *args)
     assert result.returncode == 1 and "Traceback" not in result.stderr
     reason = "perception failed: no table plane found (too few pixels with a depth)"
-    assert f"verdict: reach failure: {reason} (exit status 1); grasp not attempted" in result.stdout
+    assert f"verdict: reach failure in the reference world: {reason} (exit status 1)" in result.stdout
     report = json.loads(out.read_text())
     assert report["failure_reason"] == reason and not report["success"]
     assert report["perception"]["ok"] is False and "Target" in report["perception"]["missed"]

@@ -64,20 +64,24 @@ def test_run_scene_end_to_end_json_and_html(tmp_path):
         "execution": "open",
         "model_error_seed": None,
         "perception_source": "truth",
+        "world": "reference",
         "scenario_file": None,
     }
     assert {key: report[key] for key in ran} == ran
     line = (
         f"robot {MOBILE_UR5.name}, initialiser hlp, low-level planner sto, execution open, model error none, "
     )
-    line += "perception truth, scenario built-in default"
+    line += "perception truth, world reference, scenario built-in default"
     assert f"run: {line}\n" in result.stdout and f"ran: {line}\n" in result.stdout
     verdicts = [v for v in result.stdout.splitlines() if v.startswith("verdict: ")]
     assert len(verdicts) == 1 and verdicts[0].startswith(
-        "verdict: reach success (the paper's criterion, exit status 0); grasp "
+        "verdict: reach success in the reference world (the paper's criterion, exit status 0); the planner's "
+        "model: accepted; grasp "
         if report["success"]
-        else "verdict: reach failure: "
+        else "verdict: reach failure in the reference world: "
     )
+    assert report["model_success"] is report["optimisation"]["success"]
+    assert report["false_accept"] == (report["model_success"] and not report["success"])
     assert set(report["timings"]) >= {"plan_s", "ik_s", "optimise_s", "total_s"}
     assert [k["action"] for k in report["plan"]["keypoints"]][:: len(report["plan"]["keypoints"]) - 1] == [
         "start",
@@ -109,9 +113,7 @@ def test_run_scene_closed_loop_with_uncertainty_end_to_end(tmp_path):
     loop = report["closed_loop"]
     assert loop["replans"] >= 1 and loop["replans"] <= loop["rollouts"] <= 3 * loop["replans"]
     assert "closed loop:" in result.stdout
-    assert report["rollout_passed_execution_failed"] == (
-        report["optimisation"]["success"] and not report["success"]
-    )
+    assert report["false_accept"] == (report["optimisation"]["success"] and not report["success"])
 
 
 def test_what_ran_names_the_robot_initialiser_low_level_planner_execution_model_error_perception_and_file():
@@ -119,16 +121,18 @@ def test_what_ran_names_the_robot_initialiser_low_level_planner_execution_model_
     from hlp_drake.systems.execution.result import what_ran
 
     plain = what_ran(Scenario())
-    assert plain == WhatRan((MOBILE_UR5.name,), ("hlp",), ("hlp",), ("sto",), ("open",), (None,), ("truth",))
+    assert plain == WhatRan(
+        (MOBILE_UR5.name,), ("hlp",), ("hlp",), ("sto",), ("open",), (None,), ("truth",), ("reference",)
+    )
     assert plain.line() == (
         f"robot {MOBILE_UR5.name}, initialiser hlp, low-level planner sto, execution open, model error none, "
-        "perception truth, scenario built-in default"
+        "perception truth, world reference, scenario built-in default"
     )
     conditions = Conditions(initial="line", execution="closed", uncertainty=3, perception="camera")
     ran = what_ran(conditions.applied(Scenario()), "my.yaml")
     assert ran.line() == (
         f"robot {MOBILE_UR5.name}, initialiser line, low-level planner sto, execution closed, model error seed 3, "
-        "perception camera, scenario my.yaml"
+        "perception camera, world reference, scenario my.yaml"
     )
     assert ran.to_dict() == {
         "robot": MOBILE_UR5.name,
@@ -138,6 +142,7 @@ def test_what_ran_names_the_robot_initialiser_low_level_planner_execution_model_
         "execution": "closed",
         "model_error_seed": 3,
         "perception_source": "camera",
+        "world": "reference",
         "scenario_file": "my.yaml",
     }
     assert WhatRan.from_dict(ran.to_dict()) == ran and WhatRan.from_dict({"planner": "hlp"}) is None
@@ -149,15 +154,33 @@ def test_what_ran_names_the_robot_initialiser_low_level_planner_execution_model_
     assert WhatRan.from_dict(record) == both
 
 
+SUCCESS = "verdict: reach success in the reference world (the paper's criterion, exit status 0)"
+
+
 @pytest.mark.parametrize(
-    ("success", "grasp_held", "status", "line"),
+    ("success", "model", "grasp_held", "status", "line"),
     [
-        (True, True, 0, "verdict: reach success (the paper's criterion, exit status 0); grasp held"),
-        (True, False, 0, "verdict: reach success (the paper's criterion, exit status 0); grasp did not hold"),
-        (False, None, 1, "verdict: reach failure: in execution: x (exit status 1); grasp not attempted"),
+        (True, True, True, 0, f"{SUCCESS}; the planner's model: accepted; grasp held"),
+        (True, True, False, 0, f"{SUCCESS}; the planner's model: accepted; grasp did not hold"),
+        (
+            False,
+            True,
+            None,
+            1,
+            "verdict: reach failure in the reference world: x (exit status 1); the planner's model: accepted: "
+            "a false accept; grasp not attempted",
+        ),
+        (
+            False,
+            False,
+            None,
+            1,
+            "verdict: reach failure in the reference world: x (exit status 1); the planner's model: not "
+            "accepted; grasp not attempted",
+        ),
     ],
 )
-def test_the_exit_status_follows_the_reach_whatever_the_grasp(success, grasp_held, status, line):
+def test_the_exit_status_follows_the_reach_whatever_the_grasp(success, model, grasp_held, status, line):
     from types import SimpleNamespace
 
     from hlp_drake.commands.run_scene import exit_status, verdict
@@ -166,7 +189,10 @@ def test_the_exit_status_follows_the_reach_whatever_the_grasp(success, grasp_hel
         success=success,
         grasp_held=grasp_held,
         grasp_failure=None,
-        failure_reason=None if success else "in execution: x",
+        failure_reason=None if success else "x",
+        world="reference",
+        model_success=model,
+        false_accept=model and not success,
     )
     assert exit_status(result) == status
     assert verdict(result) == f"{line} (reported, not part of success)"
@@ -322,7 +348,7 @@ def test_a_failed_closed_loop_execution_still_reports_what_the_controller_did(tm
     result = run_module("hlp_drake.run_scene", *args, "--execution", "closed", "--json", str(out))
     assert result.returncode == 1 and "Traceback" not in result.stderr, result.stderr
     report = json.loads(out.read_text())
-    assert not report["success"] and report["failure_reason"].startswith("in execution")
+    assert not report["success"] and "pre-grasp region" in report["failure_reason"]  # the world's verdict
     loop = report["closed_loop"]
     # one rollout per re-optimisation, and one more for the remainder where it re-planned the scene
     assert (

@@ -68,7 +68,7 @@ def interrupt_on_gen1_11_hlp(job: Job) -> dict:
 def test_csv_has_the_columns_one_row_per_scene_and_planner_sorted(tmp_path):
     summary = run_experiment(settings("gen2", scenes=2, objects=(4, 3)), tmp_path, job=cheap_job)
     rows = assert_well_formed(tmp_path / "results.csv")
-    assert list(rows[0])[: len(REQUIRED_COLUMNS)] == REQUIRED_COLUMNS and list(rows[0])[-1] == "model_error"
+    assert list(rows[0])[: len(REQUIRED_COLUMNS)] == REQUIRED_COLUMNS and list(rows[0])[-1] == "world"
     assert {(r["generator"], r["robot"], r["initial"], r["low_level"]) for r in rows} == {
         ("gen2", MOBILE_UR5.name, "hlp", "sto"),
         ("gen2", MOBILE_UR5.name, "line", "sto"),

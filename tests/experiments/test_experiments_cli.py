@@ -290,6 +290,7 @@ def test_run_json_and_the_summary_say_what_ran(tmp_path, capsys):
         "execution": "closed",
         "model_error_seed": 4,
         "perception_source": "truth",
+        "world": "reference",
         "scenario_file": str(config),
     }
     run = json.loads((out / "run.json").read_text())
@@ -297,7 +298,7 @@ def test_run_json_and_the_summary_say_what_ran(tmp_path, capsys):
     assert {key: run[key] for key in ran} == ran == {key: summary[key] for key in ran}
     line = (
         f"Ran: robot {MOBILE_UR5.name}, initialisers hlp and line, low-level planner sto, execution closed, "
-        f"model error seed 4, perception truth, scenario {config}."
+        f"model error seed 4, perception truth, world reference, scenario {config}."
     )
     assert line in (out / "summary.md").read_text() and line in printed
     # Without a scenario file: the built-in default (null in the JSON).
@@ -306,7 +307,7 @@ def test_run_json_and_the_summary_say_what_ran(tmp_path, capsys):
         ["gen1", "--scenes", "1", "--workers", "1", "--quiet", "--out", str(tmp_path / "b")],
     )
     assert json.loads((tmp_path / "b" / "summary.json").read_text())["scenario_file"] is None
-    assert "model error none, perception truth, scenario built-in default." in capsys.readouterr().out
+    assert "model error none, perception truth, world reference, scenario built-in default." in capsys.readouterr().out
 
 
 @pytest.mark.slow

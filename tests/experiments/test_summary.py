@@ -79,6 +79,7 @@ def _row(i: int, planner: str, initial: str, **changes) -> dict:
         "execution": "open",
         "perception": "truth",
         "model_error": None,
+        "world": "reference",
     }
     return {**row, **changes}
 

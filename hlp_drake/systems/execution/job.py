@@ -38,6 +38,7 @@ def conditions(cell: Cell, *, workers: int | None = None) -> Conditions:
         execution=cell.execution,
         uncertainty=cell.model_error,
         perception=cell.perception,
+        world=cell.world,
         workers=workers,
     )
 
@@ -113,7 +114,7 @@ def run_job(job: Job) -> Row:
         verifications=low_level.get("verifications", 0),
         rejected=low_level.get("rejected", 0),
         verify_s=low_level.get("verify_s", 0.0),
-        passed_then_failed=result.rollout_passed_execution_failed,
+        model_success=bool(result.model_success),
         replans=result.closed_loop.get("replans", 0),
         replan_rollouts=result.closed_loop.get("rollouts", 0),
     )

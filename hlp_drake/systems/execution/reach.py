@@ -15,10 +15,10 @@ from pydrake.systems.framework import EventStatus
 
 from hlp_drake.systems.execution.command import advance_through_reach, grasp_and_lift
 from hlp_drake.systems.execution.meshcat_view import highlight_pushes, push_times
-from hlp_drake.systems.world.scene_models import fallen_objects, object_planar_poses
+from hlp_drake.systems.world.scene_models import fallen_objects, object_poses
 from hlp_drake.systems.world.simulation import simulation_failure
 from hlp_drake.systems.world.start_pose import tcp_keypoint_height
-from hlp_drake.systems.world.success import pregrasp_check, reach_problem
+from hlp_drake.systems.world.success import ReachEnd
 from hlp_drake.systems.world.world import world_plant
 
 if TYPE_CHECKING:
@@ -63,14 +63,16 @@ def execute_reach(
 
     simulator.set_monitor(monitor)
     names = [o.name for o in result.scene.objects]
-    before = object_planar_poses(plant, plant_context, names)
+    before = _centres(plant, plant_context, names)
     if meshcat is not None:
         meshcat.StartRecording(frames_per_second=RECORDING_FPS)
     try:
         settled = _reach(result, simulator, command, settle_s, listener, reached)
+        if not np.all(np.isfinite(plant.GetPositionsAndVelocities(plant_context))):
+            raise RuntimeError(f"the state is not finite at t = {settled:.2f} s")
         result.objects_dropped = fallen_objects(plant, plant_context, result.scene)
         tcp = tcp_frame.CalcPoseInWorld(plant_context).translation()
-        problem = _judge(result, scenario, before, object_planar_poses(plant, plant_context, names), tcp)
+        problem = _judge(result, scenario, before, _centres(plant, plant_context, names), tcp)
         if problem is None:
             try:
                 result.grasp_held = grasp_and_lift(
@@ -83,7 +85,7 @@ def execute_reach(
     except (RuntimeError, SystemExit) as error:
         failure = simulation_failure(error)
         if result.failure_reason is None:
-            result.failure_reason = f"simulation failed: {failure}"
+            result.failure_reason = f"the world's simulation diverged: {failure}"
     finally:
         simulator.clear_monitor()
         result.simulated_s = float(simulator.get_context().get_time())
@@ -110,27 +112,25 @@ def _reach(result, simulator, command, settle_s: float, listener, reached: Final
     return advance_through_reach(simulator, command, settle_s=settle_s)
 
 
-def _judge(result, scenario: Scenario, before: dict, after: dict, tcp: np.ndarray) -> str | None:
+def _centres(plant, context, names: list[str]) -> np.ndarray:
+    """(m, 3) the objects' centres, in the order of ``names``."""
+    poses = object_poses(plant, context, names)
+    return np.array([poses[name].translation() for name in names])
+
+
+def _judge(result, scenario: Scenario, before: np.ndarray, after: np.ndarray, tcp: np.ndarray) -> str | None:
     """The objects moved and the success test at the reach's end (``before`` and ``after``: the
-    objects' planar poses; ``result.objects_dropped`` read already); fills ``result``, returns the
-    failure (None: success)."""
+    objects' centres, scene order; ``result.objects_dropped`` read already); fills ``result``,
+    returns the failure (None: success)."""
     scene = result.scene
-    result.objects_moved = [
-        name
-        for name in before
-        if name != scene.target.name
-        and np.hypot(*np.subtract(after[name][:2], before[name][:2])) > MOVED_TOLERANCE
-    ]
-    inside, result.target_distance = pregrasp_check(
-        tcp,
-        after[scene.target.name],
-        scene,
-        tcp_height=tcp_keypoint_height(scene, scenario.ik),
-        margin=scenario.success.pregrasp_margin,
-    )
-    problem = reach_problem(result.objects_dropped, inside, result.target_distance)
+    names = [o.name for o in scene.objects]
+    shifted = np.hypot(*(after[:, :2] - before[:, :2]).T)
+    result.objects_moved = [n for n, d in zip(names[1:], shifted[1:]) if d > MOVED_TOLERANCE]
+    end = ReachEnd(tcp, before, after, result.objects_dropped, tcp_keypoint_height(scene, scenario.ik))
+    result.target_distance = end.distance()
+    problem = end.problem(scene, scenario.success)
     if problem is not None and result.failure_reason is None:
-        result.failure_reason = f"in execution: {problem}"
+        result.failure_reason = problem  # the world's verdict (the world is named beside it)
     return problem
 
 

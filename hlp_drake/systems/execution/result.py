@@ -30,6 +30,7 @@ def labels_of(scenario: Scenario) -> Labels:
         execution="closed" if scenario.closed_loop.enabled else "open",
         perception=scenario.perception.source,
         model_error=scenario.uncertainty.seed if scenario.uncertainty.enabled else None,
+        world=scenario.world.kind,
     )
 
 
@@ -49,7 +50,9 @@ class ExecutionResult:
     object's name the true object's it was matched to, None if none; ``actuated_dofs``: the robot's
     actuated joints, base, arm and gripper).
 
-    ``success`` is the paper's reach success (see ``plan_and_execute``); ``grasp_held`` is reported
+    ``success`` is the paper's reach success in the ``world`` the motion was executed in
+    (``reference`` or the planner's own ``model``), ``model_success`` the low-level planner's verdict
+    in its own model (it accepted a motion; None: it did not run); ``grasp_held`` is reported
     beside it and is not part of it (``grasp_failure``: why the grasp's simulation stopped, if it
     failed; the reach's verdict stands).
     """
@@ -79,11 +82,13 @@ class ExecutionResult:
     actuated_dofs: int = 0
     initial: str = "hlp"
     low_level: str = "sto"
+    world: str = "reference"
+    model_success: bool | None = None
 
     @property
-    def rollout_passed_execution_failed(self) -> bool:
-        """The optimiser accepted a sequence (its rollout passed), and the execution failed."""
-        return bool(self.optimisation.get("success")) and not self.success
+    def false_accept(self) -> bool:
+        """The low-level planner accepted the motion in its model, and the world failed it."""
+        return bool(self.model_success) and not self.success
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -91,7 +96,10 @@ class ExecutionResult:
             "initial": self.initial,
             "low_level": self.low_level,
             "scene": self.scene.name,
+            "world": self.world,
             "success": self.success,
+            "model_success": self.model_success,
+            "false_accept": self.false_accept,
             "failure_reason": self.failure_reason,
             "plan": named_plan(self.plan.to_dict(), self.true_names),
             "ik": {
@@ -116,7 +124,6 @@ class ExecutionResult:
             "execution": self.execution,
             "closed_loop": self.closed_loop,
             "reach_reused": self.reach_reused,
-            "rollout_passed_execution_failed": self.rollout_passed_execution_failed,
         }
 
 

@@ -142,7 +142,7 @@ def run_execution(
         and meshcat is None
         and result.failure_reason is None
     ):
-        key = world_key(scenario.scene, scenario.world_model, scenario.success.settle_s)
+        key = world_key(scenario.scene, scenario.executed_model, scenario.success.settle_s)
         reached = verified_reach(optimisation, key)
     result.reach_reused = reached is not None
     executing = handles.execution == "open" or result.failure_reason is None  # closed: an optimised sequence
@@ -188,7 +188,7 @@ def _plan(handles, scenario, simulator, listener, started, perception, perceive_
     result = ExecutionResult(
         labels.planner, scenario.scene, plan, keyframes, robot_plan, execution=handles.execution
     )
-    result.initial, result.low_level = labels.initial, labels.low_level
+    result.initial, result.low_level, result.world = labels.initial, labels.low_level, labels.world
     result.actuated_dofs = len(scenario.robot.actuated_joints)
     result.timings = {"plan_s": plan_s, "ik_s": solved - planned, "optimise_s": 0.0}
     result.true_names = names
@@ -214,6 +214,7 @@ def _low_level(handles, simulator, listener, result, trajectory):
     optimisation: LowLevelResult = handles.planning.GetOutputPort("optimisation").Eval(context)
     listener.optimised(optimisation)
     result.iterations, result.rollouts = optimisation.iterations, optimisation.rollouts
+    result.model_success = optimisation.success
     result.optimisation = optimisation.to_dict()
     result.timings["optimise_s"] = optimisation.optimise_s
     if not optimisation.success and handles.execution == "open":  # closed: the controller may rescue it

@@ -1,10 +1,13 @@
 """The paper's success test of a reach, shared by the planners that simulate and by the execution:
-the target in the gripper's pre-grasp region and no object off the table, read ``settle_s`` after
-the motion ends (``SuccessConfig``, a ``Scenario``'s ``success``)."""
+the target in the gripper's pre-grasp region, no object off the table and none lifted off it (on
+the gripper or on another object), read ``settle_s`` after the motion ends (``SuccessConfig``, a
+``Scenario``'s ``success``). ``reach_problem`` names the real cause of a failure: an object that
+fell, an object lifted, the tcp too far from the target or off grasp height.
+"""
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Annotated
 
@@ -24,10 +27,13 @@ class SuccessConfig:
         settle_s: simulated time after the motion ends before the final state is read, s, in a
             rollout and in the execution alike (a rollout's end is where the execution of the same
             motion ends).
+        max_lift: an object whose centre ends higher than it started by more than this is lifted
+            off the table (resting on the gripper or on another object), m.
     """
 
     pregrasp_margin: NonNegativeFloat = 0.03
     settle_s: Annotated[float, Positive(upper=MAX_DURATION, zero_ok=True)] = 1.0
+    max_lift: NonNegativeFloat = 0.02
 
 
 def half_extent(size: tuple[float, float, float]) -> float:
@@ -35,25 +41,60 @@ def half_extent(size: tuple[float, float, float]) -> float:
     return 0.5 * max(size[0], size[1])
 
 
-def pregrasp_check(
-    tcp: np.ndarray, target_position: np.ndarray, scene: Scene, *, tcp_height: float, margin: float
-) -> tuple[bool, float]:
-    """Whether the target (centre at ``target_position``) is inside the gripper's pre-grasp region at
-    tcp position ``tcp``: horizontally within the target's radius + ``margin``, and the tcp within
-    ``margin`` of the grasp height. Also returns the horizontal distance."""
-    distance = float(np.hypot(*(np.asarray(tcp)[:2] - np.asarray(target_position)[:2])))
-    inside = distance <= half_extent(scene.target.size) + margin and abs(tcp[2] - tcp_height) <= margin
-    return inside, distance
+@dataclass(frozen=True)
+class ReachEnd:
+    """Where a reach ended, as the success test reads it (object arrays in scene order, the target
+    first).
+
+    Attributes:
+        tcp: (3,) the tcp's position.
+        start, end: (m, 3) the objects' centres before and after.
+        fallen: the objects off the table at the end.
+        tcp_height: the grasp height of the tcp, m.
+    """
+
+    tcp: np.ndarray
+    start: np.ndarray
+    end: np.ndarray
+    fallen: Sequence[str]
+    tcp_height: float
+
+    def distance(self) -> float:
+        """The tcp's horizontal distance from the target's centre, m."""
+        return float(np.hypot(*(np.asarray(self.tcp)[:2] - np.asarray(self.end)[0, :2])))
+
+    def problem(self, scene: Scene, success: SuccessConfig, *, shrink: float = 0.0) -> str | None:
+        """Why the reach failed the success test (None: it passed), the pre-grasp region shrunk by
+        ``shrink`` m horizontally and vertically (a planner's acceptance margin)."""
+        if self.fallen:
+            return f"objects fell off the table: {', '.join(self.fallen)}"
+        names = [o.name for o in scene.objects]
+        rise = np.asarray(self.end)[:, 2] - np.asarray(self.start)[:, 2]
+        lifted = [(n, r) for n, r in zip(names, rise) if r > success.max_lift]
+        if lifted:
+            what = ", ".join(f"{n} by {r:.3f} m" for n, r in lifted)
+            return f"lifted off the table (on the gripper or another object): {what}"
+        return self.region_problem(scene, success, shrink=shrink)
+
+    def region_problem(self, scene: Scene, success: SuccessConfig, *, shrink: float = 0.0) -> str | None:
+        """Why the target is not in the gripper's pre-grasp region (None: it is), the region shrunk
+        by ``shrink`` m."""
+        radius = half_extent(scene.target.size) + success.pregrasp_margin - shrink
+        distance = self.distance()
+        if distance > radius:
+            return (
+                f"the target is not in the gripper's pre-grasp region: the tcp ends {distance:.3f} m from "
+                f"its centre (within {radius:.3f} m passes)"
+            )
+        above = float(self.tcp[2] - self.tcp_height)
+        allowed = success.pregrasp_margin - shrink
+        if abs(above) > allowed:
+            side = "above" if above > 0 else "below"
+            return (
+                f"the target is not in the gripper's pre-grasp region: the tcp ends {abs(above):.3f} m "
+                f"{side} grasp height (within {allowed:.3f} m passes)"
+            )
+        return None
 
 
-def reach_problem(fallen: Iterable[str], inside: bool, distance: float) -> str | None:
-    """Why a reach failed the success test (None if it passed)."""
-    fallen = list(fallen)
-    if fallen:
-        return f"objects fell off the table: {', '.join(fallen)}"
-    if not inside:
-        return f"the target is not in the gripper's pre-grasp region (tcp {distance:.3f} m away)"
-    return None
-
-
-__all__ = ["SuccessConfig", "half_extent", "pregrasp_check", "reach_problem"]
+__all__ = ["ReachEnd", "SuccessConfig", "half_extent"]

@@ -202,7 +202,8 @@ def make_world_diagram(
     cameras: bool | None = None,
     model_error: WorldPerturbation | None = None,
 ) -> Diagram:
-    """The world of ``scenario``: ``world_diagram`` of its scene and its ``world_model``.
+    """The world of ``scenario``: ``world_diagram`` of its scene in what the robot acts in
+    (``executed_model``: the ``world`` section's physics over the planner's model).
 
     Args:
         cameras: add the scenario's cameras (``perception.cameras``; their ports: see
@@ -213,7 +214,7 @@ def make_world_diagram(
     watching = cameras or (cameras is None and scenario.perception.source == "camera")
     return world_diagram(
         scenario.scene,
-        scenario.world_model,
+        scenario.executed_model,
         cameras=scenario.perception.cameras if watching else (),
         meshcat=meshcat,
         contact_forces=contact_forces,

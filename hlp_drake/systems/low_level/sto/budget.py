@@ -4,6 +4,7 @@ the displaced worlds)."""
 
 from __future__ import annotations
 
+import copy
 import time
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
@@ -86,6 +87,20 @@ class BudgetedRun:
         self.rollouts = self.verifications = self.rejected = 0
         self.verify_s = 0.0
         self._displaced: list[RolloutSpec] | None = None
+        self._checks: list[RolloutSpec] | None = None
+
+    def check_specs(self) -> list[RolloutSpec]:
+        """The spec on the finer check model (``sto.check_step``; none when it is 0 or from a
+        measured start), then its displaced copies."""
+        if self._checks is None:
+            step = self.spec.sto.check_step
+            fine = []
+            if step > 0 and self.start is None:
+                plant = copy.copy(self.spec.model.plant)  # Drake's MultibodyPlantConfig
+                plant.time_step = step
+                fine = [replace(self.spec, model=replace(self.spec.model, plant=plant))]
+            self._checks = fine + self.displaced_specs()
+        return self._checks
 
     def displaced_specs(self) -> list[RolloutSpec]:
         """The spec with its objects displaced, ``budget.displaced_checks`` times (none from a
@@ -111,7 +126,8 @@ class BudgetedRun:
         if not self.budget.verify:
             return
         on_model = not self.spec.sto.reduced_model
-        displaced = self.displaced_specs()
+        displaced = self.check_specs()  # the finer model's, then the displaced worlds
+        fine = len(displaced) - len(self.displaced_specs())
         for i in order:
             if not outcomes[i].success:
                 continue
@@ -146,8 +162,11 @@ class BudgetedRun:
                 else replace(
                     moved[failed],
                     failure_reason=(
-                        f"passed its verification, failed with the objects displaced ({failed + 1} of "
-                        f"{len(moved)}): {moved[failed].failure_reason}"
+                        f"passed its rollout, failed on the {self.spec.sto.check_step * 1000:g} ms check "
+                        f"model: {moved[failed].failure_reason}"
+                        if failed < fine
+                        else f"passed its verification, failed with the objects displaced ({failed - fine + 1} "
+                        f"of {len(moved) - fine}): {moved[failed].failure_reason}"
                     ),
                 )
             )

@@ -21,6 +21,7 @@ from typing import Annotated, Literal
 from hlp_drake.config.ranges import (
     MAX_DURATION,
     MAX_SEED,
+    MAX_TIME_STEP,
     PERIOD,
     Count,
     NonNegativeFloat,
@@ -121,7 +122,11 @@ class StoConfig(LowLevelConfig):
         max_object_speed: an object faster than this (m/s) means the simulation blew up.
         max_sink: an object's centre more than this below the table top while over it means it
             tunnelled into the table, m.
-        cost: the cost weights.
+        cost: the cost weights (``off_table`` is charged once more per object lifted off the table
+            at the end).
+        acceptance_margin: a rollout is accepted only if it passes the success test with the
+            pre-grasp region shrunk by this, horizontally and vertically, m (the world, finer than
+            the rollouts' model, judges by the test itself).
         verify: with ``reduced_model``, before declaring success, simulate a passing rollout's
             sequence again on the execution model (every object awake); only if it passes there too
             does the optimisation succeed, else that outcome (and cost) replaces the rollout's and
@@ -138,6 +143,9 @@ class StoConfig(LowLevelConfig):
             perceived scene cannot promise, is rejected (0: off; None, the default:
             ``PERCEIVED_CHECKS`` on a perceived scene, ``perception.source: camera``, else 0; the
             initial optimisation only, not the closed loop's re-optimisations).
+        check_step: a sequence that passes its rollout counts only if it also passes on the
+            rollouts' model at this finer plant step, s (the contact geometry unchanged; 0: off;
+            the initial optimisation only, like ``displaced_checks``; counted in ``verifications``).
         displaced_sigma: see ``displaced_checks``, m.
         displaced_yaw_sigma: see ``displaced_checks``, rad.
     """
@@ -162,9 +170,11 @@ class StoConfig(LowLevelConfig):
     max_object_speed: PositiveFloat = 5.0
     max_sink: PositiveFloat = 0.03
     cost: StoCost = field(default_factory=StoCost)
+    acceptance_margin: Annotated[float, Positive(upper=0.1, zero_ok=True)] = 0.0
     verify: bool = True
     max_verifications: Annotated[int, Count(0, 1000)] = 8
     displaced_checks: Annotated[int | None, Count(0, 100)] = None
+    check_step: Annotated[float, Positive(upper=MAX_TIME_STEP, zero_ok=True)] = 0.0
     displaced_sigma: Annotated[float, Positive(upper=0.1, zero_ok=True)] = 0.001
     displaced_yaw_sigma: Annotated[float, Positive(upper=math.pi, zero_ok=True)] = math.radians(0.5)
 

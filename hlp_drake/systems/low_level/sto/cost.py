@@ -16,7 +16,7 @@ from hlp_drake.scene.model import Scene
 from hlp_drake.systems.low_level.outcome import RolloutOutcome
 from hlp_drake.systems.low_level.sto.config import StoConfig
 from hlp_drake.systems.world.scene_models import off_table_mask
-from hlp_drake.systems.world.success import SuccessConfig, half_extent, pregrasp_check, reach_problem
+from hlp_drake.systems.world.success import ReachEnd, SuccessConfig, half_extent
 
 BLOWN_UP_COST = 1.0e9
 
@@ -75,9 +75,11 @@ def rollout_cost(
     off = np.array([off_table_mask(p, scene.table) for p in positions])  # (T, m)
     final = positions[-1]
     start = positions[0]
-    inside, distance = pregrasp_check(
-        tcp[-1], final[0], scene, tcp_height=tcp_height, margin=success.pregrasp_margin
-    )
+    fallen = tuple(name for name, f in zip(names, off[-1]) if f)
+    end = ReachEnd(tcp[-1], start, final, fallen, tcp_height)
+    distance, shrink = end.distance(), sto.acceptance_margin
+    inside = end.region_problem(scene, success, shrink=shrink) is None
+    lifted = int(np.sum(final[:, 2] - start[:, 2] > success.max_lift))
     moved = np.sum((final[:, :2] - start[:, :2]) ** 2, axis=1)
     near = [
         name
@@ -87,7 +89,7 @@ def rollout_cost(
     excess = np.clip(samples.max_force - weights.force_limit, 0.0, None)
     terms = {
         "goal": distance if inside else weights.goal_weight * distance,
-        "off_table": weights.off_table * float(np.sum(off)) * per_step,
+        "off_table": weights.off_table * (float(np.sum(off)) * per_step + lifted),
         "table_contact": weights.table_contact * float(np.sum(samples.table_contact)) * per_step,
         "force": weights.force_weight * float(np.sum(excess)) * per_step,
         "disturbance": weights.disturbance_weight * float(np.sum(moved[1:])),
@@ -95,8 +97,9 @@ def rollout_cost(
         "near_obstacle": weights.near_obstacle * len(near),
         "effort": weights.effort_weight * effort,
     }
-    fallen = tuple(name for name, f in zip(names, off[-1]) if f)
-    reason = reach_problem(fallen, inside, distance)
+    reason = end.problem(scene, success, shrink=shrink)
+    if reason is not None and shrink > 0 and end.problem(scene, success) is None:
+        reason = f"passes the success test, not by the acceptance margin of {shrink:g} m: {reason}"
     return RolloutOutcome(
         float(sum(terms.values())), terms, reason is None, reason, distance, fallen, simulated
     )

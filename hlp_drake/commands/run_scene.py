@@ -88,7 +88,7 @@ def recording_title(result, ran: WhatRan) -> str:
     """The recording's heading: the scene, the initialiser, the low-level planner and perception, and
     the verdict in short."""
     reach = "reach success" if result.success else f"reach failure: {result.failure_reason}"
-    reach += f" in the {result.world} world (the planner's model: {model_verdict(result)})"
+    reach += f" in the {result.world} world (the model: {model_verdict(result)})"
     held = {None: "", True: ", grasp held", False: ", grasp did not hold"}[result.grasp_held]
     planners = " and ".join(INITIALISER_NAMES.get(p, p) for p in ran.initials)
     planners += f" planner with the {' and '.join(ran.low_levels)} low-level planner"
@@ -111,7 +111,7 @@ def summary(result, ran: WhatRan | None = None) -> str:
     if verified:
         displaced = result.optimisation.get("displaced_checks", 0)
         optimiser += (
-            f", {verified} verified on the execution model"
+            f", {verified} checked before accepting"
             + (f" and in {displaced} displaced worlds" if displaced else "")
             + f" ({result.optimisation['rejected']} rejected, {result.optimisation.get('verify_s', 0.0):.1f} s of it)"
         )

@@ -70,7 +70,7 @@ def test_the_recording_highlights_each_pushed_obstacle_while_it_is_pushed_and_sa
     title = (
         "scene default (gen1 seed 3), human-like planner with the sto low-level planner on the true scene: "
     )
-    title += "reach success, grasp "
+    title += "reach success in the reference world (the model: accepted), grasp "
     assert title in page and 'id="hlp-clock"' in page
 
 

@@ -25,8 +25,8 @@ from hlp_drake.systems.world.world import add_position_trajectory, make_world_di
 
 
 @pytest.fixture(scope="module")
-def scenario():
-    return Scenario(scene=load_scene(DEFAULT_SCENE))
+def scenario():  # executed in the planner's own model: the accepted rollout is the execution's reach
+    return Scenario(scene=load_scene(DEFAULT_SCENE)).updated("world: model")
 
 
 def test_a_rollout_on_the_execution_model_ends_exactly_where_the_execution_does(scenario):
@@ -34,7 +34,7 @@ def test_a_rollout_on_the_execution_model_ends_exactly_where_the_execution_does(
     sequence = forward(verifier.start_positions, 0.3, 1.3)  # into the first row: it pushes
     outcome = verifier.rollout(sequence)
     final = outcome.final
-    key = world_key(scenario.scene, scenario.world_model, scenario.success.settle_s)
+    key = world_key(scenario.scene, scenario.executed_model, scenario.success.settle_s)
     assert final.world_key == key and final.time == sequence.duration + scenario.success.settle_s
     # The execution's world (its own diagram, simulated in one go) reaches the very same state.
     builder = DiagramBuilder()
@@ -69,7 +69,7 @@ def test_only_a_verification_in_the_executed_worlds_own_world_is_reused(scenario
     verified = verifier.rollout(forward(verifier.start_positions, 0.05, 0.5))
     passed = replace(verified, verification=verified)
     result = LowLevelResult(ControlSequence(np.array([0.0, 1.0]), np.zeros((2, 11))), passed, True, None)
-    key = world_key(scenario.scene, scenario.world_model, scenario.success.settle_s)
+    key = world_key(scenario.scene, scenario.executed_model, scenario.success.settle_s)
     assert verified_reach(result, key) is verified.final
     searched = scenario.updated("planner: {low_level: {seed: 1}}")  # another search, the same world
     assert verified_reach(result, world_key(searched.scene, searched.world_model, 1.0)) is verified.final

@@ -303,7 +303,7 @@ def test_a_box_pushed_by_the_gripper_slides_and_stays_on_the_table():
 
 def test_world_with_a_yaml_config_and_without_gravity_compensation(tmp_path):
     path = tmp_path / "coarse.yaml"
-    path.write_text("plant: {time_step: 0.005}\ncontroller: {gravity_compensation: false}\n")
+    path.write_text("plant: {time_step: 0.005}\ncontroller: {gravity_compensation: false}\nworld: model\n")
     scene = replace(push_scene(), obstacles=())
     world = make_world_diagram(replace(load_scenario(path), scene=scene))
     plant, _ = world_plant(world)

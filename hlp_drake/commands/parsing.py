@@ -206,7 +206,7 @@ def add_conditions(parser: argparse.ArgumentParser, *, several: bool = False) ->
         "--world",
         choices=WORLDS,
         help="what the robot acts in and the run is judged in: reference (finer physics than the "
-        "planner's model: 1 ms steps, the full contact geometry) or model (the planner's own model; "
+        "planner's model: 2 ms steps, the full contact geometry) or model (the planner's own model; "
         "the execution replays its accepted rollout); default: the scenario's, reference",
         **({"nargs": "+"} if several else {}),
     )

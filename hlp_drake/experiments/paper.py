@@ -34,13 +34,15 @@ COMMON_NOTES = [
         "and failures): init = high-level plan + keypoint IK (plan_s + ik_s), optimisation = the low-level "
         "planner (the paper's: the stochastic trajectory optimiser), total = init + optimisation. The simulated "
         "execution (execute_s in results.csv) is excluded. Verification = the low-level planner's checks of a "
-        "passing rollout on the execution model (verify_s, part of optimisation); the ratio without it "
+        "passing rollout before it accepts it (verify_s, part of optimisation); the ratio without it "
         "compares the search alone. The paper's figures are shown for its conditions only: the STO, open "
         "loop, true scene, no model error."
     ),
     (
-        "Success % is followed by its 95 % Wilson interval; success = the target in the gripper's pre-grasp "
-        "region at the end of the executed motion and no object fallen off the table."
+        "Success % is followed by its 95 % Wilson interval; success = the world's verdict on the executed "
+        "motion (world reference: finer physics than the planner's model; model: the planner's own): the "
+        "target in the gripper's pre-grasp region at the end, no object fallen off the table or lifted off "
+        "it. A false accept: the low-level planner accepted the motion in its model and the world failed it."
     ),
     (
         "A run that crashed (an exception in plan_and_execute) counts as a failure; its times are left out "

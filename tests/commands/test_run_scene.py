@@ -155,6 +155,7 @@ def test_what_ran_names_the_robot_initialiser_low_level_planner_execution_model_
 
 
 SUCCESS = "verdict: reach success in the reference world (the paper's criterion, exit status 0)"
+FAILURE = "verdict: reach failure in the reference world: x (exit status 1); the planner's model: "
 
 
 @pytest.mark.parametrize(
@@ -167,16 +168,14 @@ SUCCESS = "verdict: reach success in the reference world (the paper's criterion,
             True,
             None,
             1,
-            "verdict: reach failure in the reference world: x (exit status 1); the planner's model: accepted: "
-            "a false accept; grasp not attempted",
+            FAILURE + "accepted: a false accept; grasp not attempted",
         ),
         (
             False,
             False,
             None,
             1,
-            "verdict: reach failure in the reference world: x (exit status 1); the planner's model: not "
-            "accepted; grasp not attempted",
+            FAILURE + "not accepted; grasp not attempted",
         ),
     ],
 )

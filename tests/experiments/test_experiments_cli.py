@@ -307,7 +307,10 @@ def test_run_json_and_the_summary_say_what_ran(tmp_path, capsys):
         ["gen1", "--scenes", "1", "--workers", "1", "--quiet", "--out", str(tmp_path / "b")],
     )
     assert json.loads((tmp_path / "b" / "summary.json").read_text())["scenario_file"] is None
-    assert "model error none, perception truth, world reference, scenario built-in default." in capsys.readouterr().out
+    assert (
+        "model error none, perception truth, world reference, scenario built-in default."
+        in capsys.readouterr().out
+    )
 
 
 @pytest.mark.slow

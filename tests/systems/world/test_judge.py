@@ -23,7 +23,7 @@ def test_the_reference_world_is_finer_physics_over_the_planners_model_and_the_mo
     scenario = Scenario()
     assert scenario.world.kind == "reference"
     world, model = scenario.executed_model, scenario.world_model
-    assert (model.plant.time_step, world.plant.time_step) == (0.01, 0.001)
+    assert (model.plant.time_step, world.plant.time_step) == (0.01, 0.002)
     assert world.plant.use_sampled_output_ports and not model.plant.use_sampled_output_ports
     assert (world.contact.rim_spheres, world.contact.top_spheres, world.contact.robot_self_contact) == (
         8,
@@ -33,8 +33,8 @@ def test_the_reference_world_is_finer_physics_over_the_planners_model_and_the_mo
     assert world.robot == model.robot and world.controller == model.controller
     mine = load_scenario(data="world: model")
     assert mine.executed_model is mine.world_model
-    custom = load_scenario(data="world: {kind: reference, time_step: 0.002}")
-    assert custom.executed_model.plant.time_step == 0.002 and custom.world_model.plant.time_step == 0.01
+    custom = load_scenario(data="world: {kind: reference, time_step: 0.001}")
+    assert custom.executed_model.plant.time_step == 0.001 and custom.world_model.plant.time_step == 0.01
     assert Conditions(world="model").applied(scenario).world == WorldConfig(kind="model")
     with pytest.raises(
         HlpError, match=r"^overrides: world\.kind: expected one of model, reference, got 'moon'$"
@@ -46,7 +46,7 @@ def test_the_reference_world_is_finer_physics_over_the_planners_model_and_the_mo
 
 def test_the_execution_diagram_acts_in_the_world_and_plans_in_the_model(scene):  # noqa: F811
     handles = make_execution_diagram(on(scene))
-    assert handles.plant.time_step() == 0.001
+    assert handles.plant.time_step() == 0.002
     model = make_execution_diagram(on(scene, "world: model"))
     assert model.plant.time_step() == 0.01
 
@@ -118,9 +118,11 @@ def test_a_diverging_world_is_the_scenes_failure_with_its_reason(scene, monkeypa
 def test_an_accepted_rollout_counts_only_if_it_passes_on_the_finer_check_model(scene, trajectories):  # noqa: F811
     reaching = ControlSequence.from_trajectory(trajectories["hlp"], 0.5)  # passes at 10 ms
     with RolloutPool(1) as pool:
-        checked = optimise(sto(scene, "max_rollouts: 1, samples: 1, check_step: 0.005"), reaching, pool)
+        checked = optimise(sto(scene, "max_rollouts: 1, samples: 1"), reaching, pool)  # at 5 ms
+        unchecked = optimise(sto(scene, "max_rollouts: 1, samples: 1, check_step: 0"), reaching, pool)
         margin = optimise(sto(scene, "max_rollouts: 1, samples: 1, acceptance_margin: 0.1"), reaching, pool)
     assert checked.success and (checked.verifications, checked.rejected) == (1, 0)
+    assert unchecked.success and (unchecked.verifications, unchecked.verify_s) == (0, 0.0)  # its own check
     assert checked.verify_s > 0 and checked.outcome.verification is not None
     # a margin as wide as the region accepts nothing, and says why
     assert not margin.success and "not by the acceptance margin of 0.1 m" in margin.failure_reason

@@ -354,3 +354,34 @@ def test_a_failed_closed_loop_execution_still_reports_what_the_controller_did(tm
         loop["replans"] >= 1 and loop["replans"] <= loop["rollouts"] == loop["replans"] + loop["initialised"]
     )
     assert "closed loop:" in result.stdout
+
+
+@pytest.mark.parametrize(
+    ("module", "args", "line"),
+    [
+        (
+            "hlp_drake.run_scene",
+            ("--world", "moon"),
+            "error: argument --world: invalid choice: 'moon' (choose from 'model', 'reference')",
+        ),
+        (
+            "hlp_drake.experiments",
+            ("gen1", "--world", "moon", "--out", "OUT"),
+            "error: argument --world: invalid choice: 'moon' (choose from 'model', 'reference')",
+        ),
+        (
+            "hlp_drake.run_scene",
+            ("--config", "CONFIG"),
+            "error: CONFIG: world.kind: expected one of model, reference",
+        ),
+    ],
+)
+def test_an_unknown_world_is_one_line_and_exit_status_2(tmp_path, module, args, line):
+    config, out = tmp_path / "moon.yaml", tmp_path / "out"
+    config.write_text("world: moon\n")
+    args = [str(config) if a == "CONFIG" else str(out) if a == "OUT" else a for a in args]
+    result = run_module(module, *args)
+    line = line.replace("CONFIG", str(config))
+    assert result.returncode == 2 and result.stdout == "", result.stdout
+    assert len(result.stderr.splitlines()) == 1 and result.stderr.startswith(line), result.stderr
+    assert not out.exists()

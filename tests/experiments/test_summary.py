@@ -102,6 +102,26 @@ def test_gen1_summary_has_table_ii_paper_figures():
     assert hlp["success_ci95"][0] < 60.0 < hlp["success_ci95"][1]
 
 
+def test_the_summary_counts_the_models_accepts_and_the_false_accepts_per_world():
+    rows = [
+        _row(
+            i, "hlp", "hlp", world=world, success=ok, model_success=accepted, false_accept=accepted and not ok
+        )
+        for i, (ok, accepted) in enumerate([(True, True), (False, True), (False, False), (True, True)])
+        for world in ("reference", "model")
+    ]
+    summary = summarise(
+        Study(name="w", generators=("gen1",), initialisers=("hlp",), world=("reference", "model")), rows
+    )
+    (condition,) = summary["conditions"]
+    assert sorted(s["cell"]["world"] for s in condition["series"]) == ["model", "reference"]
+    for series in condition["series"]:
+        assert (series["stats"]["model_accepts"], series["stats"]["false_accepts"]) == (3, 1)
+    markdown = summary_markdown(summary)
+    assert "| model accepted | false accepts (model accepted, world failed) |" in markdown
+    assert "| HLP, reference | reference | 0.0 | 0.60 | 3 of 4 | 1 of 3 |" in markdown
+
+
 def test_a_grid_of_robots_and_low_level_planners_gets_a_series_per_cell_and_a_ratio_per_pair():
     rows = [
         _row(i, label, initial, robot=robot, low_level=low_level)

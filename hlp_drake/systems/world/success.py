@@ -1,8 +1,9 @@
 """The paper's success test of a reach, shared by the planners that simulate and by the execution:
-the target in the gripper's pre-grasp region, no object off the table and none lifted off it (on
-the gripper or on another object), read ``settle_s`` after the motion ends (``SuccessConfig``, a
-``Scenario``'s ``success``). ``reach_problem`` names the real cause of a failure: an object that
-fell, an object lifted, the tcp too far from the target or off grasp height.
+the target in the gripper's pre-grasp region and no object off the table, read ``settle_s`` after
+the motion ends (``SuccessConfig``, a ``Scenario``'s ``success``). ``ReachEnd.problem`` names the
+real cause of a failure: an object that fell, the tcp too far from the target or off grasp height,
+and beside it an object lifted off the table (on the gripper or on another object); a planner
+accepting a motion also asks that nothing be lifted.
 """
 
 from __future__ import annotations
@@ -28,7 +29,8 @@ class SuccessConfig:
             rollout and in the execution alike (a rollout's end is where the execution of the same
             motion ends).
         max_lift: an object whose centre ends higher than it started by more than this is lifted
-            off the table (resting on the gripper or on another object), m.
+            off the table (resting on the gripper or on another object), m: said beside a failure,
+            and a planner that simulates accepts no motion that lifts one.
     """
 
     pregrasp_margin: NonNegativeFloat = 0.03
@@ -63,18 +65,31 @@ class ReachEnd:
         """The tcp's horizontal distance from the target's centre, m."""
         return float(np.hypot(*(np.asarray(self.tcp)[:2] - np.asarray(self.end)[0, :2])))
 
-    def problem(self, scene: Scene, success: SuccessConfig, *, shrink: float = 0.0) -> str | None:
-        """Why the reach failed the success test (None: it passed), the pre-grasp region shrunk by
-        ``shrink`` m horizontally and vertically (a planner's acceptance margin)."""
+    def lifted(self, scene: Scene, success: SuccessConfig) -> str | None:
+        """The objects lifted off the table by more than ``success.max_lift`` (on the gripper or on
+        another object), said in a line (None: none)."""
+        rise = np.asarray(self.end)[:, 2] - np.asarray(self.start)[:, 2]
+        lifted = [f"{o.name} by {r:.3f} m" for o, r in zip(scene.objects, rise) if r > success.max_lift]
+        return (
+            f"lifted off the table (on the gripper or another object): {', '.join(lifted)}"
+            if lifted
+            else None
+        )
+
+    def problem(
+        self, scene: Scene, success: SuccessConfig, *, shrink: float = 0.0, accepting: bool = False
+    ) -> str | None:
+        """Why the reach failed the success test (None: it passed): an object off the table, or the
+        target outside the pre-grasp region (a lifted object said beside, as its likely cause). A
+        planner ``accepting`` it asks more: the region shrunk by ``shrink`` m horizontally and
+        vertically (its acceptance margin) and no object lifted."""
         if self.fallen:
             return f"objects fell off the table: {', '.join(self.fallen)}"
-        names = [o.name for o in scene.objects]
-        rise = np.asarray(self.end)[:, 2] - np.asarray(self.start)[:, 2]
-        lifted = [(n, r) for n, r in zip(names, rise) if r > success.max_lift]
-        if lifted:
-            what = ", ".join(f"{n} by {r:.3f} m" for n, r in lifted)
-            return f"lifted off the table (on the gripper or another object): {what}"
-        return self.region_problem(scene, success, shrink=shrink)
+        lifted = self.lifted(scene, success)
+        if accepting and lifted:
+            return lifted
+        region = self.region_problem(scene, success, shrink=shrink)
+        return region if region is None or lifted is None else f"{region}; {lifted}"
 
     def region_problem(self, scene: Scene, success: SuccessConfig, *, shrink: float = 0.0) -> str | None:
         """Why the target is not in the gripper's pre-grasp region (None: it is), the region shrunk

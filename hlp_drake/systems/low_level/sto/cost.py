@@ -97,9 +97,9 @@ def rollout_cost(
         "near_obstacle": weights.near_obstacle * len(near),
         "effort": weights.effort_weight * effort,
     }
-    reason = end.problem(scene, success, shrink=shrink)
-    if reason is not None and shrink > 0 and end.problem(scene, success) is None:
-        reason = f"passes the success test, not by the acceptance margin of {shrink:g} m: {reason}"
+    reason = end.problem(scene, success, shrink=shrink, accepting=True)
+    if reason is not None and end.problem(scene, success) is None:
+        reason = f"passes the success test, not as the planner accepts it (margin {shrink:g} m): {reason}"
     return RolloutOutcome(
         float(sum(terms.values())), terms, reason is None, reason, distance, fallen, simulated
     )

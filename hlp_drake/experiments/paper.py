@@ -41,8 +41,7 @@ COMMON_NOTES = [
     (
         "Success % is followed by its 95 % Wilson interval; success = the world's verdict on the executed "
         "motion (world reference: finer physics than the planner's model; model: the planner's own): the "
-        "target in the gripper's pre-grasp region at the end, no object fallen off the table or lifted off "
-        "it. A false accept: the low-level planner accepted the motion in its model and the world failed it."
+        "target in the gripper's pre-grasp region at the end and no object fallen off the table. A false accept: the low-level planner accepted the motion in its model and the world failed it."
     ),
     (
         "A run that crashed (an exception in plan_and_execute) counts as a failure; its times are left out "

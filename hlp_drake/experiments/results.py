@@ -67,19 +67,9 @@ COLUMNS = (
     "execute_s",
     *AXIS_COLUMNS,
 )
-KEY_COLUMNS = (
-    "scene",
-    "objects",
-    "robot",
-    "initial",
-    "low_level",
-    "execution",
-    "perception",
-    "model_error",
-    "world",
-)
+KEY_COLUMNS = ("scene", "objects", *AXIS_COLUMNS[1:])
 """A row's identity (``row_key``)."""
-CELL_COLUMNS = ("robot", "initial", "low_level", "planner", "execution", "perception", "model_error", "world")
+CELL_COLUMNS = ("robot", "initial", "low_level", "planner", *AXIS_COLUMNS[4:])
 """A row's cell of the grid, as ``hlp_drake.config.what_ran.Labels`` names it."""
 BOOL_COLUMNS = frozenset({"success", "model_success", "false_accept"})
 FLOAT_COLUMNS = frozenset({"init_s", "optimise_s", "total_s", "verify_s", "execute_s"})

@@ -85,7 +85,18 @@ def test_run_scene_meshcat_serves_the_run_live(tmp_path):
 
     out = tmp_path / "run.json"
     process = subprocess.Popen(
-        [sys.executable, "-m", "hlp_drake.run_scene", "--meshcat", "--workers", "1", "--json", str(out)],
+        [
+            sys.executable,
+            "-m",
+            "hlp_drake.run_scene",
+            "--meshcat",
+            "--world",
+            "model",
+            "--workers",
+            "1",
+            "--json",
+            str(out),
+        ],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,

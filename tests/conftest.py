@@ -5,6 +5,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -16,6 +17,16 @@ pytest_plugins = ("sto_support",)  # the optimiser's tests' fixtures
 REPO = Path(__file__).resolve().parents[1]
 DEFAULT_DATA = REPO.parent / "shared" / "data"  # the structured archive and the unstructured part 1 beside it
 DEFAULT_ARCHIVE = DEFAULT_DATA / "hlp-vr-dataset.tar.xz"
+
+
+@pytest.fixture(autouse=True)
+def _ctrl_c_delivered():
+    """Every test starts with Ctrl-C delivered to this process as a KeyboardInterrupt: not held back
+    (a blocked SIGINT is inherited by the processes a test starts) and not ignored, whatever an
+    earlier test in this worker process left."""
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
 
 
 @pytest.fixture(scope="session", autouse=True)

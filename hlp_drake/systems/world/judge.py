@@ -12,7 +12,6 @@ replays the accepted rollout). The model error of ``uncertainty`` is laid over e
 
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass, replace
 from typing import Annotated
 
@@ -52,15 +51,13 @@ class WorldConfig:
         or it with this physics (``kind: reference``)."""
         if self.is_model:
             return model
-        plant = copy.copy(model.plant)  # Drake's MultibodyPlantConfig, not a dataclass
-        plant.time_step, plant.use_sampled_output_ports = self.time_step, self.sampled_ports
         contact = replace(
             model.contact,
             top_spheres=self.top_spheres,
             rim_spheres=self.rim_spheres,
             robot_self_contact=self.robot_self_contact,
         )
-        return replace(model, plant=plant, contact=contact)
+        return replace(model.stepped(self.time_step, sampled=self.sampled_ports), contact=contact)
 
 
 def world_section(value: object) -> object:

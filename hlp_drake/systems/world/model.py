@@ -9,8 +9,9 @@ worlds of a planner that simulates are built from a scene and a ``WorldModel``.
 
 from __future__ import annotations
 
+import copy
 import hashlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from pydrake.multibody.plant import MultibodyPlantConfig
 
@@ -32,6 +33,15 @@ class WorldModel:
     bodies: BodiesConfig = field(default_factory=BodiesConfig)
     controller: ControlConfig = field(default_factory=ControlConfig)
     ik: IkConfig = field(default_factory=IkConfig)
+
+    def stepped(self, time_step: float, *, sampled: bool | None = None) -> WorldModel:
+        """This model with its plant stepping at ``time_step`` s (and its outputs from the sampled
+        state if ``sampled`` says so; None: as they are)."""
+        plant = copy.copy(self.plant)  # Drake's MultibodyPlantConfig, not a dataclass
+        plant.time_step = time_step
+        if sampled is not None:
+            plant.use_sampled_output_ports = sampled
+        return replace(self, plant=plant)
 
 
 def world_key(scene: Scene, model: WorldModel, settle_s: float) -> str:

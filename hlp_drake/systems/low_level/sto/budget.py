@@ -4,7 +4,6 @@ the displaced worlds)."""
 
 from __future__ import annotations
 
-import copy
 import time
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
@@ -96,9 +95,7 @@ class BudgetedRun:
             step = self.spec.sto.check_step
             fine = []
             if step > 0 and self.start is None:
-                plant = copy.copy(self.spec.model.plant)  # Drake's MultibodyPlantConfig
-                plant.time_step = step
-                fine = [replace(self.spec, model=replace(self.spec.model, plant=plant))]
+                fine = [replace(self.spec, model=self.spec.model.stepped(step))]
             self._checks = fine + self.displaced_specs()
         return self._checks
 

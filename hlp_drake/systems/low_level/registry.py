@@ -121,6 +121,25 @@ register_low_level(
     )
 )
 
+register_low_level(
+    LowLevelEntry(
+        "trajopt",
+        "hlp_drake.systems.low_level.kinematic.trajopt:TrajoptConfig",
+        "hlp_drake.systems.low_level.kinematic.trajopt:TrajoptPlanner",
+        "Drake's kinematic trajectory optimisation: a B-spline clear of the objects it may not touch",
+        step="trajopt",
+    )
+)
+register_low_level(
+    LowLevelEntry(
+        "rrt",
+        "hlp_drake.systems.low_level.kinematic.rrt:RrtConfig",
+        "hlp_drake.systems.low_level.kinematic.rrt:RrtPlanner",
+        "OMPL's RRT-Connect in configuration space, clear of the objects it may not touch",
+        step="rrt",
+    )
+)
+
 __all__ = [
     "LOW_LEVEL_PLANNERS",
     "LowLevelEntry",

@@ -38,6 +38,9 @@ class LowLevelResult:
         verify_s: wall-clock time of the verifications, s (part of ``optimise_s``).
         displaced_checks: simulations in worlds with the objects displaced.
         low_level: the planner's name (its registry name; empty when no planner ran).
+        fallback: how the planner relaxed its problem to find this motion, and why ("": it did not;
+            a kinematic planner: "contact allowed with every object (...)").
+        notes: what else it did that a reader should know (e.g. a sub-goal it left out).
     """
 
     sequence: ControlSequence
@@ -55,6 +58,8 @@ class LowLevelResult:
     verify_s: float = 0.0
     displaced_checks: int = 0
     low_level: str = ""
+    fallback: str = ""
+    notes: tuple[str, ...] = ()
 
     def to_dict(self) -> dict:
         """The result as JSON-ready data: its counts, times and costs (not its motion)."""
@@ -66,6 +71,7 @@ class LowLevelResult:
             final_cost=None if outcome is None else outcome.cost,
             cost_terms={} if outcome is None else dict(outcome.terms),
             costs=list(self.costs),
+            notes=list(self.notes),
         )
         return record
 

@@ -19,7 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
+from hlp_drake.commands.parsing import run_cli
 from hlp_drake.features import gap_features, object_features
+from hlp_drake.files.atomic import check_writable, write_text_atomic
 from hlp_drake.learners import DecisionModels
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.planner import PlannerConfig, plan
@@ -70,6 +72,7 @@ def main() -> None:
     parser.add_argument("--models", help="a model directory (default: the bundled models)")
     parser.add_argument("--json", type=Path, help="write the figures here")
     args = parser.parse_args()
+    check_writable(args.json)
     models = DecisionModels.load(args.models) if args.models else default_models()
     measure = row_evidence if models.planner == "rows" else paper_evidence
     results = {}
@@ -82,10 +85,11 @@ def main() -> None:
         row = results[label] = measure(models, kind, objects, args.scenes)
         print(f"{label:<14} {row['candidates']:>10d} {row['with_evidence']:>14.1%}")
     if args.json:
-        args.json.write_text(
-            json.dumps({"scenes": args.scenes, "planner": models.planner, **results}, indent=2) + "\n"
+        write_text_atomic(
+            args.json,
+            json.dumps({"scenes": args.scenes, "planner": models.planner, **results}, indent=2) + "\n",
         )
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_cli(lambda _argv: main() or 0))  # bad paths: one line, exit 2

@@ -22,8 +22,9 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from hlp_drake.commands.parsing import run_cli
 from hlp_drake.errors import HlpError
-from hlp_drake.files.atomic import write_text_atomic
+from hlp_drake.files.atomic import check_writable, write_text_atomic
 from hlp_drake.scene.generators import generate_scene
 
 
@@ -64,6 +65,7 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--json", type=Path, help="write the rows and counts here")
     args = parser.parse_args()
+    check_writable(args.json)
     from hlp_drake.systems.scenario import load_scenario
 
     try:
@@ -93,4 +95,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_cli(lambda _argv: main() or 0))  # bad paths: one line, exit 2

@@ -29,6 +29,9 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from hlp_drake.commands.parsing import run_cli
+from hlp_drake.files.atomic import check_writable, write_text_atomic
+
 MB = 10**6
 _OBSTACLE = "- {{name: o{i}, shape: box, x: {x:.3f}, y: {y:.3f}, yaw: 0.0, size: [0.02, 0.02, 0.1]}}\n"
 _HEAD = (
@@ -198,6 +201,7 @@ def main() -> None:
     parser.add_argument("--json", help="write the figures here")
     parser.add_argument("--child", nargs=2, help=argparse.SUPPRESS)
     args = parser.parse_args()
+    check_writable(args.json)
     if args.child:
         _child(args.child[0], Path(args.child[1]))
         return
@@ -225,10 +229,10 @@ def main() -> None:
             "machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores",
             "python": platform.python_version(),
         }
-        Path(args.json).write_text(
-            json.dumps({"meta": meta, "refused": rows, "valid_10000": valid}, indent=2) + "\n"
+        write_text_atomic(
+            args.json, json.dumps({"meta": meta, "refused": rows, "valid_10000": valid}, indent=2) + "\n"
         )
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_cli(lambda _argv: main() or 0))  # bad paths: one line, exit 2

@@ -29,7 +29,8 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from hlp_drake.files.atomic import write_text_atomic
+from hlp_drake.commands.parsing import run_cli
+from hlp_drake.files.atomic import check_writable, write_text_atomic
 from hlp_drake.files.plotting import new_figure, save_png
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.scene.generators import generate_scene
@@ -186,6 +187,7 @@ def plot(groups: dict[str, list[Scene]], rows: list[dict], title: str, path: Pat
 
 def main() -> None:
     args = _parser().parse_args()
+    check_writable(args.json, args.png)
     settings = load_scenario()
     settings = replace(settings, planner=replace(settings.planner, initial=initialiser_name(args.planner)))
     groups: dict[str, list[Scene]] = {
@@ -223,4 +225,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_cli(lambda _argv: main() or 0))  # bad paths: one line, exit 2

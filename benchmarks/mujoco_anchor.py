@@ -49,6 +49,8 @@ from physics_models import MODELS
 from sto import HORIZON, throughput_sequences
 from tqdm import tqdm
 
+from hlp_drake.commands.parsing import run_cli
+from hlp_drake.files.atomic import atomic_path, check_folder, write_text_atomic
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
 from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld
 from hlp_drake.systems.low_level.sto.spec import RolloutSpec
@@ -287,7 +289,8 @@ def plot(summary: dict, path: Path) -> None:
     ax.set_ylabel("CPU s per simulated s")
     ax.set_title("MuJoCo vs Drake, same scene and sequences (median over passes)")
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=120)
     plt.close(fig)
 
 
@@ -315,6 +318,10 @@ def print_table(report: dict) -> None:
     print(f"load average (1 min) before {before:.2f}, during {min(loads):.2f}-{max(loads):.2f}")
 
 
+OUTPUTS = ("mujoco_anchor.json", "mujoco_anchor.png", "mujoco_anchor.xml")
+"""The files of --out."""
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--out", default="benchmark-results", help="output directory")
@@ -327,8 +334,8 @@ def main() -> None:
     if mujoco is None:
         print(MISSING, file=sys.stderr)
         raise SystemExit(2)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = check_folder(args.out, *OUTPUTS)
+    out.mkdir(exist_ok=True)
     scene, config, sequences = throughput_sequences(args.rollouts)
     models = Models.build(config, tuple(args.steps))
     m = models.mujoco.model
@@ -360,12 +367,12 @@ def main() -> None:
     report["passes"] = measure(models, sequences, args.repeats)
     report["summary"] = summarise(report["passes"])
     report["machine"]["load_after"] = os.getloadavg()
-    (out / "mujoco_anchor.json").write_text(json.dumps(report, indent=2) + "\n")
-    (out / "mujoco_anchor.xml").write_text(models.mujoco.xml + "\n")
+    write_text_atomic(out / "mujoco_anchor.json", json.dumps(report, indent=2) + "\n")
+    write_text_atomic(out / "mujoco_anchor.xml", models.mujoco.xml + "\n")
     plot(report["summary"], out / "mujoco_anchor.png")
     print_table(report)
     print(f"wrote {out / 'mujoco_anchor.json'}, {out / 'mujoco_anchor.png'} and {out / 'mujoco_anchor.xml'}")
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_cli(lambda _argv: main() or 0))  # bad paths: one line, exit 2

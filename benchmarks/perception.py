@@ -30,6 +30,8 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
+from hlp_drake.commands.parsing import run_cli
+from hlp_drake.files.atomic import check_writable, write_text_atomic
 from hlp_drake.files.plotting import new_figure, save_png
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.planner import plan
@@ -171,6 +173,7 @@ def main() -> None:
     parser.add_argument("--csv", type=Path, help="the objects' errors, one row each")
     parser.add_argument("--png", type=Path)
     args = parser.parse_args()
+    check_writable(args.json, args.csv, args.png)
     if len(args.scenes) != len(args.objects):
         parser.error("give one --scenes per --objects")
     camera = CameraConfig(width=args.width, height=args.height)
@@ -203,9 +206,9 @@ def main() -> None:
             + (f" (target >= {target:.0%})" if target else "")
         )
     if args.json:
-        args.json.write_text(json.dumps(report, indent=2) + "\n")
+        write_text_atomic(args.json, json.dumps(report, indent=2) + "\n")
     if args.csv:
-        errors.to_csv(args.csv, index=False)
+        write_text_atomic(args.csv, errors.to_csv(index=False))
     if args.png:
         figure, axes = new_figure(7.0, 4.0)
         for count in summary:
@@ -221,4 +224,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_cli(lambda _argv: main() or 0))  # bad paths: one line, exit 2

@@ -39,6 +39,8 @@ import numpy as np
 from sto import nudged, validation_sequences
 from tqdm import tqdm
 
+from hlp_drake.commands.parsing import run_cli
+from hlp_drake.files.atomic import atomic_path, check_folder, write_text_atomic
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
 from hlp_drake.systems.low_level.sto.rollout_world import RolloutWorld
@@ -219,8 +221,13 @@ def plot(summary: dict, names: list[str], path: Path) -> None:
     ax.set_yscale("log")
     ax.set_title("Execution models: cost, and sequences agreeing with the 1 ms reference")
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=120)
     plt.close(fig)
+
+
+OUTPUTS = ("rest_check.json", "physics_models.json", "physics_models.png")
+"""The files of --out."""
 
 
 def main() -> None:
@@ -239,9 +246,9 @@ def main() -> None:
     if args.resummarise is not None:
         report = json.loads(args.resummarise.read_text())
         report["summary"] = summarise(report["rows"], list(report["models"]), args.floor)
-        args.resummarise.write_text(json.dumps(report, indent=1))
+        write_text_atomic(args.resummarise, json.dumps(report, indent=1))
         return
-    args.out.mkdir(parents=True, exist_ok=True)
+    check_folder(args.out, *OUTPUTS).mkdir(exist_ok=True)
     names = (REFERENCE, *args.models)
     count = len(_triples(args.sequences, args.scenes))
     load = os.getloadavg()
@@ -259,7 +266,9 @@ def main() -> None:
         r = rest[n]
         print(f"  {n}: {r['objects_moved']} (max drift {1000 * r['max_drift_m']:.2f} mm)")
     if args.skip_agreement:
-        (args.out / "rest_check.json").write_text(json.dumps({"load": load, "rest_check": rest}, indent=1))
+        write_text_atomic(
+            args.out / "rest_check.json", json.dumps({"load": load, "rest_check": rest}, indent=1)
+        )
         return
     summary = summarise(rows, list(names), args.floor)
     report = {
@@ -271,7 +280,7 @@ def main() -> None:
         "summary": summary,
         "rows": rows,
     }
-    (args.out / "physics_models.json").write_text(json.dumps(report, indent=1))
+    write_text_atomic(args.out / "physics_models.json", json.dumps(report, indent=1))
     plot(summary, list(names), args.out / "physics_models.png")
     print(
         f"{summary['sequences']} sequences; reference successes {summary['successes_reference']}; "
@@ -288,4 +297,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_cli(lambda _argv: main() or 0))  # bad paths: one line, exit 2

@@ -33,9 +33,11 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from hlp_drake.commands.parsing import run_cli
 from hlp_drake.dataset import STRUCTURED, UNSTRUCTURED, Dataset
 from hlp_drake.errors import HlpError
 from hlp_drake.evaluation import subject_splits
+from hlp_drake.files.atomic import check_writable, write_text_atomic
 from hlp_drake.files.plotting import new_figure, save_png
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene, SceneObject, Table
@@ -243,6 +245,7 @@ def main() -> None:
     parser.add_argument("--json")
     parser.add_argument("--png")
     args = parser.parse_args()
+    check_writable(args.json, args.png)
     groups, failed = scene_groups(args.dataset, args.scenes)
     pythons = {"this": sys.executable}
     if args.baseline is not None:
@@ -268,12 +271,13 @@ def main() -> None:
     for g, reason in failed.items():
         print(f"{g}: not generated ({reason})")
     if args.json:
-        Path(args.json).write_text(json.dumps(report, indent=2) + "\n")
+        write_text_atomic(args.json, json.dumps(report, indent=2) + "\n")
     if args.png:
         plot(report, args.png)
 
 
 if __name__ == "__main__":
     started = time.perf_counter()
-    main()
-    print(f"({time.perf_counter() - started:.0f} s)")
+    status = run_cli(lambda _argv: main() or 0)  # bad paths: one line, exit 2
+    print(f"({time.perf_counter() - started:.0f} s)", file=sys.stderr)
+    raise SystemExit(status)

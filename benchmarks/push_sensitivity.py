@@ -20,6 +20,8 @@ import time
 
 import numpy as np
 
+from hlp_drake.commands.parsing import run_cli
+from hlp_drake.files.atomic import atomic_path, check_writable
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.systems.low_level.sto.first_rollout import initial_sequence
 from hlp_drake.systems.low_level.sto.pool import SceneRollouts
@@ -55,6 +57,7 @@ def main() -> None:
     )
     parser.add_argument("--csv")
     args = parser.parse_args()
+    check_writable(args.csv)
     scene = generate_scene("gen2", args.seed, args.objects)
     scenario = Scenario(scene=scene).updated(f"planner: {{initial: {args.planner}}}")
     sequence = initial_sequence(scenario)
@@ -77,7 +80,7 @@ def main() -> None:
         )
         print(*rows[-1].values(), sep="  ", flush=True)
     if args.csv:
-        with open(args.csv, "w", newline="") as f:
+        with atomic_path(args.csv) as tmp, tmp.open("w", newline="") as f:
             writer = csv.DictWriter(f, fieldnames=list(rows[0]))
             writer.writeheader()
             writer.writerows(rows)
@@ -86,4 +89,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_cli(lambda _argv: main() or 0))  # bad paths: one line, exit 2

@@ -30,6 +30,8 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from hlp_drake.commands.parsing import run_cli
+from hlp_drake.files.atomic import atomic_path, check_folder, write_text_atomic
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.io import load_scene
 from hlp_drake.systems.execution.run import plan_and_execute
@@ -193,7 +195,7 @@ def comparison(config: Scenario, seeds: int, out: Path) -> dict:
                         "grasp_held": result.grasp_held,
                     }
                 )
-    with (out / "sto_comparison.csv").open("w", newline="") as f:
+    with atomic_path(out / "sto_comparison.csv") as tmp, tmp.open("w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=list(rows[0]))
         writer.writeheader()
         writer.writerows(rows)
@@ -248,7 +250,8 @@ def plot_comparison(rows: list[dict], path: Path) -> None:
     ax.set_title("STO optimisation time per scene (red x: failed)")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=120)
     plt.close(fig)
 
 
@@ -289,6 +292,10 @@ def print_throughput(t: dict, steps: tuple[float, ...]) -> None:
     )
 
 
+OUTPUTS = ("sto_benchmark.json", "sto_comparison.csv", "sto_comparison.png")
+"""The files of --out."""
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--out", default="benchmark-results", help="output directory")
@@ -299,8 +306,8 @@ def main() -> None:
     )
     parser.add_argument("--skip-comparison", action="store_true")
     args = parser.parse_args()
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = check_folder(args.out, *OUTPUTS)
+    out.mkdir(exist_ok=True)
     report = {
         "machine": {
             "platform": platform.platform(),
@@ -323,9 +330,9 @@ def main() -> None:
             f"HLP / straight line optimisation time: mean {c['ratio_hlp_to_sto_mean_optimise_s']:.2f}, "
             f"median {c['ratio_hlp_to_sto_median_optimise_s']:.2f}"
         )
-    (out / "sto_benchmark.json").write_text(json.dumps(report, indent=2) + "\n")
+    write_text_atomic(out / "sto_benchmark.json", json.dumps(report, indent=2) + "\n")
     print(f"wrote {out / 'sto_benchmark.json'}")
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_cli(lambda _argv: main() or 0))  # bad paths: one line, exit 2

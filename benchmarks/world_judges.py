@@ -26,6 +26,8 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from hlp_drake.commands.parsing import run_cli
+from hlp_drake.files.atomic import atomic_path, check_folder, write_text_atomic
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.systems.conditions import Conditions
 from hlp_drake.systems.execution.run import RunListener, plan_and_execute
@@ -129,8 +131,13 @@ def plot(summary: dict, names: list[str], path: Path) -> None:
     ax.set_title(f"Worlds judging {summary['accepted']} accepted plans, against {FINE}")
     ax.margins(y=0.25)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=120)
     plt.close(fig)
+
+
+OUTPUTS = ("world_judges.json", "world_judges.png")
+"""The files of --out."""
 
 
 def main() -> None:
@@ -146,7 +153,7 @@ def main() -> None:
     )
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args()
-    args.out.mkdir(parents=True, exist_ok=True)
+    check_folder(args.out, *OUTPUTS).mkdir(exist_ok=True)
     config = args.config.read_text() if args.config else ""
     names = tuple(args.worlds)
     jobs = [("gen1", args.seed + i, None) for i in range(args.gen1)]
@@ -168,7 +175,7 @@ def main() -> None:
         "summary": summary,
         "rows": rows,
     }
-    (args.out / "world_judges.json").write_text(json.dumps(report, indent=1))
+    write_text_atomic(args.out / "world_judges.json", json.dumps(report, indent=1))
     plot(summary, list(names), args.out / "world_judges.png")
     print(f"{summary['accepted']} accepted plans of {summary['jobs']}")
     print("| world | passes | agrees with 0.5 ms | CPU ms / simulated s |")
@@ -181,4 +188,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_cli(lambda _argv: main() or 0))  # bad paths: one line, exit 2

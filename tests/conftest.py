@@ -6,6 +6,7 @@ import hashlib
 import json
 import os
 import signal
+import stat
 import subprocess
 import sys
 from pathlib import Path
@@ -132,3 +133,17 @@ def pytest_terminal_summary(terminalreporter) -> None:
     if stats is not None and stats.STATS:
         counts = ", ".join(f"{name} {count}" for name, count in sorted(stats.STATS.items()))
         terminalreporter.write_line(f"fuzz: {counts}")
+
+
+@pytest.fixture
+def char_device(tmp_path) -> Path:
+    """A character device to refuse as an output: a null device made in ``tmp_path`` (root), else
+    ``/dev/null`` (which a user other than root cannot replace, so a regression cannot harm it)."""
+    device = tmp_path / "null"
+    try:
+        os.mknod(device, 0o666 | stat.S_IFCHR, os.makedev(1, 3))
+    except PermissionError:
+        if os.geteuid() == 0:
+            pytest.skip("cannot make a device here, and /dev/null must not be risked as root")
+        return Path("/dev/null")
+    return device

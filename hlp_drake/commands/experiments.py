@@ -40,10 +40,11 @@ from hlp_drake.commands.parsing import (
 from hlp_drake.config.ranges import MAX_SEED, config_problems
 from hlp_drake.errors import HlpError
 from hlp_drake.experiments.executors import EXECUTORS
-from hlp_drake.experiments.experiment import CONFIG, DERIVED, RESULTS, RUN, ExperimentSettings, run_experiment
+from hlp_drake.experiments.experiment import OUTPUTS, ExperimentSettings, run_experiment
 from hlp_drake.experiments.runner import JobFunction, StudyResolver
 from hlp_drake.experiments.study import MAX_SCENES, Study, bundled_studies, load_study
 from hlp_drake.experiments.summary import summary_markdown
+from hlp_drake.files.atomic import check_folder
 from hlp_drake.scene.generators import MAX_GENERATED
 
 PROG = "python -m hlp_drake.experiments"
@@ -114,7 +115,10 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--fresh", action="store_true", help="discard DIR's earlier results and start over")
     add_verbosity(parser)
     parser.add_argument(
-        "--out", required=True, metavar="DIR", help="output directory (resumes the run there)"
+        "--out",
+        required=True,
+        metavar="DIR",
+        help="output directory, made if missing (its parent must exist); resumes the run there",
     )
     return parser
 
@@ -158,6 +162,7 @@ def main(
     e.g. in tests."""
     parser = _parser()
     args = parser.parse_args(argv)
+    check_folder(args.out, *OUTPUTS)  # a bad folder: exit 2, before the study is read
     drake_logging(args.verbose)  # before Drake is first imported
     study = study_of(args)
     config_yaml = None
@@ -183,5 +188,5 @@ def main(
         resolve = resolve or drake_side.resolve_study
     summary = run_experiment(settings, args.out, job=job, resolve=resolve, command=command)
     print(summary_markdown(summary), end="")
-    print(f"wrote {', '.join(str(Path(args.out) / name) for name in (RESULTS, CONFIG, RUN, *DERIVED))}")
+    print(f"wrote {', '.join(str(Path(args.out) / name) for name in OUTPUTS)}")
     return 0

@@ -21,6 +21,7 @@ from typing import NoReturn
 
 from hlp_drake import DRAKE_LOG, __version__
 from hlp_drake.errors import FormerName, HlpError
+from hlp_drake.files.atomic import output_streams
 from hlp_drake.models import SHIPPED_ROBOTS
 from hlp_drake.runtime.processes import Terminated, terminations_raised
 from hlp_drake.systems.names import EXECUTIONS, PERCEPTION_SOURCES, WORLDS
@@ -236,10 +237,11 @@ def _shown_as_note(show: Callable[..., None]) -> Callable[..., None]:
 
 def run_cli(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | None = None) -> int:
     """Run ``main(argv)``; print each problem of an ``HlpError`` as ``error: ...`` and return its
-    ``exit_status`` (2, or 1 for a ``StorageError``: the run failed); a Ctrl-C prints "interrupted"
+    ``exit_status`` (2, or 1 for a ``StorageError``: the run failed), standard output kept for an
+    output ``-`` (``output_streams``); a Ctrl-C prints "interrupted"
     and returns 130, a SIGTERM "terminated" and 143 (its workers stopped)."""
     try:
-        with terminations_raised(), warnings.catch_warnings():
+        with terminations_raised(), warnings.catch_warnings(), output_streams():
             warnings.simplefilter("once", FormerName)
             warnings.showwarning = _shown_as_note(warnings.showwarning)
             return main(argv)

@@ -12,14 +12,13 @@ from __future__ import annotations
 import time
 from collections import Counter
 from collections.abc import Sequence
-from pathlib import Path
 
 from hlp_drake.commands.parsing import add_quiet, make_parser
 from hlp_drake.dataset.dataset import Dataset
 from hlp_drake.dataset.records import STRUCTURED, UNSTRUCTURED, category_of
 from hlp_drake.errors import HlpError
 from hlp_drake.features import training_data
-from hlp_drake.files.atomic import check_writable
+from hlp_drake.files.atomic import check_folder
 from hlp_drake.learners import DEFAULT_PRESET, PRESETS, DecisionModels
 from hlp_drake.segmentation import DEFAULT_MODE, MODES, demonstration_records, segment_dataset
 
@@ -43,10 +42,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         help="the trials to learn from (default: structured and unstructured; faithful: structured)",
     )
     parser.add_argument("--subjects", nargs="+", help="train on these subjects only (default: all)")
-    parser.add_argument("--out", required=True, help="directory for models.json and models.npz")
+    parser.add_argument(
+        "--out",
+        required=True,
+        help="directory for models.json and models.npz, made if missing (its parent must exist)",
+    )
     add_quiet(parser)
     args = parser.parse_args(argv)
-    check_writable(Path(args.out) / "models.json", Path(args.out) / "models.npz")
+    check_folder(args.out, "models.json", "models.npz")
     dataset = Dataset(args.dataset)
     if args.subjects:
         unknown = sorted(set(args.subjects) - set(dataset.subjects))

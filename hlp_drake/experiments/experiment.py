@@ -32,11 +32,13 @@ from hlp_drake.experiments.results import START_OVER, ResultsFile, read_results,
 from hlp_drake.experiments.runner import Job, JobFunction, StudyResolver, make_jobs
 from hlp_drake.experiments.study import Study
 from hlp_drake.experiments.summary import summarise, write_summary
-from hlp_drake.files.atomic import check_writable, write_text_atomic
+from hlp_drake.files.atomic import check_folder, write_text_atomic
 from hlp_drake.runtime.terminal import bars_disabled
 
 RESULTS, CONFIG, RUN = "results.csv", "config.json", "run.json"
 DERIVED = ("summary.md", "summary.json", "success.png", "times.png")
+OUTPUTS = (RESULTS, CONFIG, RUN, *DERIVED)
+"""The files a run writes in its output folder."""
 MAX_RECORD_BYTES = 16 << 20
 """A larger ``config.json`` or ``run.json`` is refused (a run's are a few kB to a few MB)."""
 IDENTITY_LABELS = {"study": "grid or scenes", "scenario": "scenario"}
@@ -90,9 +92,7 @@ class ExperimentSettings:
 
 
 def _check_directory(out: Path, identity: dict[str, Any], fresh: bool) -> None:
-    """Refuse a directory that is not one, or that holds another run's results (unless ``fresh``)."""
-    if out.exists() and not out.is_dir():
-        raise HlpError(f"--out {out} is not a directory")
+    """Refuse a directory that holds another run's results (unless ``fresh``)."""
     if fresh:
         return
     config = out / CONFIG
@@ -185,7 +185,7 @@ def _run_record(
 
 def _prepare(out: Path, identity: dict[str, Any], fresh: bool) -> None:
     """Create the directory and record its identity; ``fresh`` removes the earlier run's outputs."""
-    out.mkdir(parents=True, exist_ok=True)
+    out.mkdir(exist_ok=True)  # its parent checked (check_folder), never made
     if fresh:
         for name in (RESULTS, *DERIVED):
             (out / name).unlink(missing_ok=True)
@@ -281,13 +281,12 @@ def run_experiment(
     if problems:
         raise HlpError(*problems)
     check_executor(settings.executor, settings.scheduler)
-    out, study = Path(out), settings.study
+    out, study = check_folder(out, *OUTPUTS), settings.study
     resolved = resolve(study, settings.config_yaml, single_process_rollouts=settings.parallel)
     jobs = make_jobs(study, resolved)
     identity = {"name": study.name, "study": study.identity(), "scenario": resolved.scenario}
     identity = json.loads(json.dumps(identity))  # as config.json holds it: lists, not tuples
     _check_directory(out, identity, settings.fresh)
-    check_writable(*(out / name for name in (RESULTS, CONFIG, RUN, *DERIVED)))
     cells = [astuple(cell.labels) for cell in resolved.cells]
     rows = [] if settings.fresh else read_results(out / RESULTS, study.generators, cells)
     results = ResultsFile(out / RESULTS, rows)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import numpy as np
 from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.gaussian_process import GaussianProcessRegressor
@@ -11,6 +13,7 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 from hlp_drake.learners.encoding import N_DIRECTIONS, check_categorical, expand_directions
 from hlp_drake.learners.inputs import prediction_input
 from hlp_drake.learners.kernel import distance_weights, gaussian_kernel
+from hlp_drake.learners.state import Spec
 
 CATEGORICAL = (4,)  # direction class index in Xa
 
@@ -29,6 +32,20 @@ class ArmRegressor(RegressorMixin, BaseEstimator):
     Inputs are standardised (the original did not; one shared length scale then weighs angles,
     displacements and one-hot classes alike). Saved as plain arrays; prediction is the GP mean.
     """
+
+    STATE: ClassVar[dict[str, Spec]] = {
+        "mean": ("float64", ("n_encoded",)),
+        "scale": ("float64", ("n_encoded",)),
+        "train": ("float64", ("n_samples", "n_encoded")),
+        "alpha": ("float64", ("n_outputs", "n_samples")),
+        "length_scale": ("float64", ("n_outputs",)),
+        "amplitude": ("float64", ("n_outputs",)),
+        "y_mean": ("float64", ("n_outputs",)),
+        "y_std": ("float64", ("n_outputs",)),
+        "outputs": ("int64", ()),
+    }
+    """The arrays of ``get_state``: dtype and shape (``n_encoded``: the features after one-hot
+    encoding)."""
 
     def __init__(
         self, max_samples: int = 1500, categorical: tuple[int, ...] = (), random_state: int = 0

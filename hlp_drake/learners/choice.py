@@ -24,6 +24,7 @@ from hlp_drake.learners.inputs import binary_classes, prediction_input, sample_w
 from hlp_drake.learners.kernel import distance_weights
 from hlp_drake.learners.novelty import SAMPLES as NOVELTY_SAMPLES
 from hlp_drake.learners.novelty import fit_novelty, novelty_score
+from hlp_drake.learners.state import Spec
 from hlp_drake.learners.svm import RbfSvmClassifier
 from hlp_drake.learners.trees import BoostedTrees, boosted_tree_arrays
 
@@ -43,6 +44,27 @@ class RowChoiceClassifier(ClassifierMixin, BaseEstimator):
         novelty_neighbours, novelty_quantile, novelty_samples: see ``learners.novelty``.
         random_state: seed of the subsamples and folds.
     """
+
+    NOVELTY: ClassVar[dict[str, Spec]] = {
+        "mean": ("float64", ("n_features",)),
+        "scale": ("float64", ("n_features",)),
+        "points": ("float64", ("n_points", "n_features")),
+        "neighbours": ("int64", ()),
+        "threshold": ("float64", ()),
+    }
+    """The novelty model's arrays (``novelty.*`` of ``get_state``): dtype and shape."""
+
+    @staticmethod
+    def state(learner: str) -> dict[str, Spec]:
+        """The arrays of ``get_state`` with the ``learner`` ("boosted" or "svm"): dtype and shape,
+        the row learner's and the novelty model's ``n_features`` one dimension."""
+        inner = BoostedTrees.STATE if learner == "boosted" else RbfSvmClassifier.STATE
+        return {
+            "classes": ("float64", (2,)),
+            "calibration": ("float64", (2,)),
+            **{f"learner.{name}": spec for name, spec in inner.items()},
+            **{f"novelty.{name}": spec for name, spec in RowChoiceClassifier.NOVELTY.items()},
+        }
 
     EXPECTED_FAILED_CHECKS: ClassVar[dict[str, str]] = {
         SAMPLE_WEIGHT_EQUIVALENCE: (

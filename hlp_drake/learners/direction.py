@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.svm import SVC
@@ -11,6 +13,7 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 from hlp_drake.learners.balance import oversample
 from hlp_drake.learners.encoding import check_categorical, expand_directions
 from hlp_drake.learners.inputs import prediction_input
+from hlp_drake.learners.state import Spec
 from hlp_drake.taskspace import DIRECTIONS
 
 CATEGORICAL = (8, 9)  # hand_to_object, object_to_target class indices in Xd
@@ -23,6 +26,14 @@ class DirectionClassifier(ClassifierMixin, BaseEstimator):
     Every class is oversampled to the largest; prediction is by one-vs-one votes (ties: the
     smaller class index).
     """
+
+    STATE: ClassVar[dict[str, Spec]] = {
+        "classes": ("float64", ("n_classes",)),
+        "coef": ("float64", ("n_pairs", "n_encoded")),
+        "intercept": ("float64", ("n_pairs",)),
+    }
+    """The arrays of ``get_state``: dtype and shape (``n_pairs``: the one-vs-one class pairs,
+    ``n_encoded``: the features after one-hot encoding)."""
 
     def __init__(self, C: float = 1.0, categorical: tuple[int, ...] = (), random_state: int = 0) -> None:
         self.C = C

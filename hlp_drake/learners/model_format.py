@@ -1,8 +1,10 @@
 """The model-file format as data: ``models.json``'s fields and every array of ``models.npz`` by
 name, dtype and shape, checked before any array is used.
 
-Shapes are written with symbols: a number is a fixed size, a name a size every array that uses it
-must share (``F`` the row-choice features, ``P`` the kept novelty points, ...). The npz members'
+Each learner declares its arrays (``STATE``: dtype and shape in its own dimensions, e.g. an SVM's
+``support_vectors``: ``(n_support, n_features)``; see ``learners.state``); a dimension is a number
+or a name every array of the learner that uses it must share, the feature code fixing some
+(``FIXED``). The npz members'
 headers are read first (within ``MAX_HEADER``), so a header declaring a huge array is refused
 before anything is allocated; then the values are checked (indices in range, scales positive, every number within ``MAX_VALUE``),
 and the sizes against the learner settings ``models.json`` declares (``check_declared``: e.g. as many
@@ -35,9 +37,14 @@ from hlp_drake.features.scene_features import GAP_FEATURES, OBJECT_FEATURES
 from hlp_drake.features.segment import SEGMENT_FEATURES
 from hlp_drake.files.documents import brief
 from hlp_drake.learners.arm import CATEGORICAL as ARM_CATEGORICAL
+from hlp_drake.learners.arm import ArmRegressor
+from hlp_drake.learners.choice import RowChoiceClassifier
 from hlp_drake.learners.direction import CATEGORICAL as DIRECTION_CATEGORICAL
+from hlp_drake.learners.direction import DirectionClassifier
 from hlp_drake.learners.encoding import N_DIRECTIONS
 from hlp_drake.learners.novelty import SAMPLES as NOVELTY_SAMPLES
+from hlp_drake.learners.state import Spec, prefixed
+from hlp_drake.learners.svm import RbfSvmClassifier
 from hlp_drake.learners.trees import LEAF
 
 if TYPE_CHECKING:
@@ -55,8 +62,6 @@ MAX_VALUE = 1e9
 """Largest magnitude of a stored number, and the inverse of the smallest scale (trained models
 stay within 1e5; beyond, z-scores and kernels overflow)."""
 
-Spec = tuple[str, tuple[int | str, ...]]
-
 
 def _encoded(features: int, categorical: int) -> int:
     """Columns after one-hot encoding ``categorical`` of ``features`` columns into directions."""
@@ -64,77 +69,31 @@ def _encoded(features: int, categorical: int) -> int:
 
 
 FIXED = {
-    "F": len(ROW_CHOICE_FEATURES),
-    "D": _encoded(len(DIRECTION_FEATURES), len(DIRECTION_CATEGORICAL)),
-    "Q": comb(N_DIRECTIONS, 2),  # the one-vs-one direction pairs
-    "C": N_DIRECTIONS,
-    "A": _encoded(len(ARM_FEATURES), len(ARM_CATEGORICAL)),
-    "O": 2,  # the arm's two angles
-    "Fg": len(GAP_FEATURES),
-    "Fo": len(OBJECT_FEATURES),
-    "Fs": len(SEGMENT_FEATURES),
+    "row.n_features": len(ROW_CHOICE_FEATURES),  # the row learner's and the novelty model's
+    "direction.n_encoded": _encoded(len(DIRECTION_FEATURES), len(DIRECTION_CATEGORICAL)),
+    "direction.n_pairs": comb(N_DIRECTIONS, 2),  # the one-vs-one direction pairs
+    "direction.n_classes": N_DIRECTIONS,
+    "arm.n_encoded": _encoded(len(ARM_FEATURES), len(ARM_CATEGORICAL)),
+    "arm.n_outputs": 2,  # the arm's two angles
+    "gap.n_features": len(GAP_FEATURES),
+    "object.n_features": len(OBJECT_FEATURES),
+    "segment.n_features": len(SEGMENT_FEATURES),
 }
-"""The sizes the feature code fixes (models of other sizes cannot plan)."""
-
-
-def _svm(prefix: str, features: str) -> dict[str, Spec]:
-    sv = f"S_{prefix}"
-    return {
-        f"{prefix}classes": ("float64", (2,)),
-        f"{prefix}mean": ("float64", (features,)),
-        f"{prefix}scale": ("float64", (features,)),
-        f"{prefix}gamma": ("float64", ()),
-        f"{prefix}support_vectors": ("float64", (sv, features)),
-        f"{prefix}dual_coef": ("float64", (sv,)),
-        f"{prefix}intercept": ("float64", ()),
-    }
-
-
-def _trees(prefix: str) -> dict[str, Spec]:
-    arrays: dict[str, Spec] = {
-        f"{prefix}{name}": (dtype, ("T", "N"))
-        for name, dtype in (
-            ("feature", "int32"),
-            ("threshold", "float64"),
-            ("left", "int32"),
-            ("right", "int32"),
-            ("value", "float64"),
-        )
-    }
-    return arrays | {f"{prefix}depth": ("int64", ()), f"{prefix}offset": ("float64", ())}
+"""The learners' dimensions the feature code fixes (models of other sizes cannot plan)."""
 
 
 def expected_arrays(planner: str, row_learner: str) -> dict[str, Spec]:
-    """Every array of a ``models.npz`` of ``planner`` ("rows" or "paper") by name: (dtype, shape)."""
+    """Every array of a ``models.npz`` of ``planner`` ("rows" or "paper") by name: (dtype, shape), as
+    each learner declares its arrays (``STATE``), its dimensions prefixed with its name."""
     arrays: dict[str, Spec] = {}
     if planner == "rows":
-        arrays |= {"row.classes": ("float64", (2,)), "row.calibration": ("float64", (2,))}
-        arrays |= _trees("row.learner.") if row_learner == "boosted" else _svm("row.learner.", "F")
-        arrays |= {
-            "row.novelty.mean": ("float64", ("F",)),
-            "row.novelty.scale": ("float64", ("F",)),
-            "row.novelty.points": ("float64", ("P", "F")),
-            "row.novelty.neighbours": ("int64", ()),
-            "row.novelty.threshold": ("float64", ()),
-        }
+        arrays |= prefixed("row.", RowChoiceClassifier.state(row_learner))
     else:
-        for name, features in (("gap", "Fg"), ("object", "Fo"), ("segment", "Fs")):
-            arrays |= _svm(f"{name}.", features)
-    arrays |= {
-        "direction.classes": ("float64", ("C",)),
-        "direction.coef": ("float64", ("Q", "D")),
-        "direction.intercept": ("float64", ("Q",)),
-    }
-    arrays |= {f"arm.{name}": ("float64", ("A",)) for name in ("mean", "scale")}
-    arrays |= {"arm.train": ("float64", ("M", "A")), "arm.alpha": ("float64", ("O", "M"))}
-    arrays |= {
-        f"arm.{name}": ("float64", ("O",)) for name in ("length_scale", "amplitude", "y_mean", "y_std")
-    }
-    arrays |= {
-        "arm.outputs": ("int64", ()),
-        "priors.start_arm": ("float64", (2,)),
-        "priors.link_lengths": ("float64", (2,)),
-    }
+        for name in ("gap", "object", "segment"):
+            arrays |= prefixed(f"{name}.", RbfSvmClassifier.STATE)
+    arrays |= prefixed("direction.", DirectionClassifier.STATE)
+    arrays |= prefixed("arm.", ArmRegressor.STATE)
+    arrays |= {"priors.start_arm": ("float64", (2,)), "priors.link_lengths": ("float64", (2,))}
     return arrays
 
 
@@ -158,17 +117,34 @@ def _header(member: Any) -> tuple[tuple[int, ...], np.dtype]:
 def _check_shape(
     name: str, spec: Spec, shape: tuple[int, ...], dtype: np.dtype, sizes: dict[str, int]
 ) -> None:
+    """Raise ``ValueError`` unless the array ``name`` has its learner's declared dtype and shape
+    (``spec``), its named dimensions bound in ``sizes`` (the first array to use one binds it)."""
     kind, dims = spec
     if dtype != np.dtype(kind):
         raise ValueError(f"array {name!r} has dtype {dtype}, the format has {kind}")
-    if len(shape) != len(dims):
-        raise ValueError(f"array {name!r} has shape {shape}, the format has {len(dims)} dimensions")
+    wanted = [dim if isinstance(dim, int) else sizes.get(dim) for dim in dims]
+    if len(shape) != len(dims) or any(w is not None and w != size for w, size in zip(wanted, shape)):
+        raise ValueError(f"array {name!r} has shape {shape}, expected {_declared(dims, sizes)}")
     for size, dim in zip(shape, dims):
-        want = dim if isinstance(dim, int) else sizes.setdefault(dim, size)
-        if size != want or size < 1:
-            raise ValueError(f"array {name!r} has shape {shape}, the format needs {dim} = {want}")
+        if size < 1:
+            raise ValueError(
+                f"array {name!r} has shape {shape}, expected {_declared(dims, sizes)}, none empty"
+            )
+        if isinstance(dim, str):
+            sizes.setdefault(dim, size)
     if int(np.prod(shape, dtype=np.int64)) * dtype.itemsize > MAX_ARRAY_BYTES:
         raise ValueError(f"array {name!r} of shape {shape} is larger than {MAX_ARRAY_BYTES // 2**20} MiB")
+
+
+def _declared(dims: tuple[int | str, ...], sizes: dict[str, int]) -> str:
+    """A declared shape as the learner names it, with the sizes known: ``(n_support, n_features=5)``."""
+    shown = [
+        str(dim)
+        if isinstance(dim, int)
+        else dim.rsplit(".", 1)[-1] + (f"={sizes[dim]}" if dim in sizes else "")
+        for dim in dims
+    ]
+    return f"({', '.join(shown)}{',' if len(shown) == 1 else ''})"
 
 
 def read_arrays(payload: bytes, expected: dict[str, Spec]) -> dict[str, np.ndarray]:
@@ -228,7 +204,7 @@ def check_values(arrays: dict[str, np.ndarray]) -> None:
         _range(name, arrays[name], 1 / MAX_VALUE, MAX_VALUE)
     if "row.learner.feature" in arrays:
         nodes = arrays["row.learner.feature"].shape[1]
-        _range("row.learner.feature", arrays["row.learner.feature"], 0, FIXED["F"] - 1)
+        _range("row.learner.feature", arrays["row.learner.feature"], 0, FIXED["row.n_features"] - 1)
         for side in ("left", "right"):
             _range(f"row.learner.{side}", arrays[f"row.learner.{side}"], LEAF, nodes - 1)
         if np.any((arrays["row.learner.left"] == LEAF) != (arrays["row.learner.right"] == LEAF)):
@@ -241,7 +217,7 @@ def check_values(arrays: dict[str, np.ndarray]) -> None:
     for name in [n for n in arrays if n.endswith("classes")]:
         if len(np.unique(arrays[name])) != len(arrays[name]):
             raise ValueError(f"array {name!r} repeats a class")
-    _range("arm.outputs", arrays["arm.outputs"], 0, FIXED["O"])
+    _range("arm.outputs", arrays["arm.outputs"], 0, FIXED["arm.n_outputs"])
 
 
 def check_declared(arrays: dict[str, np.ndarray], settings: LearnerSettings) -> None:

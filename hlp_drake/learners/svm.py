@@ -14,6 +14,7 @@ from hlp_drake.learners.balance import oversample
 from hlp_drake.learners.conformance import SAMPLE_WEIGHT_EQUIVALENCE
 from hlp_drake.learners.inputs import binary_classes, prediction_input, sample_weights
 from hlp_drake.learners.kernel import distance_weights, gaussian_kernel
+from hlp_drake.learners.state import Spec
 
 
 class RbfSvmClassifier(ClassifierMixin, BaseEstimator):
@@ -31,6 +32,17 @@ class RbfSvmClassifier(ClassifierMixin, BaseEstimator):
     The fitted model keeps only plain arrays (scaler, support vectors, dual coefficients), so
     ``decision_function`` is reproduced exactly from a saved file.
     """
+
+    STATE: ClassVar[dict[str, Spec]] = {
+        "classes": ("float64", (2,)),
+        "mean": ("float64", ("n_features",)),
+        "scale": ("float64", ("n_features",)),
+        "gamma": ("float64", ()),
+        "support_vectors": ("float64", ("n_support", "n_features")),
+        "dual_coef": ("float64", ("n_support",)),
+        "intercept": ("float64", ()),
+    }
+    """The arrays of ``get_state``: dtype and shape."""
 
     EXPECTED_FAILED_CHECKS: ClassVar[dict[str, str]] = {
         SAMPLE_WEIGHT_EQUIVALENCE: (

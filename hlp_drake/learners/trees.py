@@ -7,8 +7,12 @@ and predict the same on any scikit-learn version.
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import numpy as np
 from sklearn.ensemble import GradientBoostingClassifier
+
+from hlp_drake.learners.state import Spec
 
 LEAF = -1  # child index of a leaf (scikit-learn's TREE_LEAF)
 
@@ -51,6 +55,17 @@ class BoostedTrees:
     The nodes are laid out flat (node k of tree t at t * nodes + k), a leaf's children pointing at
     itself, so every row walks the full depth in a few array operations.
     """
+
+    STATE: ClassVar[dict[str, Spec]] = {
+        "feature": ("int32", ("n_trees", "n_nodes")),
+        "threshold": ("float64", ("n_trees", "n_nodes")),
+        "left": ("int32", ("n_trees", "n_nodes")),
+        "right": ("int32", ("n_trees", "n_nodes")),
+        "value": ("float64", ("n_trees", "n_nodes")),
+        "depth": ("int64", ()),
+        "offset": ("float64", ()),
+    }
+    """The arrays of ``boosted_tree_arrays``: dtype and shape."""
 
     def __init__(self, arrays: dict[str, np.ndarray]) -> None:
         self.arrays = arrays

@@ -16,7 +16,7 @@ import yaml
 
 from hlp_drake.config.typed_yaml import load_typed
 from hlp_drake.errors import SceneError
-from hlp_drake.files.atomic import write_text_atomic
+from hlp_drake.files.atomic import is_stdout, write_text_atomic
 from hlp_drake.files.documents import parse_json, parse_yaml, read_document
 from hlp_drake.scene.constants import DEFAULT_SCENE_FILE
 from hlp_drake.scene.model import Scene, SceneObject
@@ -103,9 +103,10 @@ def load_scene(path: str | os.PathLike[str]) -> Scene:
 
 
 def save_scene(scene: Scene, path: str | os.PathLike[str]) -> None:
-    """Validate ``scene`` and write it atomically as YAML or JSON (by extension)."""
+    """Validate ``scene`` and write it atomically as YAML or JSON (by extension; ``-``: YAML on
+    standard output)."""
     path = Path(path)
-    suffix = _suffix(path)
+    suffix = YAML_SUFFIXES[0] if is_stdout(path) else _suffix(path)
     validate_scene(scene)
     write_text_atomic(path, scene_to_text(scene, json_format=suffix in JSON_SUFFIXES))
 

@@ -108,7 +108,8 @@ def test_outputs_that_cannot_be_written_are_refused_before_any_work(tmp_path):
 
     a_file = tmp_path / "a_file"
     a_file.write_text("x")
-    check_writable(None, tmp_path / "new" / "er" / "out.json")  # folders made at the end, not now
+    with pytest.raises(HlpError, match="the folder .*new/er does not exist"):  # never made
+        check_writable(None, tmp_path / "new" / "er" / "out.json")
     assert sorted(tmp_path.rglob("*")) == [a_file]
     with pytest.raises(HlpError) as info:
         check_writable(tmp_path, a_file / "out.json", tmp_path / "fine.json", a_file / "out.npz")

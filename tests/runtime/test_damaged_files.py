@@ -16,6 +16,7 @@ from hlp_drake.commands.parsing import run_cli
 from hlp_drake.errors import ModelError
 from hlp_drake.learners.bundled import BUNDLED_DIRECTORY
 from hlp_drake.learners.models import VERSION, DecisionModels
+from hlp_drake.learners.svm import RbfSvmClassifier
 
 
 def models_copy(folder: pathlib.Path, *, meta=None, arrays=None) -> pathlib.Path:
@@ -128,3 +129,58 @@ def test_damaged_interaction_logs_are_reported_per_trial_and_left_out(tmp_path, 
     assert capsys.readouterr().err == (
         f"error: sub_01/T010 was left out of the dataset: {log_of(folder, 10)}: {expected[log_of(folder, 10)]}\n"
     )
+
+
+def paper_arrays(arrays: dict) -> None:
+    """The bundled rows models' arrays made a paper planner's: small SVMs for Cg, Co and Cc."""
+    from hlp_drake.learners.model_format import FIXED
+
+    for name in [n for n in arrays if n.startswith("row.")]:
+        del arrays[name]
+    for learner in ("gap", "object", "segment"):
+        features = FIXED[f"{learner}.n_features"]
+        arrays |= {
+            f"{learner}.classes": np.array([0.0, 1.0]),
+            f"{learner}.mean": np.zeros(features),
+            f"{learner}.scale": np.ones(features),
+            f"{learner}.gamma": np.array(1.0),
+            f"{learner}.support_vectors": np.linspace(-1.0, 1.0, 4 * features).reshape(4, features),
+            f"{learner}.dual_coef": np.array([1.0, -1.0, 0.5, -0.5]),
+            f"{learner}.intercept": np.array(0.0),
+        }
+
+
+def as_paper(meta: dict) -> None:
+    meta["settings"]["planner"] = "paper"
+
+
+@pytest.mark.parametrize(
+    ("array", "value", "expected"),
+    [
+        ("gap.support_vectors", np.array([1.0, 2.0, 3.0]), "(n_support, n_features=5)"),
+        ("segment.dual_coef", np.ones((4, 2)), "(n_support=4,)"),
+        ("arm.alpha", np.ones(3), "(n_outputs=2, n_samples="),
+    ],
+)
+def test_an_array_not_of_its_learners_declared_shape_is_refused_naming_both_shapes(
+    tmp_path, capsys, array, value, expected
+):
+    from hlp_drake.commands.run_scene import main
+
+    DecisionModels.load(models_copy(tmp_path / "paper", meta=as_paper, arrays=paper_arrays))  # loads
+    assert RbfSvmClassifier.STATE["support_vectors"] == ("float64", ("n_support", "n_features"))
+
+    def damaged(arrays: dict) -> None:
+        paper_arrays(arrays)
+        arrays[array] = value
+
+    folder = models_copy(tmp_path / "damaged", meta=as_paper, arrays=damaged)  # re-signed: checksum fits
+    with pytest.raises(ModelError) as refused:
+        DecisionModels.load(folder)
+    (problem,) = refused.value.problems
+    assert problem.startswith(f"{folder / 'models.npz'}: array '{array}' has shape {value.shape}, expected ")
+    assert expected in problem
+    config = tmp_path / "scenario.yaml"
+    config.write_text(f"planner: {{models: {folder}}}\n")
+    assert run_cli(main, ["--config", str(config), "--workers", "1", "--quiet"]) == 2
+    assert capsys.readouterr().err == f"error: {problem}\n"

@@ -20,6 +20,7 @@ from contextvars import ContextVar
 from typing import NoReturn
 
 from hlp_drake import DRAKE_LOG, __version__
+from hlp_drake.config.ranges import MAX_SEED
 from hlp_drake.errors import FormerName, HlpError
 from hlp_drake.models import SHIPPED_ROBOTS
 from hlp_drake.runtime.processes import Terminated, terminations_raised
@@ -95,6 +96,22 @@ def integer(low: int, high: int) -> Callable[[str], int]:
         return value
 
     parse.__name__ = "integer"
+    return parse
+
+
+def seconds(high: float) -> Callable[[str], float]:
+    """An argparse ``type``: a number of seconds in [0, high] (else a one-line usage error)."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text[:40]!r}") from None
+        if not 0.0 <= value <= high:  # also refuses nan
+            raise argparse.ArgumentTypeError(f"must be between 0 and {high:g} s, got {text[:40]}")
+        return value
+
+    parse.__name__ = "seconds"
     return parse
 
 
@@ -195,7 +212,7 @@ def add_conditions(parser: argparse.ArgumentParser, *, several: bool = False) ->
     )
     parser.add_argument(
         "--uncertainty",
-        type=int,
+        type=integer(0, MAX_SEED),
         nargs="?",
         const=0,
         metavar="SEED",

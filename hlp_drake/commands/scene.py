@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 from hlp_drake.commands.parsing import add_robot_option, integer, make_parser
 from hlp_drake.config.ranges import MAX_SEED
 from hlp_drake.files.atomic import check_writable
+from hlp_drake.runtime.terminal import counted
 from hlp_drake.scene.generators import KINDS, MAX_GENERATED, generate_scene
 from hlp_drake.scene.io import load_scene, save_scene
 from hlp_drake.scene.rows import find_rows
@@ -55,7 +56,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         workspace = None if robot is None else robot.workspace  # a fixed robot's tables within its reach
         scene = generate_scene(args.kind, args.seed, args.objects, workspace)
         save_scene(scene, args.out)
-        print(f"wrote {args.out}: {scene.name}, {len(scene.obstacles)} obstacles")
+        print(f"wrote {args.out}: {scene.name}, {counted(len(scene.obstacles), 'obstacle')}")
     elif args.command == "show":
         from hlp_drake.scene.plot import save_scene_png
 
@@ -69,7 +70,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     else:
         scene = load_scene(args.file)
         rows = find_rows(scene)
-        print(f"{args.file}: valid ({len(scene.obstacles)} obstacles in {len(rows)} rows)")
+        print(
+            f"{args.file}: valid ({counted(len(scene.obstacles), 'obstacle')} in {counted(len(rows), 'row')})"
+        )
     return 0
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 from dataclasses import replace
 
 import pytest
@@ -72,7 +73,7 @@ def test_run_scene_end_to_end_json_and_html(tmp_path):
         f"robot {MOBILE_UR5.name}, initialiser hlp, low-level planner sto, execution open, model error none, "
     )
     line += "perception truth, world reference, scenario built-in default"
-    assert f"run: {line}\n" in result.stdout and f"ran: {line}\n" in result.stdout
+    assert result.stdout.count(f"run: {line}\n") == 1 and "ran: " not in result.stdout  # said once
     verdicts = [v for v in result.stdout.splitlines() if v.startswith("verdict: ")]
     assert len(verdicts) == 1 and verdicts[0].startswith(
         "verdict: reach success in the reference world (the paper's criterion, exit status 0); the planner's "
@@ -256,7 +257,7 @@ def test_a_run_logged_to_a_file_has_one_line_per_stage_and_no_carriage_returns(t
         ).returncode
     text = log.read_text()
     assert code == 0 and "\r" not in text and "INFO:drake" not in text, text
-    stages = ("scene ", "run: ", "plan: ", "IK: ", "optimise: ", "execute: ", "ran: ", "verdict: ")
+    stages = ("scene ", "run: ", "plan: ", "IK: ", "optimise: ", "execute: ", "timings: ", "verdict: ")
     lines = text.splitlines()
     found = [next(i for i, line in enumerate(lines) if line.startswith(stage)) for stage in stages]
     assert found == sorted(found), text
@@ -282,11 +283,35 @@ def test_progress_bars_only_on_a_terminal():
         listener.simulated(0.5)
         listener.close()
         assert ("\r" in stream.getvalue()) == bars
+    stream = Terminal()
+    listener = ProgressListener(stream=stream)
+    listener.optimising("sto")
+    listener.rollout(SimpleNamespace(cost=1.0))
+    listener.close()
+    shown = stream.getvalue()
+    assert "optimise: 0 rollouts [00:00, ? rollouts/s]" in shown and "0rollout" not in shown, shown
     quiet = Terminal()
     listener = ProgressListener(quiet=True, stream=quiet)
     listener.optimising("sto")
     listener.close()
     assert quiet.getvalue() == ""
+
+
+def test_counts_are_said_in_the_singular_for_one():
+    from types import SimpleNamespace
+
+    from hlp_drake.commands.progress import ProgressListener
+    from hlp_drake.runtime.terminal import counted
+
+    assert [counted(n, "obstacle") for n in (0, 1, 6)] == ["0 obstacles", "1 obstacle", "6 obstacles"]
+    lines = []
+    listener = ProgressListener(quiet=True)
+    listener._line = lines.append
+    listener.optimising("sto")
+    listener.optimised(
+        SimpleNamespace(success=True, failure_reason=None, iterations=1, rollouts=1, optimise_s=0.5)
+    )
+    assert lines == ["optimise: success after 1 iteration, 1 rollout (0.5 s)"]
 
 
 def test_quiet_and_verbose_are_exclusive():
@@ -322,11 +347,70 @@ def test_run_scene_rejects_a_bad_execution_or_uncertainty_seed(tmp_path):
     out = tmp_path / "run.json"
     for args, problem in (
         (["--execution", "half"], "invalid choice: 'half'"),
-        (["--uncertainty", "x"], "invalid int value: 'x'"),
+        (["--uncertainty", "x"], "argument --uncertainty: expected an integer, got 'x'"),
     ):
         result = run_module("hlp_drake.run_scene", *args, "--json", str(out))
         assert result.returncode == 2 and problem in result.stderr and "Traceback" not in result.stderr
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "args, problem",
+    [
+        (["--robot", "nosuch"], "robot 'nosuch': not a shipped robot"),
+        (["--uncertainty", "-1"], "argument --uncertainty: must be between 0 and"),  # the flag, not the field
+        (["--kind", "gen1", "--robot", "nosuch"], "robot 'nosuch'"),
+        (["--meshcat-wait", "0"], "give --meshcat too"),
+        (["--meshcat", "--meshcat-wait", "-1"], "argument --meshcat-wait: must be between 0"),
+    ],
+)
+def test_bad_input_is_refused_before_any_line_is_printed(args, problem):
+    result = run_module("hlp_drake.run_scene", *args)
+    assert result.returncode == 2 and result.stdout == "", result.stdout
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ") and problem in lines[0], result.stderr
+
+
+def test_meshcat_serves_until_ctrl_c_or_as_long_as_meshcat_wait_says():
+    from hlp_drake.commands.run_scene import serve
+
+    slept = []
+
+    def sleep(seconds):
+        slept.append(seconds)
+        if len(slept) == 3:
+            raise KeyboardInterrupt  # Ctrl-C ends the wait, quietly
+
+    serve(0, 1.0, sleep=sleep)
+    assert slept == []
+    serve(2.5, 1.0, sleep=sleep)
+    assert slept == [2.5]
+    slept.clear()
+    serve(None, 1.0, sleep=sleep)  # until Ctrl-C
+    assert slept == [1.0, 1.0, 1.0]
+
+
+def test_meshcat_wait_0_ends_the_run_at_once():
+    import subprocess
+    import sys
+
+    args = ["--meshcat", "--meshcat-wait", "0", "--world", "model", "--workers", "1", "--quiet"]
+    result = subprocess.run(
+        [sys.executable, "-m", "hlp_drake.run_scene", *args],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "DRAKE_ALLOW_NETWORK": "meshcat"},
+        timeout=300,  # serving until Ctrl-C would time out
+        check=False,
+    )
+    if "MeshCat" in result.stderr and result.returncode == 2:
+        pytest.skip(f"MeshCat did not start here: {result.stderr}")
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.splitlines()
+    assert lines[0].startswith("scene default") and lines[0].endswith(": 6 obstacles"), result.stdout
+    assert sum(line.startswith(("run: ", "ran: ")) for line in lines) == 1  # what runs, said once
+    assert not re.search(r"\b1 (rollouts|iterations|obstacles)\b", result.stdout), result.stdout
+    assert lines[-1].endswith("MeshCat stops now (--meshcat-wait 0)"), result.stdout
 
 
 def test_run_scene_rejects_a_bad_worker_count(tmp_path):

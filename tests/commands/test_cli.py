@@ -30,20 +30,19 @@ def test_help_is_plain_text_and_every_command_has_a_version(module, capsys):
     assert __version__ in capsys.readouterr().out
 
 
-@pytest.mark.parametrize(
-    "module",
-    [
-        "hlp_drake.commands.run_scene",
-        "hlp_drake.commands.experiments",
-        "hlp_drake.commands.train",
-        "hlp_drake.commands.evaluate",
-        "hlp_drake.commands.segment",
-    ],
-)
-def test_long_commands_take_quiet(module, capsys):
-    with pytest.raises(SystemExit):
-        importlib.import_module(module).main(["--help"])
-    assert "--quiet" in capsys.readouterr().out
+SUBCOMMANDS = {"scene": ("generate", "show", "validate"), "dataset": ("summary",)}
+WITH_CONFIG = ("run-scene", "experiments", "scene")
+"""The commands that take a scenario (--config); the others read the VR dataset."""
+
+
+@pytest.mark.parametrize("command", sorted(COMMANDS))
+def test_every_command_takes_quiet_and_those_that_run_a_scenario_take_config(command, capsys):
+    for sub in SUBCOMMANDS.get(command, ("",)):
+        with pytest.raises(SystemExit):
+            command_main(command)([sub, "--help"] if sub else ["--help"])
+        text = capsys.readouterr().out
+        assert "--quiet" in text, (command, sub)
+        assert ("--config" in text) == (command in WITH_CONFIG), (command, sub)
 
 
 def test_hlp_drake_dispatches_to_the_commands(capsys):

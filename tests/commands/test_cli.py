@@ -47,7 +47,13 @@ def test_every_command_takes_quiet_and_those_that_run_a_scenario_take_config(com
 
 def test_hlp_drake_dispatches_to_the_commands(capsys):
     assert main(["--version"]) == 0 and capsys.readouterr().out.strip() == f"hlp-drake {__version__}"
-    assert main([]) == 2 and "run-scene" in capsys.readouterr().out
+    assert main(["--help"]) == 0 and "run-scene" in capsys.readouterr().out
+    # No command: a usage error as `scene` without its subcommand gives (stderr, exit status 2).
+    assert main([]) == 2
+    assert capsys.readouterr() == (
+        "",
+        "error: the following arguments are required: command (see hlp-drake --help)\n",
+    )
     assert main(["fly"]) == 2 and "unknown command 'fly'" in capsys.readouterr().err
     assert main(["scene", "validate", "missing.yaml"]) == 2
     assert capsys.readouterr().err.strip() == "error: missing.yaml: no such file"

@@ -79,6 +79,12 @@ def make_parser(prog: str, doc: str | None, **kwargs) -> Parser:
     return parser
 
 
+DATASET_DEFAULT = (
+    "(default: $HLP_DATASET, paths joined by ':'; else, in a source checkout, ../shared/data beside the "
+    "project folder, the one holding pyproject.toml and hlp_drake/)"
+)
+"""How ``--dataset``'s help says where the dataset is read from without it (``default_dataset``)."""
+
 MAX_WORKERS = 64
 """Most worker processes a command starts."""
 

@@ -1,7 +1,7 @@
 """Your own robot: write a small 6-DOF arm (URDF) and its description (YAML), then run it.
 
     python examples/own_robot.py --out my_robot
-    python -m hlp_drake.run_scene --robot my_robot/arm6.yaml --kind gen1 --seed 3
+    python -m hlp_drake.run_scene --robot my_robot/arm6.yaml --kind gen1 --seed 4
 
 The arm stands on a pedestal in front of the table: a shoulder turning about z, two pitching joints
 (upper arm and forearm 0.45 m each), a spherical wrist (roll, pitch, roll) and a two-finger gripper

@@ -2,6 +2,9 @@
 
     hlp-drake COMMAND [ARGS ...]      (or: python -m hlp_drake COMMAND [ARGS ...])
 
+Without a command it is a usage error, as for the commands that take a subcommand (scene, dataset):
+one error: line on stderr and exit status 2; --help prints this help on stdout (exit status 0).
+
 Commands (each takes --help; the same as python -m hlp_drake.MODULE):
     run-scene     plan a scene (initialiser, low-level planner) and run it in Drake (python -m hlp_drake.run_scene)
     scene         generate, validate and draw scene files (python -m hlp_drake.scene)
@@ -30,9 +33,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run ``hlp-drake``'s command ``argv[0]`` with the rest of ``argv``."""
     args = list(sys.argv[1:] if argv is None else argv)
     name = PYTHON_M if argv is None and Path(sys.argv[0]).name == "__main__.py" else PROG
-    if not args or args[0] in ("-h", "--help"):
+    if not args:  # as a command without its required argument: one line, exit status 2
+        print(f"error: the following arguments are required: command (see {name} --help)", file=sys.stderr)
+        return 2
+    if args[0] in ("-h", "--help"):
         print(plain(__doc__).strip())
-        return 0 if args else 2
+        return 0
     if args[0] == "--version":
         print(f"{name} {__version__}")
         return 0

@@ -7,7 +7,7 @@ import sys
 from collections.abc import Sequence
 from typing import Any
 
-from hlp_drake.commands.parsing import make_parser
+from hlp_drake.commands.parsing import DATASET_DEFAULT, add_quiet, make_parser
 from hlp_drake.dataset.dataset import Dataset
 from hlp_drake.dataset.records import CATEGORIES
 from hlp_drake.files.atomic import check_writable, write_text_atomic
@@ -47,13 +47,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = make_parser("python -m hlp_drake.dataset", __doc__)
     commands = parser.add_subparsers(dest="command", required=True)
     summary = commands.add_parser("summary", help="trial and success counts per category")
-    summary.add_argument(
-        "--dataset", help="the archive or the unpacked dataset/ folder (default: $HLP_DATASET)"
-    )
+    summary.add_argument("--dataset", help="the archive or the unpacked dataset/ folder " + DATASET_DEFAULT)
     summary.add_argument("--json", help="also write the summary as JSON to this file")
+    add_quiet(summary)
     args = parser.parse_args(argv)
     check_writable(args.json)  # a bad path: exit 2, before the dataset is read
-    dataset = Dataset(args.dataset)
+    dataset = Dataset(args.dataset, progress=not args.quiet)
     result = summarise(dataset)
     for problem in result["problems"]:
         print(f"warning: {problem['path']}: {problem['reason']}", file=sys.stderr)

@@ -23,7 +23,7 @@ from functools import partial
 
 from tqdm import tqdm
 
-from hlp_drake.commands.parsing import MAX_WORKERS, Parser, add_quiet, integer, make_parser
+from hlp_drake.commands.parsing import DATASET_DEFAULT, MAX_WORKERS, Parser, add_quiet, integer, make_parser
 from hlp_drake.config.ranges import MAX_SEED
 from hlp_drake.dataset.dataset import Dataset
 from hlp_drake.dataset.records import STRUCTURED, UNSTRUCTURED, category_of
@@ -85,7 +85,7 @@ def _jobs(
 def _parser() -> Parser:
     """The command line of ``python -m hlp_drake.evaluate``."""
     parser = make_parser("python -m hlp_drake.evaluate", __doc__)
-    parser.add_argument("--dataset", help="the dataset: archives or folders (default: $HLP_DATASET)")
+    parser.add_argument("--dataset", help="the dataset: archives or folders " + DATASET_DEFAULT)
     parser.add_argument("--protocol", choices=PROTOCOLS, default="80_20")
     parser.add_argument(
         "--splits", type=integer(1, 1000), default=5, help="random subject splits per size (default 5)"

@@ -28,6 +28,7 @@ import sys
 from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from hlp_drake.commands.parsing import (
     MAX_WORKERS,
@@ -39,13 +40,12 @@ from hlp_drake.commands.parsing import (
 )
 from hlp_drake.config.ranges import MAX_SEED, config_problems
 from hlp_drake.errors import HlpError
-from hlp_drake.experiments.executors import EXECUTORS
-from hlp_drake.experiments.experiment import OUTPUTS, ExperimentSettings, run_experiment
-from hlp_drake.experiments.runner import JobFunction, StudyResolver
-from hlp_drake.experiments.study import MAX_SCENES, Study, bundled_studies, load_study
-from hlp_drake.experiments.summary import summary_markdown
+from hlp_drake.experiments.study import EXECUTORS, MAX_SCENES, Study, bundled_studies, load_study
 from hlp_drake.files.atomic import check_folder
-from hlp_drake.scene.generators import MAX_GENERATED
+from hlp_drake.scene.constants import MAX_GENERATED
+
+if TYPE_CHECKING:
+    from hlp_drake.experiments.runner import JobFunction, StudyResolver
 
 PROG = "python -m hlp_drake.experiments"
 OVERRIDES = {
@@ -162,8 +162,13 @@ def main(
     e.g. in tests."""
     parser = _parser()
     args = parser.parse_args(argv)
-    check_folder(args.out, *OUTPUTS)  # a bad folder: exit 2, before the study is read
     drake_logging(args.verbose)  # before Drake is first imported
+    # Imported once the arguments are good: --help and a usage error need none of them.
+    from hlp_drake.experiments.experiment import OUTPUTS, ExperimentSettings, run_experiment
+    from hlp_drake.experiments.summary import summary_markdown
+
+    check_folder(args.out, *OUTPUTS)  # a bad folder: exit 2, before the study is read
+
     study = study_of(args)
     config_yaml = None
     if args.config:

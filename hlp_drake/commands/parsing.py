@@ -20,6 +20,7 @@ from contextvars import ContextVar
 from typing import NoReturn
 
 from hlp_drake import DRAKE_LOG, __version__
+from hlp_drake.config.ranges import MAX_SEED
 from hlp_drake.errors import FormerName, HlpError
 from hlp_drake.files.atomic import output_streams
 from hlp_drake.models import SHIPPED_ROBOTS
@@ -79,6 +80,12 @@ def make_parser(prog: str, doc: str | None, **kwargs) -> Parser:
     return parser
 
 
+DATASET_DEFAULT = (
+    "(default: $HLP_DATASET, paths joined by ':'; else, in a source checkout, ../shared/data beside the "
+    "project folder, the one holding pyproject.toml and hlp_drake/)"
+)
+"""How ``--dataset``'s help says where the dataset is read from without it (``default_dataset``)."""
+
 MAX_WORKERS = 64
 """Most worker processes a command starts."""
 
@@ -96,6 +103,22 @@ def integer(low: int, high: int) -> Callable[[str], int]:
         return value
 
     parse.__name__ = "integer"
+    return parse
+
+
+def seconds(high: float) -> Callable[[str], float]:
+    """An argparse ``type``: a number of seconds in [0, high] (else a one-line usage error)."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text[:40]!r}") from None
+        if not 0.0 <= value <= high:  # also refuses nan
+            raise argparse.ArgumentTypeError(f"must be between 0 and {high:g} s, got {text[:40]}")
+        return value
+
+    parse.__name__ = "seconds"
     return parse
 
 
@@ -196,7 +219,7 @@ def add_conditions(parser: argparse.ArgumentParser, *, several: bool = False) ->
     )
     parser.add_argument(
         "--uncertainty",
-        type=int,
+        type=integer(0, MAX_SEED),
         nargs="?",
         const=0,
         metavar="SEED",

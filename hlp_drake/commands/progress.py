@@ -15,7 +15,7 @@ from typing import TextIO
 
 from tqdm import tqdm
 
-from hlp_drake.runtime.terminal import is_terminal
+from hlp_drake.runtime.terminal import counted, is_terminal
 from hlp_drake.systems.low_level.registry import LowLevelEntry, low_level_entry
 
 
@@ -80,7 +80,7 @@ class ProgressListener:
 
     def perceived(self, perception, seconds: float) -> None:
         if perception.ok:
-            what = f"{len(perception.objects)} objects, the target {perception.objects[0].name}"
+            what = f"{counted(len(perception.objects), 'object')}, the target {perception.objects[0].name}"
         else:
             what = f"failed: {perception.reason}"
         self._line(
@@ -111,7 +111,7 @@ class ProgressListener:
 
     def optimising(self, low_level: str) -> None:
         self._entry = low_level_entry(low_level)
-        self._open(desc=self._entry.step, unit="rollout")
+        self._open(desc=self._entry.step, unit=" rollouts")  # "optimise: 3 rollouts [00:01, 2.50 rollouts/s]"
         self._optimising = True
 
     def rollout(self, outcome) -> None:
@@ -124,7 +124,7 @@ class ProgressListener:
         self._optimising = False
         verdict = "success" if result.success else f"no success ({result.failure_reason})"
         entry = self._entry
-        spent = f" after {result.iterations} iterations, {result.rollouts} rollouts"
+        spent = f" after {counted(result.iterations, 'iteration')}, {counted(result.rollouts, 'rollout')}"
         spent = spent if entry is None or entry.rolls_out else ""
         self._line(f"{entry.step if entry else 'low-level'}: {verdict}{spent} ({result.optimise_s:.1f} s)")
 

@@ -2,7 +2,7 @@
 
     python -m hlp_drake.run_scene [--scene FILE | --kind vr|gen1|gen2|unstructured --seed N [--objects K]]
         [--planner hlp|line] [--low-level sto] [--perception truth|camera] [--config SCENARIO.yaml]
-        [--workers N] [--meshcat] [--html FILE] [--contact-forces] [--execution open|closed]
+        [--workers N] [--meshcat [--meshcat-wait SECONDS]] [--html FILE] [--contact-forces] [--execution open|closed]
         [--uncertainty [SEED]] [--json FILE] [--quiet | --verbose]
 
 With no arguments it runs the bundled default scene with the bundled models. --planner picks the
@@ -16,6 +16,9 @@ execution mode, model error, perception source and scenario file), each stage is
 happens (plan, IK, the optimiser's rollouts, the execution's simulated time), then a summary ending
 in one verdict line: the paper's reach success (the target in the gripper's pre-grasp region, no
 object off the table), the grasp beside it.
+
+With --meshcat, MeshCat keeps serving the run after it ends, until Ctrl-C: a script that must
+go on gives --meshcat-wait SECONDS (0: end at once; N: serve N s more, then end).
 
 Exit status: 0 when the reach succeeded, whether or not the grasp then held (the grasp is reported,
 not part of success); 1 when it failed (the verdict line says why); 2 on bad input; 130 when
@@ -38,15 +41,19 @@ from hlp_drake.commands.parsing import (
     drake_logging,
     integer,
     make_parser,
+    seconds,
 )
 from hlp_drake.config.ranges import MAX_SEED
 from hlp_drake.config.what_ran import WhatRan
 from hlp_drake.errors import InstallError
 from hlp_drake.files.atomic import check_writable, write_text_atomic
+from hlp_drake.runtime.terminal import counted
 from hlp_drake.scene.constants import DEFAULT_SCENE_FILE, KINDS, MAX_GENERATED
 
 DEFAULT_SCENE = DEFAULT_SCENE_FILE
 PROG = "python -m hlp_drake.run_scene"
+MAX_MESHCAT_WAIT = 7 * 24 * 3600.0
+"""Longest --meshcat-wait, in seconds (a week)."""
 INITIALISER_NAMES = {"hlp": "human-like", "line": "straight-line"}
 """The initialisers as the recording's heading names them."""
 
@@ -96,14 +103,15 @@ def recording_title(result, ran: WhatRan) -> str:
     return f"scene {result.scene.name}, {planners} {seen}: {reach}{held}"
 
 
-def summary(result, ran: WhatRan | None = None) -> str:
-    """The run's summary: what ran (``ran``), timings, the objects moved and dropped, the verdict."""
+def summary(result) -> str:
+    """The run's summary: timings, the objects moved and dropped, the verdict (what ran is the
+    header's ``run:`` line, printed before the run)."""
     t = result.timings
     start = (result.optimisation or {}).get("start", 0)
     alternative = f", from the planner's alternative {start}" if start else ""
     optimiser = (
-        f"optimise {t['optimise_s']:.1f} s ({result.iterations} iterations, "
-        f"{result.rollouts} rollouts{alternative})"
+        f"optimise {t['optimise_s']:.1f} s ({counted(result.iterations, 'iteration')}, "
+        f"{counted(result.rollouts, 'rollout')}{alternative})"
         if result.rollouts
         else "not optimised"
     )
@@ -118,11 +126,10 @@ def summary(result, ran: WhatRan | None = None) -> str:
     loop = result.closed_loop
     if loop:
         optimiser += (
-            f"; closed loop: {loop['replans']} re-optimisations, {loop['rollouts']} rollouts, "
-            f"{loop['on_track']} periods on track"
+            f"; closed loop: {counted(loop['replans'], 're-optimisation')}, "
+            f"{counted(loop['rollouts'], 'rollout')}, {counted(loop['on_track'], 'period')} on track"
         )
-    lines = [f"ran: {ran.line()}"] if ran is not None else []
-    lines += [
+    lines = [
         (
             f"timings: plan {t['plan_s']:.3f} s, IK {t['ik_s']:.2f} s, {optimiser}, execute {t['execute_s']:.1f} s "
             f"({result.simulated_s:.1f} s simulated), total {t['total_s']:.1f} s"
@@ -162,7 +169,17 @@ def _parser():
         help="rollout processes of a low-level planner that rolls out (default: the scenario's, 2)",
     )
     parser.add_argument(
-        "--meshcat", action="store_true", help="show the run live in MeshCat (prints the URL)"
+        "--meshcat",
+        action="store_true",
+        help="show the run live in MeshCat (prints the URL); MeshCat keeps serving after the run until "
+        "Ctrl-C unless --meshcat-wait says otherwise",
+    )
+    parser.add_argument(
+        "--meshcat-wait",
+        type=seconds(MAX_MESHCAT_WAIT),
+        metavar="SECONDS",
+        help="with --meshcat: serve the finished run this long, then end (0: end at once; default: "
+        "until Ctrl-C)",
     )
     parser.add_argument("--html", metavar="FILE", help="write a self-contained MeshCat recording of the run")
     parser.add_argument("--contact-forces", action="store_true", help="draw the contact forces in MeshCat")
@@ -177,36 +194,57 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.kind is None and (args.seed is not None or args.objects is not None):
         parser.error("--seed and --objects describe a generated scene: give its --kind too")
+    if args.meshcat_wait is not None and not args.meshcat:
+        parser.error("--meshcat-wait is how long --meshcat serves after the run: give --meshcat too")
     check_writable(args.json, args.html)
-    scenario = _scenario(args)
+    scenario = _scenario(args)  # every input checked before the first line is printed
     from hlp_drake.systems.execution.result import what_ran
 
     ran = what_ran(scenario, args.config)
+    _print(f"scene {scenario.scene.name}: {counted(len(scenario.scene.obstacles), 'obstacle')}")
     _print(f"run: {ran.line()}")
     result, meshcat = _run(scenario, args, started)
-    print(summary(result, ran))
+    print(summary(result))
     _write(args, scenario, result, ran, meshcat)
     if args.meshcat:
-        print(f"done in {time.perf_counter() - started:.1f} s; MeshCat keeps serving until you press Ctrl-C")
-        try:
-            while True:
-                time.sleep(1.0)
-        except KeyboardInterrupt:
-            pass
+        serve(args.meshcat_wait, time.perf_counter() - started)
     return exit_status(result)
+
+
+def serve(wait: float | None, spent: float, sleep=time.sleep) -> None:
+    """Keep MeshCat serving the finished run ``wait`` seconds (None: until Ctrl-C; 0: not at all),
+    after saying so; Ctrl-C ends the wait (the run's exit status stands)."""
+    done = f"done in {spent:.1f} s"
+    if wait == 0:
+        print(f"{done}; MeshCat stops now (--meshcat-wait 0)", flush=True)
+        return
+    if wait is None:
+        print(
+            f"{done}; MeshCat keeps serving until you press Ctrl-C (or give --meshcat-wait SECONDS)",
+            flush=True,
+        )
+    else:
+        print(f"{done}; MeshCat keeps serving {wait:g} s more (Ctrl-C ends it sooner)", flush=True)
+    try:
+        if wait is None:
+            while True:
+                sleep(1.0)
+        else:
+            sleep(wait)
+    except KeyboardInterrupt:
+        pass
 
 
 def _scenario(args):
     """The run's scenario: ``--config`` (the defaults without it) under the flags' ``Conditions``, on
     ``--scene``, a scene generated for the robot (``--kind``), the bundled default scene or the
-    scenario's own; the scene is named as soon as it is known."""
+    scenario's own; nothing is printed (a bad input is refused before any output)."""
     from hlp_drake.scene.generators import generate_scene  # numpy and shapely: once the arguments are good
     from hlp_drake.scene.io import load_scene
 
     scene = None
     if args.kind is None and (args.scene is not None or args.config is None):
         scene = load_scene(args.scene or DEFAULT_SCENE)
-        _print(f"scene {scene.name}: {len(scene.obstacles)} obstacles")
     drake_logging(args.verbose)  # Drake is imported from here on
     from hlp_drake.systems.conditions import Conditions
     from hlp_drake.systems.scenario import load_scenario
@@ -216,7 +254,6 @@ def _scenario(args):
     if args.kind is not None:  # generated for the robot: a fixed one's table within its reach
         robot = base.robot if args.robot is None else load_robot(args.robot)
         scene = generate_scene(args.kind, args.seed or 0, args.objects, robot.workspace)
-        _print(f"scene {scene.name}: {len(scene.obstacles)} obstacles")
     conditions = Conditions(
         robot=args.robot,
         initial=args.planner,
@@ -227,10 +264,7 @@ def _scenario(args):
         world=args.world,
         workers=args.workers,
     )
-    scenario = conditions.applied(base, scene=scene)
-    if scene is None:
-        _print(f"scene {scenario.scene.name}: {len(scenario.scene.obstacles)} obstacles")
-    return scenario
+    return conditions.applied(base, scene=scene)
 
 
 def _write(args, scenario, result, ran, meshcat) -> None:

@@ -14,7 +14,7 @@ import time
 from collections import Counter
 from collections.abc import Sequence
 
-from hlp_drake.commands.parsing import add_quiet, make_parser
+from hlp_drake.commands.parsing import DATASET_DEFAULT, add_quiet, make_parser
 from hlp_drake.dataset.dataset import Dataset
 from hlp_drake.dataset.records import STRUCTURED, UNSTRUCTURED
 from hlp_drake.errors import HlpError
@@ -77,9 +77,7 @@ def report(result: SegmentationResult, total: int, seconds: float, category: str
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = make_parser("python -m hlp_drake.segment", __doc__)
-    parser.add_argument(
-        "--dataset", help="the archive or the unpacked dataset/ folder (default: $HLP_DATASET)"
-    )
+    parser.add_argument("--dataset", help="the archive or the unpacked dataset/ folder " + DATASET_DEFAULT)
     parser.add_argument(
         "--mode",
         choices=MODES,

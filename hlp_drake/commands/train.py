@@ -13,7 +13,7 @@ import time
 from collections import Counter
 from collections.abc import Sequence
 
-from hlp_drake.commands.parsing import add_quiet, make_parser
+from hlp_drake.commands.parsing import DATASET_DEFAULT, add_quiet, make_parser
 from hlp_drake.dataset.dataset import Dataset
 from hlp_drake.dataset.records import STRUCTURED, UNSTRUCTURED, category_of
 from hlp_drake.errors import HlpError
@@ -25,9 +25,7 @@ from hlp_drake.segmentation import DEFAULT_MODE, MODES, demonstration_records, s
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = make_parser("python -m hlp_drake.train", __doc__)
-    parser.add_argument(
-        "--dataset", help="the archive or the unpacked dataset/ folder (default: $HLP_DATASET)"
-    )
+    parser.add_argument("--dataset", help="the archive or the unpacked dataset/ folder " + DATASET_DEFAULT)
     parser.add_argument("--mode", choices=MODES, default=DEFAULT_MODE)
     parser.add_argument(
         "--preset",

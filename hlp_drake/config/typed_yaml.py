@@ -20,6 +20,7 @@ default one. A Drake struct is merged by Drake's ``yaml_load_typed`` (imported t
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import functools
 import hashlib
 import types
@@ -154,6 +155,12 @@ def _variant_problems(
     return kind, problems
 
 
+def _did_you_mean(key: Any, known: Any) -> str:
+    """``; did you mean 'planner'?`` when ``key`` is close to one of the ``known`` names, else ""."""
+    close = difflib.get_close_matches(str(key), list(known), n=1, cutoff=0.75)
+    return f"; did you mean {close[0]!r}?" if close else ""
+
+
 def document_problems(
     schema: Any, value: Any, where: str = "", *, top: str = "document", default: Any = None
 ) -> list[str]:
@@ -189,7 +196,9 @@ def document_problems(
         if not isinstance(value, dict):
             return [f"{label}: expected a mapping, got {type(value).__name__}"]
         hints = _fields(schema)
-        problems = [f"{label}: unknown field {key!r}" for key in value if key not in hints]
+        problems = [
+            f"{label}: unknown field {key!r}{_did_you_mean(key, hints)}" for key in value if key not in hints
+        ]
         problems += [f"{label}: missing field {name!r}" for name in _required(schema) if name not in value]
         merged = default is not None and not _required(schema)
         for name, sub in value.items():

@@ -198,8 +198,25 @@ def _resolve_part(given: Path) -> list[SourcePart]:
     )
 
 
+def default_dataset(project: Path | None = None) -> Path | None:
+    """Where the dataset is read from when neither a path nor ``HLP_DATASET`` is given: ``shared/data``
+    beside the project folder (``../shared/data`` from it) when the package runs from a source checkout
+    (the folder holding ``hlp_drake/`` holds ``pyproject.toml``: ``pip install -e .``) and that folder
+    exists; else None (an installed package has no project folder to look beside).
+
+    Args:
+        project: the project folder (default: the one holding this package).
+    """
+    project = Path(__file__).resolve().parents[2] if project is None else project
+    if not (project / "pyproject.toml").is_file():
+        return None
+    data = project.parent / "shared" / "data"
+    return data if data.is_dir() else None
+
+
 def resolve_source(path: str | os.PathLike[str] | Sequence[str | os.PathLike[str]] | None = None) -> Source:
-    """Find the dataset from ``path`` or, when it is None, from the ``HLP_DATASET`` variable.
+    """Find the dataset from ``path`` or, when it is None, from the ``HLP_DATASET`` variable, else
+    ``default_dataset()`` (``../shared/data`` beside a source checkout).
 
     Accepted: an archive, the unpacked ``dataset/`` folder, a folder holding ``dataset/``,
     ``hlp-vr-dataset/dataset/`` or the archive (e.g. ``../shared/data``; the archives named
@@ -211,9 +228,13 @@ def resolve_source(path: str | os.PathLike[str] | Sequence[str | os.PathLike[str
     """
     if path is None:
         text = os.environ.get(ENV_VAR) or None
-        if text is None:
-            raise DatasetError(f"no dataset given: pass --dataset PATH or set {ENV_VAR} ({WHERE_TO_GET})")
-        paths = [p for p in text.split(os.pathsep) if p]
+        default = default_dataset() if text is None else None
+        if text is None and default is None:
+            raise DatasetError(
+                f"no dataset given: pass --dataset PATH, set {ENV_VAR} or, in a source checkout, place it "
+                f"in ../shared/data beside the project folder ({WHERE_TO_GET})"
+            )
+        paths = [default] if text is None else [p for p in text.split(os.pathsep) if p]
     elif isinstance(path, (str, os.PathLike)):
         paths = [path]
     else:

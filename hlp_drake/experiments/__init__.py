@@ -12,8 +12,16 @@
 The command line is ``hlp_drake.commands.experiments``.
 """
 
-from hlp_drake.experiments.experiment import ExperimentSettings, run_experiment
-from hlp_drake.experiments.runner import Job, ResolvedStudy, make_row
-from hlp_drake.experiments.study import Study, load_study
+from hlp_drake.runtime.exports import lazy_exports
 
 __all__ = ["ExperimentSettings", "Job", "ResolvedStudy", "Study", "load_study", "make_row", "run_experiment"]
+
+# Imported on first use: the command's parser needs ``study`` alone (not matplotlib, numpy or shapely).
+__getattr__, __dir__ = lazy_exports(
+    __name__,
+    {
+        "hlp_drake.experiments.experiment": ("ExperimentSettings", "run_experiment"),
+        "hlp_drake.experiments.runner": ("Job", "ResolvedStudy", "make_row"),
+        "hlp_drake.experiments.study": ("Study", "load_study"),
+    },
+)

@@ -30,7 +30,6 @@ from hlp_drake.runtime.processes import (
     worker_pool,
 )
 
-EXECUTORS = ("local", "dask")
 CLUSTER_EXTRA = 'pip install "hlp_drake[cluster]"'
 CONNECT_TIMEOUT = "20s"
 

@@ -25,12 +25,12 @@ from tqdm import tqdm
 from hlp_drake.config.ranges import config_problems
 from hlp_drake.config.what_ran import WhatRan
 from hlp_drake.errors import HlpError, StorageError
-from hlp_drake.experiments.executors import EXECUTORS, check_executor, run_jobs
+from hlp_drake.experiments.executors import check_executor, run_jobs
 from hlp_drake.experiments.metadata import git_commit, machine_info, software_versions, utc_now
 from hlp_drake.experiments.plots import write_plots
 from hlp_drake.experiments.results import START_OVER, ResultsFile, read_results, read_run_file, row_key
 from hlp_drake.experiments.runner import Job, JobFunction, StudyResolver, make_jobs
-from hlp_drake.experiments.study import Study
+from hlp_drake.experiments.study import EXECUTORS, Study
 from hlp_drake.experiments.summary import summarise, write_summary
 from hlp_drake.files.atomic import check_folder, write_text_atomic
 from hlp_drake.runtime.terminal import bars_disabled

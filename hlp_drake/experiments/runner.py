@@ -17,6 +17,7 @@ from typing import Any, Protocol
 from hlp_drake.config.what_ran import Labels, WhatRan
 from hlp_drake.errors import SceneError
 from hlp_drake.experiments.study import Cell, Study
+from hlp_drake.runtime.terminal import counted
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene
 from hlp_drake.scene.workspace import Workspace
@@ -134,7 +135,7 @@ def _scene(generator: str, seed: int, count: int | None, workspace: Workspace | 
     try:
         return generate_scene(generator, seed, count, workspace)
     except SceneError as error:
-        objects = "" if count is None else f" with {count} objects"
+        objects = "" if count is None else f" with {counted(count, 'object')}"
         raise SceneError(f"cannot generate the {generator} scene of seed {seed}{objects}: {error}") from None
 
 

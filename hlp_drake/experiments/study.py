@@ -21,14 +21,14 @@ from pathlib import Path
 from typing import Annotated, Any
 
 from hlp_drake.config.ranges import MAX_SEED, Count, config_problems
-from hlp_drake.config.typed_yaml import load_typed
 from hlp_drake.errors import HlpError
-from hlp_drake.files.documents import parse_yaml, read_document
 from hlp_drake.scene.constants import KINDS, MAX_GENERATED
 
 STUDIES = Path(__file__).resolve().parent / "studies"
 """The bundled studies, ``NAME.yaml``."""
 MAX_SCENES = 100_000
+EXECUTORS = ("local", "dask")
+"""Where a study's jobs run: this process or a local process pool, or a dask cluster (``executors``)."""
 FIXED_COUNT_KINDS = ("vr", "gen1")
 """Generators whose scenes always have the same number of obstacles (``objects`` does not apply)."""
 AXES = ("robots", "initialisers", "low_level", "execution", "perception", "model_error", "world")
@@ -169,6 +169,9 @@ def load_study(name: str) -> Study:
         path = Path(name)
     else:
         raise HlpError(f"unknown study {name!r}: one of {', '.join(bundled_studies())} or a study .yaml file")
+    from hlp_drake.config.typed_yaml import load_typed  # YAML: once a study is read, not for --help
+    from hlp_drake.files.documents import parse_yaml, read_document
+
     text = read_document(path, missing="study file not found")
     study = load_typed(Study, parse_yaml(text, str(path)), defaults=Study(), where=str(path), top="study")
     problems = config_problems(study)  # the ranges, then the rules (Study.problems)

@@ -24,6 +24,7 @@ from hlp_drake.experiments.paper import PaperFigures, notes, paper_figures
 from hlp_drake.experiments.runner import Row
 from hlp_drake.experiments.study import Study
 from hlp_drake.files.atomic import write_text_atomic
+from hlp_drake.runtime.terminal import counted
 
 PLANNER_LABELS = {"hlp": "HLP", "sto": "STO (straight line)"}
 """The paper's planners as the tables name them."""
@@ -36,8 +37,8 @@ CELL = ("robot", "initial", "low_level", "execution", "perception", "model_error
 def condition_label(generator: str, objects: int, generators: tuple[str, ...]) -> str:
     """A condition's name: the generator (one study of several) and the object count."""
     if len(generators) > 1:
-        return f"{generator}, {objects} objects"
-    return f"Gen I ({objects} objects)" if generator == "gen1" else f"{objects} objects"
+        return f"{generator}, {counted(objects, 'object')}"
+    return f"Gen I ({counted(objects, 'object')})" if generator == "gen1" else counted(objects, "object")
 
 
 def wilson_interval(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:

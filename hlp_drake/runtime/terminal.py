@@ -1,4 +1,5 @@
-"""Progress bars only on a terminal: in a file or a pipe their carriage returns would run into the lines."""
+"""Progress bars only on a terminal (in a file or a pipe their carriage returns would run into the
+lines), and counts said in words."""
 
 from __future__ import annotations
 
@@ -12,6 +13,11 @@ def is_terminal(stream: TextIO | None) -> bool:
         return stream is not None and stream.isatty()
     except (AttributeError, ValueError):  # no isatty, or closed
         return False
+
+
+def counted(n: int, noun: str, plural: str | None = None) -> str:
+    """``n`` and ``noun``, in the plural unless ``n`` is 1: ``1 obstacle``, ``6 obstacles``."""
+    return f"{n} {noun if n == 1 else plural or noun + 's'}"
 
 
 def bars_disabled(progress: bool, stream: TextIO | None = None) -> bool:

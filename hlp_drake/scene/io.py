@@ -99,6 +99,8 @@ def load_scene(path: str | os.PathLike[str]) -> Scene:
     text = read_document(path, SceneError)
     parse = parse_json if suffix in JSON_SUFFIXES else parse_yaml
     data = parse(text, str(path), SceneError)
+    if data is None:  # YAML of nothing but blanks and comments
+        raise SceneError(f"{path}: the file is empty; a scene gives its table, start, target and obstacles")
     return scene_from_dict(data, where=str(path))
 
 

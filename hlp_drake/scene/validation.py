@@ -219,7 +219,10 @@ def scene_problems(scene: Scene) -> list[str]:
             if obj.name in seen:
                 problems.append(f"two objects are named {obj.name!r}")
             seen.add(obj.name)
-        problems += own
+        if role == "target" and isinstance(obj, SceneObject):  # another shape: "must be a cylinder", above
+            problems += [p for p in own if not p.startswith(f"{_label(obj, role)}: unknown shape")]
+        else:
+            problems += own
         if not own:
             sound.append((obj, role))
 

@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import contextvars
 import warnings
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from functools import cached_property
 from pathlib import Path
 from typing import Annotated, Any
@@ -234,6 +234,18 @@ def _given(document: dict, dotted: str) -> bool:
     return True
 
 
+def _a_scene(document: Any) -> bool:
+    """Whether ``document`` (a parsed scenario) is a scene instead: only a scene's fields, a table or
+    obstacles among them."""
+    scene_fields = {f.name for f in fields(Scene)}
+    return (
+        isinstance(document, dict)
+        and bool(document)
+        and set(document) <= scene_fields
+        and bool({"table", "obstacles"} & set(document))
+    )
+
+
 def legacy(document: Any, where: str) -> Any:
     """``document`` (a parsed scenario) with its former spellings in their places: ``optimiser: {...}``
     is ``planner.low_level: {kind: sto, ...}`` (its ``alternatives``: ``planner.alternatives``),
@@ -320,7 +332,13 @@ def load_scenario(
     try:
         scenario = Scenario() if defaults is None else defaults
         for name, text in sources:
-            document = legacy(parse_yaml(text, name), name)
+            document = parse_yaml(text, name)
+            if _a_scene(document):
+                raise HlpError(
+                    f"{name}: this is a scene (table, target, obstacles), not a scenario: run it with "
+                    "--scene FILE, or give it as a scenario's 'scene:' section"
+                )
+            document = legacy(document, name)
             scenario = load_typed(Scenario, document, defaults=scenario, where=name, top="scenario")
             if filename is not None and name == str(filename):  # a relative model path: the file's neighbour
                 scenario = replace(scenario, robot=with_model_beside(scenario.robot, Path(filename).parent))

@@ -30,25 +30,30 @@ def test_help_is_plain_text_and_every_command_has_a_version(module, capsys):
     assert __version__ in capsys.readouterr().out
 
 
-@pytest.mark.parametrize(
-    "module",
-    [
-        "hlp_drake.commands.run_scene",
-        "hlp_drake.commands.experiments",
-        "hlp_drake.commands.train",
-        "hlp_drake.commands.evaluate",
-        "hlp_drake.commands.segment",
-    ],
-)
-def test_long_commands_take_quiet(module, capsys):
-    with pytest.raises(SystemExit):
-        importlib.import_module(module).main(["--help"])
-    assert "--quiet" in capsys.readouterr().out
+SUBCOMMANDS = {"scene": ("generate", "show", "validate"), "dataset": ("summary",)}
+WITH_CONFIG = ("run-scene", "experiments", "scene")
+"""The commands that take a scenario (--config); the others read the VR dataset."""
+
+
+@pytest.mark.parametrize("command", sorted(COMMANDS))
+def test_every_command_takes_quiet_and_those_that_run_a_scenario_take_config(command, capsys):
+    for sub in SUBCOMMANDS.get(command, ("",)):
+        with pytest.raises(SystemExit):
+            command_main(command)([sub, "--help"] if sub else ["--help"])
+        text = capsys.readouterr().out
+        assert "--quiet" in text, (command, sub)
+        assert ("--config" in text) == (command in WITH_CONFIG), (command, sub)
 
 
 def test_hlp_drake_dispatches_to_the_commands(capsys):
     assert main(["--version"]) == 0 and capsys.readouterr().out.strip() == f"hlp-drake {__version__}"
-    assert main([]) == 2 and "run-scene" in capsys.readouterr().out
+    assert main(["--help"]) == 0 and "run-scene" in capsys.readouterr().out
+    # No command: a usage error as `scene` without its subcommand gives (stderr, exit status 2).
+    assert main([]) == 2
+    assert capsys.readouterr() == (
+        "",
+        "error: the following arguments are required: command (see hlp-drake --help)\n",
+    )
     assert main(["fly"]) == 2 and "unknown command 'fly'" in capsys.readouterr().err
     assert main(["scene", "validate", "missing.yaml"]) == 2
     assert capsys.readouterr().err.strip() == "error: missing.yaml: no such file"

@@ -72,7 +72,7 @@ def test_run_scene_end_to_end_json_and_html(tmp_path):
         f"robot {MOBILE_UR5.name}, initialiser hlp, low-level planner sto, execution open, model error none, "
     )
     line += "perception truth, world reference, scenario built-in default"
-    assert f"run: {line}\n" in result.stdout and f"ran: {line}\n" in result.stdout
+    assert result.stdout.count(f"run: {line}\n") == 1 and "ran: " not in result.stdout  # said once
     verdicts = [v for v in result.stdout.splitlines() if v.startswith("verdict: ")]
     assert len(verdicts) == 1 and verdicts[0].startswith(
         "verdict: reach success in the reference world (the paper's criterion, exit status 0); the planner's "
@@ -256,7 +256,7 @@ def test_a_run_logged_to_a_file_has_one_line_per_stage_and_no_carriage_returns(t
         ).returncode
     text = log.read_text()
     assert code == 0 and "\r" not in text and "INFO:drake" not in text, text
-    stages = ("scene ", "run: ", "plan: ", "IK: ", "optimise: ", "execute: ", "ran: ", "verdict: ")
+    stages = ("scene ", "run: ", "plan: ", "IK: ", "optimise: ", "execute: ", "timings: ", "verdict: ")
     lines = text.splitlines()
     found = [next(i for i, line in enumerate(lines) if line.startswith(stage)) for stage in stages]
     assert found == sorted(found), text
@@ -282,6 +282,13 @@ def test_progress_bars_only_on_a_terminal():
         listener.simulated(0.5)
         listener.close()
         assert ("\r" in stream.getvalue()) == bars
+    stream = Terminal()
+    listener = ProgressListener(stream=stream)
+    listener.optimising("sto")
+    listener.rollout(SimpleNamespace(cost=1.0))
+    listener.close()
+    shown = stream.getvalue()
+    assert "optimise: 0 rollouts [00:00, ? rollouts/s]" in shown and "0rollout" not in shown, shown
     quiet = Terminal()
     listener = ProgressListener(quiet=True, stream=quiet)
     listener.optimising("sto")
@@ -322,7 +329,7 @@ def test_run_scene_rejects_a_bad_execution_or_uncertainty_seed(tmp_path):
     out = tmp_path / "run.json"
     for args, problem in (
         (["--execution", "half"], "invalid choice: 'half'"),
-        (["--uncertainty", "x"], "invalid int value: 'x'"),
+        (["--uncertainty", "x"], "argument --uncertainty: expected an integer, got 'x'"),
     ):
         result = run_module("hlp_drake.run_scene", *args, "--json", str(out))
         assert result.returncode == 2 and problem in result.stderr and "Traceback" not in result.stderr

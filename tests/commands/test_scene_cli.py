@@ -90,3 +90,27 @@ def test_show_draws_the_named_robots_plan_and_refuses_an_unknown_robot(tmp_path)
     result = run_module("hlp_drake.scene", "show", str(scene), "--png", str(png), "--robot", "r2d2")
     assert_one_line_error(result, "robot 'r2d2': not a shipped robot")
     assert not png.exists()
+
+
+def test_every_subcommand_takes_config_and_quiet(tmp_path):
+    """--config's robot (here the Panda) is what --robot would give: generate fits its reach."""
+    from textwrap import indent
+
+    from hlp_drake.systems.world.robot_description import load_robot, robot_file
+
+    config = tmp_path / "panda.yaml"
+    config.write_text("robot:\n" + indent(robot_file("panda").read_text(), "  "))
+    out, png = tmp_path / "scene.yaml", tmp_path / "scene.png"
+    args = ["generate", "--kind", "gen1", "--seed", "5", "--out", str(out)]
+    result = run_module("hlp_drake.scene", *args, "--config", str(config), "--quiet")
+    assert result.returncode == 0 and result.stderr == "", result.stderr
+    assert load_scene(out) == generate_scene("gen1", 5, workspace=load_robot("panda").workspace)
+    assert load_scene(out) != generate_scene("gen1", 5)  # the mobile UR5's table
+    for args in (["validate", str(out)], ["show", str(out), "--png", str(png), "--plan"]):
+        result = run_module("hlp_drake.scene", *args, "--config", str(config), "--quiet")
+        assert result.returncode == 0 and result.stderr == "", result.stderr
+    assert png.read_bytes().startswith(PNG_SIGNATURE)
+    result = run_module(
+        "hlp_drake.scene", "validate", str(out), "--config", str(out)
+    )  # a scene, not a scenario
+    assert_one_line_error(result, "this is a scene")

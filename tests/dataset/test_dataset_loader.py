@@ -240,8 +240,31 @@ def test_overlapping_objects_in_a_layout_reject_the_trial(folder, tmp_path):
     assert "overlap" in ds.problems[0]["reason"] and "sub_01/T010" not in ds
 
 
-def test_bad_paths_raise_one_clear_error(tmp_path, monkeypatch):
+def test_without_a_path_the_dataset_is_hlp_dataset_else_shared_data_beside_a_source_checkout(
+    folder, tmp_path, monkeypatch
+):
+    from hlp_drake.dataset import source
+
+    project = tmp_path / "project"
+    project.mkdir()
+    data = tmp_path / "shared" / "data"
+    data.mkdir(parents=True)
+    assert source.default_dataset(project) is None  # no pyproject.toml: an installed package
+    (project / "pyproject.toml").write_text("")
+    assert source.default_dataset(project) == data
     monkeypatch.delenv("HLP_DATASET", raising=False)
+    monkeypatch.setattr(source, "default_dataset", lambda: folder)
+    assert Dataset(cache_dir=tmp_path / "c", progress=False).source.path == folder
+    monkeypatch.setenv("HLP_DATASET", str(tmp_path / "elsewhere"))  # the variable comes first
+    with pytest.raises(DatasetError, match="elsewhere"):
+        Dataset(cache_dir=tmp_path / "c", progress=False)
+
+
+def test_bad_paths_raise_one_clear_error(tmp_path, monkeypatch):
+    from hlp_drake.dataset import source
+
+    monkeypatch.delenv("HLP_DATASET", raising=False)
+    monkeypatch.setattr(source, "default_dataset", lambda: None)  # no ../shared/data either
     with pytest.raises(DatasetError, match="no dataset given"):
         Dataset(cache_dir=tmp_path)
     with pytest.raises(DatasetError, match="no such file or directory"):

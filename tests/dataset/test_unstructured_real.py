@@ -6,10 +6,11 @@ import csv
 import io
 import tarfile
 from collections import Counter
+from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import DEFAULT_DATA
+from conftest import missing
 
 from hlp_drake.dataset import UNSTRUCTURED, category_of
 from hlp_drake.segmentation import segment_dataset
@@ -17,7 +18,7 @@ from hlp_drake.segmentation.batch import log_agreement
 from hlp_drake.taskspace import TaskSpace
 
 pytestmark = pytest.mark.dataset
-PART1 = DEFAULT_DATA / "hlp-vr-unstructured-part1.tar.xz"
+PART1 = "hlp-vr-unstructured-part1.tar.xz"
 
 
 @pytest.fixture(scope="module")
@@ -25,10 +26,16 @@ def segmented(unstructured):
     return segment_dataset(unstructured, mode="fixed", categories=(UNSTRUCTURED,))
 
 
-def _start_positions() -> dict[str, float]:
+def part1_archive(dataset) -> Path | None:
+    """The part 1 archive among the dataset's parts (found where HLP_DATASET or ../shared/data put
+    it), None if the trials come from elsewhere (e.g. an unpacked folder)."""
+    return next((part.path for part in dataset.source.parts if part.path.name == PART1), None)
+
+
+def _start_positions(archive_path: Path) -> dict[str, float]:
     """trial_results.csv's start_pos_x of every trial in part 1, read straight from the archive."""
     starts = {}
-    with tarfile.open(PART1) as archive:
+    with tarfile.open(archive_path) as archive:
         for member in archive:
             if member.name.endswith("/trial_results.csv"):
                 subject = member.name.split("/")[-2]
@@ -45,9 +52,10 @@ def test_part1_counts(unstructured):
 
 
 def test_the_stale_start_of_t100_is_replaced_by_trial_results(unstructured):
-    if not PART1.exists():
-        pytest.skip(f"{PART1} not found (the test reads its trial_results.csv)")
-    starts = _start_positions()
+    archive = part1_archive(unstructured)
+    if archive is None:
+        missing(f"{PART1} is not among the dataset's parts (the test reads its trial_results.csv)")
+    starts = _start_positions(archive)
     # Every participant's T100 scene file keeps x = 0: one note each, naming the file and both values.
     noted = sorted(n["path"].split(":")[-1].split("/scene")[0] for n in unstructured.notes)
     assert noted == sorted(

@@ -145,3 +145,29 @@ def test_the_readme_lists_every_scenario_section():
     start = text.index("Sections, each documented on its dataclass")
     listed = re.findall(r"`(\w+)`", text[start : text.index(". A scene, in metres", start)])
     assert listed == [field.name for field in dataclasses.fields(Scenario)]
+
+
+def test_the_own_robot_examples_commands_are_the_readmes_and_what_they_write_is_ignored():
+    """The example's docstring gives the README's commands (the README's run is the one run above);
+    the folder they write is not for git."""
+    usage = [
+        line.strip()
+        for line in (REPO / "examples" / "own_robot.py").read_text().split('"""')[1].splitlines()
+        if line.strip().startswith("python ")
+    ]
+    readme = [c for block in blocks("bash") for c in commands(block)]
+    assert len(usage) == 2 and all(line in readme for line in usage), (usage, readme)
+    assert "--out my_robot" in usage[0] and "/my_robot/" in (REPO / ".gitignore").read_text().splitlines()
+
+
+def test_the_readme_says_how_to_run_the_notebook_headless():
+    """The command the README gives exists where the test extras are installed (nbclient's)."""
+    command = "jupyter execute examples/tutorial.ipynb"
+    assert command in (REPO / "README.md").read_text()
+    jupyter = Path(sys.executable).with_name("jupyter")
+    if not jupyter.exists():
+        pytest.skip(f"{jupyter} is not installed (pip install -e '.[test]' installs it)")
+    result = subprocess.run(
+        [str(jupyter), "execute", "--help"], capture_output=True, text=True, timeout=120, check=False
+    )
+    assert result.returncode == 0 and "notebook" in result.stdout, result.stderr

@@ -11,7 +11,13 @@ import pytest
 WORKER_UNNEEDED = ("sklearn", "pandas", "matplotlib", "scipy.stats")
 """Libraries a rollout never uses (the planner's learners, the dataset's tables, plots)."""
 NUMERICAL = ("pydrake", "sklearn", "scipy", "numpy", "pandas", "matplotlib", "shapely", "yaml")
-LAZY_PACKAGES = ("hlp_drake.systems", "hlp_drake.scene", "hlp_drake.segmentation", "hlp_drake.planner")
+LAZY_PACKAGES = (
+    "hlp_drake.systems",
+    "hlp_drake.scene",
+    "hlp_drake.segmentation",
+    "hlp_drake.planner",
+    "hlp_drake.experiments",
+)
 
 
 def _modules_after(code: str) -> tuple[int | None, set[str]]:
@@ -65,6 +71,21 @@ def test_run_scene_help_version_and_usage_errors_import_no_numerical_library(arg
         )
         assert code == exit_code
         assert not _loaded(modules, NUMERICAL), module
+
+
+@pytest.mark.parametrize(
+    ("argv", "exit_code"), [(["--help"], 0), (["--version"], 0), (["gen1", "--scenes", "0", "--out", "x"], 2)]
+)
+def test_experiments_help_version_and_usage_errors_import_no_numerical_library(argv, exit_code):
+    """``experiments --help`` took 0.5 s importing matplotlib, numpy and shapely; now what
+    ``run_scene --help`` takes."""
+    for module, prefix in (("hlp_drake.experiments", []), ("hlp_drake", ["experiments"])):
+        code, modules = _modules_after(
+            f"import runpy\nsys.argv = {['prog', *prefix, *argv]!r}\n"
+            f"runpy.run_module({module!r}, run_name='__main__', alter_sys=True)"
+        )
+        assert code == exit_code
+        assert not _loaded(modules, NUMERICAL), (module, _loaded(modules, NUMERICAL))
 
 
 def test_importing_hlp_drake_systems_imports_no_drake():

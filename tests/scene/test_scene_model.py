@@ -80,6 +80,10 @@ def test_valid_scene_has_no_problems():
             small_scene(target=SceneObject("Target", "box", 0.7, 0.0, (0.06, 0.06, 0.12))),
             "must be a cylinder",
         ),
+        (  # one line for one problem, not "unknown shape" too
+            small_scene(target=SceneObject("Target", "sphere", 0.7, 0.0, (0.06, 0.06, 0.12))),
+            "target 'Target' must be a cylinder, got 'sphere'",
+        ),
         (small_scene(target=None), "scene has no target"),
     ],
 )
@@ -148,6 +152,13 @@ def test_unreadable_files(tmp_path):
         load_scene(write_yaml(tmp_path, "table: {length: 1\nstart: [0, 0]\n"))
     with pytest.raises(SceneError, match="expected a mapping"):
         load_scene(write_yaml(tmp_path, "- just\n- a list\n"))
+    for empty in ("", "# nothing yet\n"):
+        path = write_yaml(tmp_path, empty)
+        with pytest.raises(SceneError) as info:
+            load_scene(path)
+        assert info.value.problems == (
+            f"{path}: the file is empty; a scene gives its table, start, target and obstacles",
+        )
     (tmp_path / "s.json").write_text("{not json")
     with pytest.raises(SceneError, match="not valid JSON"):
         load_scene(tmp_path / "s.json")

@@ -195,6 +195,8 @@ def _parse_error(parser: Parser, robot: RobotDescription, error: RuntimeError) -
             f"{robot.model}: the robot model cannot be parsed ({drake_reason(error, path)}); {REINSTALL}"
         )
     path = Path(robot.model.removeprefix("file://"))
+    if not path.exists():
+        return HlpError(f"robot.model: {robot.model} does not exist")
     return HlpError(f"robot.model: {robot.model} cannot be parsed ({drake_reason(error, path)})")
 
 

@@ -222,12 +222,26 @@ def load_robot(name_or_file: str | Path) -> RobotDescription:
             f"robot {text!r}: not a shipped robot ({', '.join(SHIPPED_ROBOTS)}) nor a .yaml description file"
         )
     document = parse_yaml(read_document(path, missing="robot description not found"), str(path))
+    if document is None:  # else the defaults: the mobile UR5 under another name
+        raise HlpError(f"{path}: the file is empty; a robot description names its model, joints and frames")
     robot = load_typed(RobotDescription, document, defaults=RobotDescription(), where=str(path), top="robot")
     robot = with_model_beside(robot, path.parent)
     problems = robot.problems(str(path))
+    model = missing_model(robot)
+    if model is not None:
+        problems.insert(0, f"{path}: model: {model} does not exist")
     if problems:
         raise HlpError(*problems)
     return robot
+
+
+def missing_model(robot: RobotDescription) -> Path | None:
+    """The model file a description names when it is a path or ``file://`` URL and the file does not
+    exist, else None (a ``package://`` URL is resolved when the model is loaded)."""
+    if robot.model.startswith("package://"):
+        return None
+    path = Path(robot.model.removeprefix("file://"))
+    return None if path.exists() else path
 
 
 def with_model_beside(robot: RobotDescription, folder: Path) -> RobotDescription:
@@ -244,6 +258,7 @@ __all__ = [
     "BaseConfig",
     "RobotDescription",
     "load_robot",
+    "missing_model",
     "models_directory",
     "robot_file",
     "with_model_beside",

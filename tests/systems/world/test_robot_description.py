@@ -108,6 +108,22 @@ def test_a_model_that_does_not_parse_is_one_line(tmp_path):
         Scenario(robot=robot)
 
 
+def test_a_missing_model_file_is_named_by_its_description_file(own_robot, tmp_path):
+    description = tmp_path / "arm.yaml"
+    description.write_text(own_robot.read_text().replace("model: arm6.urdf", "model: gone.urdf"))
+    assert "model: gone.urdf" in description.read_text()
+    with pytest.raises(HlpError) as error:
+        load_robot(description)
+    assert error.value.problems == (f"{description}: model: {tmp_path / 'gone.urdf'} does not exist",)
+    robot = replace(MOBILE_UR5, name="gone", model=str(tmp_path / "gone.urdf"))  # in a scenario
+    with pytest.raises(HlpError) as error:
+        Scenario(robot=robot)
+    assert error.value.problems == (f"robot.model: {tmp_path / 'gone.urdf'} does not exist",)
+    (empty := tmp_path / "empty.yaml").write_text("")  # not the mobile UR5 under another name
+    with pytest.raises(HlpError, match="empty.yaml: the file is empty"):
+        load_robot(empty)
+
+
 def test_the_command_line_names_an_unknown_robot_and_a_bad_description(own_robot, tmp_path):
     def run(*args: str) -> subprocess.CompletedProcess:
         return subprocess.run(

@@ -70,7 +70,9 @@ def test_a_scenarios_scene_is_read_whole_in_the_scene_file_format(tmp_path):
     "text, problem",
     [
         ("plant: [0.002,\n", "not valid YAML at line 2"),
-        ("plant: {time_stp: 0.002}\n", "plant: unknown field 'time_stp'"),
+        ("plant: {time_stp: 0.002}\n", "plant: unknown field 'time_stp'; did you mean 'time_step'?"),
+        ("planer: {initial: line}\n", "scenario: unknown field 'planer'; did you mean 'planner'?"),
+        ("colour: red\n", "scenario: unknown field 'colour'"),  # nothing close: no guess
         ("controller: {arm: {kp: fast}}\n", "controller.arm.kp: expected a number, got 'fast'"),
         ("ik: 3\n", "ik: expected a mapping, got int"),
         ("plant: {discrete_contact_approximation: tamsi}\n", "SAP"),
@@ -147,6 +149,7 @@ def test_bad_scenario_file_raises_one_line_hlp_errors_naming_the_file_and_field(
     with pytest.raises(HlpError) as info:
         load_scenario(path)
     assert any(problem in p for p in info.value.problems), info.value.problems
+    assert "colour" not in text or "did you mean" not in info.value.problems[0]
     assert all(p.startswith(str(path)) and "\n" not in p for p in info.value.problems)
     with pytest.raises(HlpError, match=r"missing\.yaml"):
         load_scenario(tmp_path / "missing.yaml")
@@ -286,3 +289,18 @@ def test_the_world_model_gathers_the_sections_a_world_is_made_of():
         scenario.ik,
     )
     assert not model.controller.gravity_compensation and WorldModel().robot == Scenario().robot
+
+
+def test_a_scene_file_given_as_a_scenario_is_one_line_pointing_at_scene():
+    from hlp_drake.scene import DEFAULT_SCENE_FILE
+
+    with pytest.raises(HlpError) as info:
+        load_scenario(DEFAULT_SCENE_FILE)
+    (problem,) = info.value.problems
+    assert problem.startswith(
+        f"{DEFAULT_SCENE_FILE}: this is a scene (table, target, obstacles), not a scenario"
+    )
+    assert "run it with --scene FILE" in problem
+    with pytest.raises(HlpError) as info:  # a scenario with a misplaced scene field is not a scene
+        load_scenario(data="plant: {time_step: 0.002}\ntable: {length: 1}\n")
+    assert info.value.problems == ("overrides: scenario: unknown field 'table'",)

@@ -237,8 +237,9 @@ def serve(wait: float | None, spent: float, sleep=time.sleep) -> None:
 
 def _scenario(args):
     """The run's scenario: ``--config`` (the defaults without it) under the flags' ``Conditions``, on
-    ``--scene``, a scene generated for the robot (``--kind``), the bundled default scene or the
-    scenario's own; nothing is printed (a bad input is refused before any output)."""
+    ``--scene``, a scene generated for the robot (``--kind``), the bundled default scene (scaled to a
+    fixed robot's reach) or the scenario's own; nothing is printed (a bad input is refused before any
+    output)."""
     from hlp_drake.scene.generators import generate_scene  # numpy and shapely: once the arguments are good
     from hlp_drake.scene.io import load_scene
 

@@ -9,11 +9,13 @@ the world frame of ``hlp_drake.dataset.frames`` (front edge of the table at x = 
 - ``gen1``: Generalization I: the same two-row structure on a robot-sized table with table and object
   dimensions varied (see ``GEN1``).
 
-For a robot fixed before the table, gen1 and gen2 keep their tables within its reach (``workspace``).
 - ``gen2``: Generalization II: 5, 7 or 9 (any N >= 1) boxes and cylinders placed at random, the start
   on a random point of the front edge with a random heading, the target not aligned with the start.
 - ``unstructured``: the dataset's unstructured trials (T100-T129): the VR table, N (default 6) obstacles
   at random on a 1 cm grid, random lateral start and target positions.
+
+For a robot fixed before the table, gen1 and gen2 keep their tables within its reach (``workspace``);
+``scaled_to_reach`` scales a given scene (the bundled default) by the same factor.
 """
 
 from __future__ import annotations
@@ -33,7 +35,7 @@ from hlp_drake.scene.constants import KINDS, MAX_GENERATED
 from hlp_drake.scene.geometry import footprint
 from hlp_drake.scene.model import Scene, SceneObject, Table
 from hlp_drake.scene.validation import validate_scene
-from hlp_drake.scene.workspace import EDGE_INSET, Workspace, within_reach
+from hlp_drake.scene.workspace import EDGE_INSET, Workspace, reach_scale, within_reach
 
 # --- The VR study (reference notes 1.2): metres, world frame. -----------------------------------
 VR_TABLE = Table(length=0.60, width=0.74, height=0.73)
@@ -363,6 +365,37 @@ def generate_unstructured(seed: int, objects: int = 6) -> Scene:
     )
     return _finish(
         Scene(table=VR_TABLE, start=start, target=target, obstacles=obstacles, name=f"unstructured-{seed}")
+    )
+
+
+def scaled_to_reach(scene: Scene, workspace: Workspace | None, robot: str) -> Scene:
+    """``scene`` scaled by the factor the generators scale their tables by for ``workspace``
+    (``reach_scale`` of ``GEN1``), as they scale: the table's length and width, every position on it and
+    the obstacles' footprints; heights, the start's heading and the target's size (the gripper's) kept.
+    Its name says so ("..., scaled to the ROBOT's reach x0.59"); ``scene`` itself at a factor of 1.
+
+    Raises:
+        SceneError: the robot reaches too little of a table (``reach_scale``), or the scaled scene is
+            not valid (e.g. the target now overlaps an obstacle).
+    """
+    scale = reach_scale(GEN1, workspace)
+    if scale == 1.0:
+        return scene
+
+    def scaled(obj: SceneObject) -> SceneObject:
+        size = obj.size if obj is scene.target else (obj.size[0] * scale, obj.size[1] * scale, obj.size[2])
+        return replace(obj, x=obj.x * scale, y=obj.y * scale, size=size)
+
+    table = scene.table
+    return _finish(
+        replace(
+            scene,
+            table=Table(table.length * scale, table.width * scale, table.height),
+            start=(scene.start[0] * scale, scene.start[1] * scale),
+            target=scaled(scene.target),
+            obstacles=tuple(scaled(o) for o in scene.obstacles),
+            name=f"{scene.name}, scaled to the {robot}'s reach x{scale:.2f}",
+        )
     )
 
 

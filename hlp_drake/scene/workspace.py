@@ -1,5 +1,5 @@
 """``Workspace``: where a robot fixed in front of the table reaches, and the generators' tables kept
-within it (``within_reach``)."""
+within it (``reach_scale``, ``within_reach``)."""
 
 from __future__ import annotations
 
@@ -26,17 +26,16 @@ class Workspace:
     reach: float
 
 
-def within_reach(ranges: RobotSceneRanges, workspace: Workspace | None) -> RobotSceneRanges:
-    """``ranges`` with the table's length and width scaled by one factor (at most 1) so that the
-    farthest start or target the generators place on the largest table is within ``workspace``'s
-    reach; ``ranges`` itself for None (a mobile robot).
+def reach_scale(ranges: RobotSceneRanges, workspace: Workspace | None) -> float:
+    """The one factor (at most 1) the generators scale their tables by so that the farthest start or
+    target placed on ``ranges``' largest table is within ``workspace``'s reach; 1 for None (a mobile
+    robot).
 
-    Gen II's obstacle footprints (box depth and width, cylinder diameter) scale by the same factor, as
-    Gen I's scale with the table's width: a smaller table holds as much clutter for its size, not the
-    same objects crowded three times as densely. Heights and the target (the gripper's) do not scale.
+    Raises:
+        SceneError: the factor would be below ``MIN_TABLE_SCALE`` (the objects would not fit).
     """
     if workspace is None:
-        return ranges
+        return 1.0
 
     def farthest(scale: float) -> float:  # a Gen II target in the far corner: the farthest point placed
         x = ranges.target_band[1] * ranges.table_length[1] * scale
@@ -44,7 +43,7 @@ def within_reach(ranges: RobotSceneRanges, workspace: Workspace | None) -> Robot
         return math.hypot(x - workspace.x, y)
 
     if farthest(1.0) <= workspace.reach:
-        return ranges
+        return 1.0
     low, high = 0.0, 1.0  # farthest() grows with the scale: bisect
     for _ in range(40):
         middle = (low + high) / 2.0
@@ -54,12 +53,26 @@ def within_reach(ranges: RobotSceneRanges, workspace: Workspace | None) -> Robot
             f"a robot reaching {workspace.reach} m from ({workspace.x}, {workspace.y}) reaches too little "
             "of a table to generate scenes on"
         )
+    return low
+
+
+def within_reach(ranges: RobotSceneRanges, workspace: Workspace | None) -> RobotSceneRanges:
+    """``ranges`` with the table's length and width scaled by ``reach_scale`` so that every generated
+    start and target is within ``workspace``'s reach; ``ranges`` itself for None (a mobile robot).
+
+    Gen II's obstacle footprints (box depth and width, cylinder diameter) scale by the same factor, as
+    Gen I's scale with the table's width: a smaller table holds as much clutter for its size, not the
+    same objects crowded three times as densely. Heights and the target (the gripper's) do not scale.
+    """
+    scale = reach_scale(ranges, workspace)
+    if scale == 1.0:
+        return ranges
     scaled = ("table_length", "table_width", "box_depth", "box_width", "cylinder_diameter")
-    return replace(ranges, **{name: tuple(low * v for v in getattr(ranges, name)) for name in scaled})
+    return replace(ranges, **{name: tuple(scale * v for v in getattr(ranges, name)) for name in scaled})
 
 
 MIN_TABLE_SCALE = 0.5
 """The smallest table scale ``within_reach`` makes (the objects still have to fit)."""
 
 
-__all__ = ["EDGE_INSET", "MIN_TABLE_SCALE", "Workspace", "within_reach"]
+__all__ = ["EDGE_INSET", "MIN_TABLE_SCALE", "Workspace", "reach_scale", "within_reach"]

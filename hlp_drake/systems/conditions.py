@@ -1,7 +1,8 @@
 """``Conditions``: what a run's command line, or one cell of a study's grid, sets over a scenario.
 
 The one way options become a ``Scenario``: ``run_scene``'s flags, the experiments' flags and a
-study's grid cells are each a ``Conditions``, applied by ``Conditions.applied``.
+study's grid cells are each a ``Conditions``, applied by ``Conditions.applied``. The bundled default
+scene, drawn for the mobile UR5, is scaled there to a fixed robot's reach (``scene_for_robot``).
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ from typing import TYPE_CHECKING
 
 from hlp_drake.systems.low_level.registry import low_level_entry
 from hlp_drake.systems.planning.initialisers import initialiser_name
-from hlp_drake.systems.world.robot_description import load_robot
+from hlp_drake.systems.world.robot_description import RobotDescription, load_robot
 
 if TYPE_CHECKING:
     from hlp_drake.scene.model import Scene
@@ -44,7 +45,8 @@ class Conditions:
     workers: int | None = None
 
     def applied(self, scenario: Scenario, *, scene: Scene | None = None) -> Scenario:
-        """``scenario`` under these conditions, on ``scene`` if given (None: its own), checked once.
+        """``scenario`` under these conditions, on ``scene`` if given (None: its own), checked once; the
+        bundled default scene scaled to a fixed robot's reach (``scene_for_robot``).
 
         Raises:
             HlpError: an unknown robot, initialiser or low-level planner, or settings that do not
@@ -64,6 +66,10 @@ class Conditions:
             changes["perception"] = replace(scenario.perception, source=self.perception)
         if self.world is not None and self.world != scenario.world.kind:
             changes["world"] = replace(scenario.world, kind=self.world)
+        on = changes.get("scene", scenario.scene)
+        fitted = scene_for_robot(on, changes.get("robot", scenario.robot))
+        if fitted is not on:
+            changes["scene"] = fitted
         return replace(scenario, **changes) if changes else scenario  # checked as it is made
 
     def _planner(self, scenario: Scenario):
@@ -79,10 +85,22 @@ class Conditions:
         return planner
 
 
+def scene_for_robot(scene: Scene, robot: RobotDescription) -> Scene:
+    """``scene``, or for the bundled default scene (drawn for the mobile UR5) on a fixed robot, the
+    default scaled to its reach as the generators scale their tables (``scaled_to_reach``: the same
+    as gen1 seed 3 generated for that robot). Any other scene is the user's: never changed."""
+    from hlp_drake.scene.generators import scaled_to_reach
+    from hlp_drake.scene.io import default_scene
+
+    if robot.mobile or scene != default_scene():
+        return scene
+    return scaled_to_reach(scene, robot.workspace, robot.name)
+
+
 def rollout_workers(scenario: Scenario) -> int | None:
     """The rollout processes the scenario's low-level planner needs (None: it does not roll out)."""
     entry = low_level_entry(scenario.low_level.kind)
     return getattr(scenario.low_level, "workers", 1) if entry.rolls_out else None
 
 
-__all__ = ["Conditions", "rollout_workers"]
+__all__ = ["Conditions", "rollout_workers", "scene_for_robot"]

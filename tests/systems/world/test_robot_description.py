@@ -15,9 +15,11 @@ from conftest import REPO
 
 from hlp_drake.commands.parsing import SHIPPED_ROBOTS
 from hlp_drake.errors import HlpError
-from hlp_drake.scene.generators import GEN1, generate_scene
+from hlp_drake.scene.generators import GEN1, generate_scene, scaled_to_reach
+from hlp_drake.scene.io import default_scene
 from hlp_drake.scene.workspace import Workspace, within_reach
 from hlp_drake.systems import Scenario, load_scenario
+from hlp_drake.systems.conditions import Conditions
 from hlp_drake.systems.low_level.control_sequence import ControlSequence
 from hlp_drake.systems.low_level.sto.planar_noise import planar_maps, planar_shift
 from hlp_drake.systems.world.robot_description import MOBILE_UR5, BaseConfig, RobotDescription, load_robot
@@ -237,6 +239,54 @@ def test_a_users_own_arm_runs_a_scene_end_to_end(own_robot, tmp_path):
     record = json.loads(out.read_text())
     assert record["robot"] == "arm6" and record["robot_actuated_dofs"] == 7  # 6 joints and a gripper
     assert result.returncode == 0, result.stdout + result.stderr
+
+
+@pytest.mark.parametrize("name", ["panda", "iiwa14", "own"])
+def test_the_default_scene_is_scaled_as_the_generators_scale_gen1_seed_3(name, own_robot):
+    robot = load_robot(own_robot if name == "own" else name)
+    scene = Conditions(robot=str(own_robot if name == "own" else name)).applied(Scenario()).scene
+    generated = generate_scene("gen1", 3, workspace=robot.workspace)  # the default is gen1 seed 3
+    assert scene.name.startswith(f"default (gen1 seed 3), scaled to the {robot.name}'s reach x0.")
+    assert (scene.table, scene.start) == (generated.table, generated.start)
+    for mine, theirs in zip((scene.target, *scene.obstacles), (generated.target, *generated.obstacles)):
+        assert mine.name == theirs.name
+        np.testing.assert_allclose(
+            [mine.x, mine.y, *mine.size], [theirs.x, theirs.y, *theirs.size], atol=2e-4
+        )
+    for x, y in (scene.start, (scene.target.x, scene.target.y)):
+        assert np.hypot(x - robot.workspace.x, y - robot.workspace.y) <= robot.workspace.reach
+    assert Conditions().applied(Scenario(robot=robot)).scene == scene  # the scenario's own robot: the same
+
+
+def test_only_the_default_scene_is_scaled_and_only_for_a_fixed_robot():
+    panda = load_robot("panda")
+    assert Conditions().applied(Scenario()).scene is default_scene()  # the mobile UR5's own
+    mine = replace(default_scene(), name="mine")  # a user's scene is never changed
+    assert Conditions(robot="panda").applied(Scenario(), scene=mine).scene is mine
+    assert scaled_to_reach(mine, None, "mobile_ur5") is mine
+    assert scaled_to_reach(mine, panda.workspace, "panda").table.length < 0.6 * mine.table.length
+
+
+@pytest.mark.parametrize("name", ["panda", "iiwa14", "own"])
+def test_every_fixed_robot_reaches_the_target_on_the_default_scene(name, own_robot, tmp_path):
+    """``run_scene --robot R`` with no scene: the bundled default, scaled to R's reach, succeeds in the
+    reference world (the paper's success)."""
+    out = tmp_path / "run.json"
+    robot = str(own_robot) if name == "own" else name
+    result = subprocess.run(
+        [sys.executable, "-m", "hlp_drake.run_scene", "--robot", robot, "--workers", "1", "--quiet"]
+        + ["--json", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    assert "Traceback" not in result.stderr, result.stderr
+    label = "arm6" if name == "own" else name
+    assert result.stdout.startswith(f"scene default (gen1 seed 3), scaled to the {label}'s reach x0.")
+    record = json.loads(out.read_text())
+    assert record["robot"] == label and record["world"] == "reference"
+    assert record["success"] is True and result.returncode == 0, result.stdout + result.stderr
 
 
 def test_a_fixed_arms_recording_looks_past_the_arm():

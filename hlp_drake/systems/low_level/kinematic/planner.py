@@ -176,9 +176,9 @@ class KinematicPlanner:
         for k in range(1, len(kept)):
             world.touching(touches[k - 1] | touches[k])
             goal = kept[k]
-            a, b = path[-1].copy(), goal.copy()
-            opening = np.maximum(a[fingers], b[fingers])  # checked with the wider grip of the two
-            a[fingers] = b[fingers] = opening
+            a, b = _gripped(world, path[-1], goal, fingers)
+            if a is None:
+                return failed(f"sub-goal {k} touches {_named(world.contacts(goal))} on its leg", iterations)
             if world.edge_free(a, b):
                 leg = Leg(np.array([a, b]), 0)
             else:
@@ -192,6 +192,17 @@ class KinematicPlanner:
             path.extend(knots)
             durations.extend(np.zeros(len(knots)) if leg.durations is None else leg.durations)
         return _Attempt(np.array(path), np.array(durations), iterations, "", notes, world)
+
+
+def _gripped(world: KinematicWorld, start: np.ndarray, goal: np.ndarray, fingers: list[int]):
+    """``start`` and ``goal`` with the fingers at the leg's grip: the wider of their two openings, or
+    the narrower where the wider touches an obstacle; (None, None) if neither is free at both ends."""
+    for grip in (np.maximum, np.minimum):
+        a, b = start.copy(), goal.copy()
+        a[fingers] = b[fingers] = grip(start[fingers], goal[fingers])
+        if world.free(a) and world.free(b):
+            return a, b
+    return None, None
 
 
 def _named(contacts: list[tuple[str, float]]) -> str:

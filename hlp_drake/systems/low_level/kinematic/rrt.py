@@ -44,7 +44,7 @@ class RrtConfig(KinematicConfig):
     """
 
     kind: Literal["rrt"] = "rrt"
-    iterations: Annotated[int, Count(1, 1_000_000)] = 20_000
+    iterations: Annotated[int, Count(1, 1_000_000)] = 5_000
     range: Annotated[float, Positive(0.0, 10.0, zero_ok=True)] = 0.5
     margin: Annotated[float, Positive(0.0, 6.3, zero_ok=True)] = 0.6
     shortcut: bool = True
@@ -101,6 +101,8 @@ class RrtPlanner(KinematicPlanner):
     def segment(self, world: KinematicWorld, start: np.ndarray, goal: np.ndarray, budget: int) -> Leg:
         base, geometric, _ = _ompl()
         config = self.config
+        if not (world.free(start) and world.free(goal)):  # RRT-Connect would wait for a valid end
+            return Leg(None, 0, "rrt: a leg's end touches an obstacle")
         columns = world.planned_columns
         lower, upper, _ = world.limits
         low = np.maximum(lower[columns], np.minimum(start[columns], goal[columns]) - config.margin)
@@ -121,7 +123,8 @@ class RrtPlanner(KinematicPlanner):
 
         setup.setStateValidityChecker(lambda state: world.free(positions(state)))
         information = setup.getSpaceInformation()
-        information.setStateValidityCheckingResolution(min(1.0, config.edge_step / space.getMaximumExtent()))
+        validator = _edge_validator(information, world, positions)
+        information.setMotionValidator(validator)
         ends = []
         for values in (start[columns], goal[columns]):
             state = space.allocState()
@@ -141,6 +144,7 @@ class RrtPlanner(KinematicPlanner):
             return count > budget
 
         setup.solve(base.PlannerTerminationCondition(stop))
+        del validator  # OMPL's space information holds it until the setup goes
         iterations = min(count, budget)
         if not setup.haveExactSolutionPath():
             return Leg(None, iterations)
@@ -151,6 +155,30 @@ class RrtPlanner(KinematicPlanner):
 
     def noun(self, iterations: int) -> str:
         return f"rrt found no path in {iterations} iterations"
+
+
+def _edge_validator_class():
+    base, _, _ = _ompl()
+
+    class EdgeValidator(base.MotionValidator):
+        """A motion is valid when Drake's checker finds the straight one free (one call per motion,
+        checked in C++ at the world's ``edge_step``)."""
+
+        def __init__(self, information, world: KinematicWorld, positions) -> None:
+            super().__init__(information)
+            self._world, self._positions = world, positions
+
+        def checkMotion(self, a, b, *last_valid) -> bool:
+            return self._world.edge_free(self._positions(a), self._positions(b))
+
+    return EdgeValidator
+
+
+def _edge_validator(information, world: KinematicWorld, positions):
+    cls = getattr(_edge_validator, "cls", None)
+    if cls is None:
+        cls = _edge_validator.cls = _edge_validator_class()
+    return cls(information, world, positions)
 
 
 def shortcut(world: KinematicWorld, path: np.ndarray) -> np.ndarray:

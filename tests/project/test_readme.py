@@ -65,7 +65,11 @@ def test_every_bash_block_runs(tmp_path):
         assert result.returncode == 0, (command, result.stdout, result.stderr)
         if "scene show" in command:
             assert "robot plan: start ->" in result.stdout and "human plan: start ->" in result.stdout
-        if "--robot" in command:  # your own robot, written by the example beside it
+        if "own_planner" in command:  # your own low-level planner, registered by the example
+            assert (
+                "low-level planner smooth" in result.stdout and "verdict: reach success" in result.stdout
+            ), result.stdout
+        elif "--robot" in command:  # your own robot, written by the example beside it
             assert "run: robot arm6" in result.stdout and "verdict: reach success" in result.stdout, (
                 result.stdout
             )

@@ -66,15 +66,24 @@ COLUMNS = (
     "replan_rollouts",
     "execute_s",
     *AXIS_COLUMNS,
+    "grasp_held",
+    "fallback",
 )
+"""The columns of ``results.csv``; a file written before the last ``LATER_COLUMNS`` lacks them."""
+LATER_COLUMNS = {"grasp_held": None, "fallback": False}
+"""Columns added after the first results files, with the value an older file's rows take (None:
+unknown): ``grasp_held``, the grasp after a reach success (empty when there was none);
+``fallback``, the low-level planner relaxed its problem to find the motion."""
 KEY_COLUMNS = ("scene", "objects", *AXIS_COLUMNS[1:])
 """A row's identity (``row_key``)."""
 CELL_COLUMNS = ("robot", "initial", "low_level", "planner", *AXIS_COLUMNS[4:])
 """A row's cell of the grid, as ``hlp_drake.config.what_ran.Labels`` names it."""
-BOOL_COLUMNS = frozenset({"success", "model_success", "false_accept"})
+BOOL_COLUMNS = frozenset({"success", "model_success", "false_accept", "fallback"})
 FLOAT_COLUMNS = frozenset({"init_s", "optimise_s", "total_s", "verify_s", "execute_s"})
 TEXT_COLUMNS = frozenset({"scene", "planner", "failure_reason", *AXIS_COLUMNS} - {"model_error"})
-INT_COLUMNS = frozenset(COLUMNS) - BOOL_COLUMNS - FLOAT_COLUMNS - TEXT_COLUMNS - {"model_error"}
+INT_COLUMNS = (
+    frozenset(COLUMNS) - BOOL_COLUMNS - FLOAT_COLUMNS - TEXT_COLUMNS - {"model_error", "grasp_held"}
+)
 BOOLEANS = {"true": True, "false": False}
 MAX_RESULTS_BYTES = 64 << 20
 """A larger ``results.csv`` is refused (a run of thousands of jobs writes a few MB)."""
@@ -96,6 +105,8 @@ def sort_key(row: Row) -> tuple:
 
 
 def _format(column: str, value: Any) -> str:
+    if column == "grasp_held":
+        return "" if value is None else ("true" if value else "false")
     if column in BOOL_COLUMNS:
         return "true" if value else "false"
     if column in FLOAT_COLUMNS:
@@ -106,6 +117,8 @@ def _format(column: str, value: Any) -> str:
 def _parse(column: str, text: str) -> Any:
     if column == "model_error":
         return int(text) if text else None
+    if column == "grasp_held":
+        return BOOLEANS[text] if text else None
     if column in BOOL_COLUMNS:
         return BOOLEANS[text]  # KeyError: not a boolean
     if column in INT_COLUMNS:
@@ -147,7 +160,7 @@ def read_results(
     reader = csv.reader(io.StringIO(read_run_file(path, MAX_RESULTS_BYTES), newline=""))
     try:
         header = tuple(next(reader, ()))
-        if header != COLUMNS:
+        if header != COLUMNS and header != COLUMNS[: -len(LATER_COLUMNS)]:
             raise HlpError(f"{path}: not an experiment results file (unexpected columns); {START_OVER}")
         rows = []
         for record in reader:
@@ -184,6 +197,8 @@ def _row(
     if len(record) != len(header):
         raise ValueError(f"{len(record)} fields")
     row = {c: _parse(c, text) for c, text in zip(header, record)}
+    for column, value in LATER_COLUMNS.items():  # an older file's rows
+        row.setdefault(column, value)
     for column in INT_COLUMNS:
         if row[column] < 0:
             raise ValueError(f"{column} {row[column]}, expected a count")

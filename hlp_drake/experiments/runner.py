@@ -158,9 +158,12 @@ def make_row(
     model_success: bool = False,
     replans: int = 0,
     replan_rollouts: int = 0,
+    grasp_held: bool | None = None,
+    fallback: bool = False,
 ) -> Row:
     """The row of ``job``'s outcome: init = plan + IK, total = init + low-level planning (execution
-    excluded), then the cell's labels."""
+    excluded), then the cell's labels, the grasp (None: not attempted) and whether the low-level
+    planner fell back to a relaxed problem."""
     init_s = plan_s + ik_s
     labels = job.cell.labels
     return {
@@ -193,6 +196,8 @@ def make_row(
         "perception": labels.perception,
         "model_error": labels.model_error,
         "world": labels.world,
+        "grasp_held": None if grasp_held is None else bool(grasp_held),
+        "fallback": bool(fallback),
     }
 
 

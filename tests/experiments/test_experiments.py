@@ -65,10 +65,28 @@ def interrupt_on_gen1_11_hlp(job: Job) -> dict:
     return cheap_job(job)
 
 
+def test_a_results_file_without_the_later_columns_still_reads(tmp_path):
+    """A results.csv written before ``grasp_held`` and ``fallback``: its rows read with them unknown."""
+    from hlp_drake.errors import HlpError
+    from hlp_drake.experiments.results import COLUMNS, LATER_COLUMNS, read_results
+
+    run_experiment(settings("gen1", scenes=1), tmp_path, job=cheap_job)
+    path = tmp_path / "results.csv"
+    lines = path.read_text().splitlines()
+    keep = len(COLUMNS) - len(LATER_COLUMNS)
+    path.write_text("\n".join(",".join(line.split(",")[:keep]) for line in lines) + "\n")
+    rows = read_results(path)
+    assert rows and all(r["grasp_held"] is None and r["fallback"] is False for r in rows)
+    path.write_text(lines[0].rsplit(",", 1)[0] + "\n")  # one later column only: not a results file
+    with pytest.raises(HlpError, match="unexpected columns"):
+        read_results(path)
+
+
 def test_csv_has_the_columns_one_row_per_scene_and_planner_sorted(tmp_path):
     summary = run_experiment(settings("gen2", scenes=2, objects=(4, 3)), tmp_path, job=cheap_job)
     rows = assert_well_formed(tmp_path / "results.csv")
-    assert list(rows[0])[: len(REQUIRED_COLUMNS)] == REQUIRED_COLUMNS and list(rows[0])[-1] == "world"
+    assert list(rows[0])[: len(REQUIRED_COLUMNS)] == REQUIRED_COLUMNS
+    assert list(rows[0])[-3:] == ["world", "grasp_held", "fallback"]
     assert {(r["generator"], r["robot"], r["initial"], r["low_level"]) for r in rows} == {
         ("gen2", MOBILE_UR5.name, "hlp", "sto"),
         ("gen2", MOBILE_UR5.name, "line", "sto"),

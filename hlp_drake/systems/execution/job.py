@@ -117,6 +117,8 @@ def run_job(job: Job) -> Row:
         model_success=bool(result.model_success),
         replans=result.closed_loop.get("replans", 0),
         replan_rollouts=result.closed_loop.get("rollouts", 0),
+        grasp_held=result.grasp_held,
+        fallback=bool(low_level.get("fallback")),
     )
 
 

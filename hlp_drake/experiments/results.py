@@ -81,9 +81,7 @@ CELL_COLUMNS = ("robot", "initial", "low_level", "planner", *AXIS_COLUMNS[4:])
 BOOL_COLUMNS = frozenset({"success", "model_success", "false_accept", "fallback"})
 FLOAT_COLUMNS = frozenset({"init_s", "optimise_s", "total_s", "verify_s", "execute_s"})
 TEXT_COLUMNS = frozenset({"scene", "planner", "failure_reason", *AXIS_COLUMNS} - {"model_error"})
-INT_COLUMNS = (
-    frozenset(COLUMNS) - BOOL_COLUMNS - FLOAT_COLUMNS - TEXT_COLUMNS - {"model_error", "grasp_held"}
-)
+INT_COLUMNS = frozenset(COLUMNS) - BOOL_COLUMNS - FLOAT_COLUMNS - TEXT_COLUMNS - {"model_error", "grasp_held"}
 BOOLEANS = {"true": True, "false": False}
 MAX_RESULTS_BYTES = 64 << 20
 """A larger ``results.csv`` is refused (a run of thousands of jobs writes a few MB)."""

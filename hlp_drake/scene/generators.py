@@ -8,14 +8,13 @@ the world frame of ``hlp_drake.dataset.frames`` (front edge of the table at x = 
   row in random order, free intervals of at least 5 mm on a 5 mm grid, target can at 0.525 m.
 - ``gen1``: Generalization I: the same two-row structure on a robot-sized table with table and object
   dimensions varied (see ``GEN1``).
-
 - ``gen2``: Generalization II: 5, 7 or 9 (any N >= 1) boxes and cylinders placed at random, the start
   on a random point of the front edge with a random heading, the target not aligned with the start.
 - ``unstructured``: the dataset's unstructured trials (T100-T129): the VR table, N (default 6) obstacles
   at random on a 1 cm grid, random lateral start and target positions.
 
 For a robot fixed before the table, gen1 and gen2 keep their tables within its reach (``workspace``);
-``scaled_to_reach`` scales a given scene (the bundled default) by the same factor.
+``hlp_drake.scene.scaled`` scales a given scene (the bundled default) by the same factor.
 """
 
 from __future__ import annotations
@@ -35,7 +34,7 @@ from hlp_drake.scene.constants import KINDS, MAX_GENERATED
 from hlp_drake.scene.geometry import footprint
 from hlp_drake.scene.model import Scene, SceneObject, Table
 from hlp_drake.scene.validation import validate_scene
-from hlp_drake.scene.workspace import EDGE_INSET, Workspace, reach_scale, within_reach
+from hlp_drake.scene.workspace import EDGE_INSET, Workspace, within_reach
 
 # --- The VR study (reference notes 1.2): metres, world frame. -----------------------------------
 VR_TABLE = Table(length=0.60, width=0.74, height=0.73)
@@ -81,7 +80,7 @@ def _rounded(value: float) -> float:
     return round(float(value), DECIMALS)
 
 
-def _finish(scene: Scene) -> Scene:
+def finished(scene: Scene) -> Scene:
     """Round every generated number to ``DECIMALS`` and validate the scene."""
 
     def tidy(obj: SceneObject) -> SceneObject:
@@ -186,7 +185,7 @@ def generate_vr(seed: int) -> Scene:
             grid=VR_GRID,
         )
     target = SceneObject(name="Target", shape="cylinder", x=VR_TARGET_X, y=0.0, size=VR_TARGET_SIZE)
-    return _finish(
+    return finished(
         Scene(table=VR_TABLE, start=VR_START, target=target, obstacles=tuple(obstacles), name=f"vr-{seed}")
     )
 
@@ -236,7 +235,7 @@ def generate_gen1(seed: int, ranges: RobotSceneRanges = GEN1) -> Scene:
         )
     target = _target(rng, ranges, VR_TARGET_X * depth_ratio, 0.0)
     start = (VR_START[0] * depth_ratio, 0.0)
-    return _finish(
+    return finished(
         Scene(table=table, start=start, target=target, obstacles=tuple(obstacles), name=f"gen1-{seed}")
     )
 
@@ -313,7 +312,7 @@ def generate_gen2(seed: int, objects: int = 7, ranges: RobotSceneRanges = GEN1) 
         _place_at_random(rng, make(i), occupied, ranges.min_clearance, f"obstacle {i} of {objects}")
         for i in range(1, objects + 1)
     )
-    return _finish(
+    return finished(
         Scene(
             table=table,
             start=start,
@@ -363,39 +362,8 @@ def generate_unstructured(seed: int, objects: int = 6) -> Scene:
         _place_at_random(rng, make(i), occupied, VR_MIN_GAP, f"obstacle {i + 1} of {objects}")
         for i in range(objects)
     )
-    return _finish(
+    return finished(
         Scene(table=VR_TABLE, start=start, target=target, obstacles=obstacles, name=f"unstructured-{seed}")
-    )
-
-
-def scaled_to_reach(scene: Scene, workspace: Workspace | None, robot: str) -> Scene:
-    """``scene`` scaled by the factor the generators scale their tables by for ``workspace``
-    (``reach_scale`` of ``GEN1``), as they scale: the table's length and width, every position on it and
-    the obstacles' footprints; heights, the start's heading and the target's size (the gripper's) kept.
-    Its name says so ("..., scaled to the ROBOT's reach x0.59"); ``scene`` itself at a factor of 1.
-
-    Raises:
-        SceneError: the robot reaches too little of a table (``reach_scale``), or the scaled scene is
-            not valid (e.g. the target now overlaps an obstacle).
-    """
-    scale = reach_scale(GEN1, workspace)
-    if scale == 1.0:
-        return scene
-
-    def scaled(obj: SceneObject) -> SceneObject:
-        size = obj.size if obj is scene.target else (obj.size[0] * scale, obj.size[1] * scale, obj.size[2])
-        return replace(obj, x=obj.x * scale, y=obj.y * scale, size=size)
-
-    table = scene.table
-    return _finish(
-        replace(
-            scene,
-            table=Table(table.length * scale, table.width * scale, table.height),
-            start=(scene.start[0] * scale, scene.start[1] * scale),
-            target=scaled(scene.target),
-            obstacles=tuple(scaled(o) for o in scene.obstacles),
-            name=f"{scene.name}, scaled to the {robot}'s reach x{scale:.2f}",
-        )
     )
 
 

@@ -89,8 +89,8 @@ def scene_for_robot(scene: Scene, robot: RobotDescription) -> Scene:
     """``scene``, or for the bundled default scene (drawn for the mobile UR5) on a fixed robot, the
     default scaled to its reach as the generators scale their tables (``scaled_to_reach``: the same
     as gen1 seed 3 generated for that robot). Any other scene is the user's: never changed."""
-    from hlp_drake.scene.generators import scaled_to_reach
     from hlp_drake.scene.io import default_scene
+    from hlp_drake.scene.scaled import scaled_to_reach
 
     if robot.mobile or scene != default_scene():
         return scene

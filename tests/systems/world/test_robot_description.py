@@ -15,8 +15,9 @@ from conftest import REPO
 
 from hlp_drake.commands.parsing import SHIPPED_ROBOTS
 from hlp_drake.errors import HlpError
-from hlp_drake.scene.generators import GEN1, generate_scene, scaled_to_reach
+from hlp_drake.scene.generators import GEN1, generate_scene
 from hlp_drake.scene.io import default_scene
+from hlp_drake.scene.scaled import scaled_to_reach
 from hlp_drake.scene.workspace import Workspace, within_reach
 from hlp_drake.systems import Scenario, load_scenario
 from hlp_drake.systems.conditions import Conditions

@@ -100,6 +100,18 @@ def test_each_planner_alone_detours_around_what_it_may_not_touch(detour, planner
     assert np.max(speeds) <= config.timing.tcp_speed + 1e-6  # timed at the tcp's speed
 
 
+@pytest.mark.parametrize("kind", ["trajopt", "rrt"])
+def test_each_planner_in_the_planning_diagram_needs_no_pool(detour, kind):
+    scene, _, trajectory = detour
+    diagram = make_planning_diagram(on(scene, f"planner: {{low_level: {{kind: {kind}}}}}"))  # no pool given
+    context = diagram.CreateDefaultContext()
+    diagram.GetInputPort("scene").FixValue(context, scene)
+    result = diagram.GetOutputPort("optimisation").Eval(context)
+    assert result.success and result.low_level == kind and result.iterations >= 1
+    planned = diagram.GetOutputPort("optimised_trajectory").Eval(context)
+    assert np.allclose(planned.value(planned.end_time()).ravel(), sub_goals(trajectory)[-1])
+
+
 def test_rrt_is_deterministic_per_seed(detour):
     scene, keyframes, trajectory = detour
     model = on(scene).world_model

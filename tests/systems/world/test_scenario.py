@@ -223,11 +223,12 @@ def test_the_low_level_section_is_a_tagged_union_of_the_registered_planners_sett
         load_scenario(data="planner: {low_level: {samples: 3, smoothness: 2.0}}")
     (line,) = info.value.problems
     assert line.startswith("overrides: planner.low_level: 'smoothness' is a setting of sketch, not of sto")
-    assert "(the low-level planners: sto, sketch; give its kind to use another)" in line
+    assert "(the low-level planners: sto, trajopt, rrt, sketch; give its kind to use another)" in line
     with pytest.raises(
-        HlpError, match=r"planner\.low_level\.kind: unknown low-level planner 'rrt' \(known: sto, sketch\)"
+        HlpError,
+        match=r"planner\.low_level\.kind: unknown low-level planner 'prm' \(known: sto, trajopt, rrt, sketch\)",
     ):
-        load_scenario(data="planner: {low_level: {kind: rrt}}")
+        load_scenario(data="planner: {low_level: {kind: prm}}")
 
 
 def test_the_former_spellings_are_read_in_their_new_places():
@@ -272,7 +273,9 @@ def test_conditions_lay_the_command_lines_settings_over_a_scenario(sketch):
     assert line.closed_loop.enabled and line.uncertainty.enabled and line.uncertainty.seed == 3
     other = Conditions(low_level="sketch", workers=4).applied(scenario)  # its default settings
     assert other.low_level == SketchConfig()  # it does not roll out: no workers to set
-    with pytest.raises(HlpError, match=r"unknown low-level planner 'astar' \(known: sto, sketch\)"):
+    with pytest.raises(
+        HlpError, match=r"unknown low-level planner 'astar' \(known: sto, trajopt, rrt, sketch\)"
+    ):
         Conditions(low_level="astar").applied(scenario)
     with pytest.raises(HlpError, match=r"unknown initialiser 'astar' \(known: hlp, line, sto \(= line\)\)"):
         Conditions(initial="astar").applied(scenario)

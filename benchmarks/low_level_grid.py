@@ -55,7 +55,7 @@ def grid(rows: pd.DataFrame) -> pd.DataFrame:
                 "model_accepted": int(got.model_success.sum()),
                 "false_accepts": int(got.false_accept.sum()),
                 "fallbacks": int(got.fallback.sum()),
-                "grasp_held": None if held.isna().any() else int(held.sum()),
+                "grasp_held": None if held.isna().any() else int(held.astype(bool).sum()),
                 "reach_successes": wins,
             }
         )
@@ -74,7 +74,8 @@ def main(argv: list[str] | None = None) -> int:
     check_folder(args.out, *OUTPUTS).mkdir(exist_ok=True)
     rows = pd.DataFrame([row for run in args.runs for row in read_results(run / "results.csv")])
     table = grid(rows)
-    write_text_atomic(args.out / OUTPUTS[0], json.dumps(table.to_dict(orient="records"), indent=1))
+    records = [{k: None if pd.isna(v) else v for k, v in r.items()} for r in table.to_dict(orient="records")]
+    write_text_atomic(args.out / OUTPUTS[0], json.dumps(records, indent=1))
     write_text_atomic(args.out / OUTPUTS[1], table.to_csv(index=False, float_format="%.4f"))
     conditions = list(dict.fromkeys(table.condition))
     figure, _ = new_figure(4.0 * len(conditions), 3.6)

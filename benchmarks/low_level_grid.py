@@ -5,7 +5,7 @@
 
 Reads each run folder's ``results.csv`` and gives per condition (generator, object count, robot),
 low-level planner and initialiser: success with its 95 % Wilson interval, the planning time (init +
-low-level planning, s) mean and median, the low-level planner's iterations and rollouts (mean,
+low-level planning, s) mean and median (and the medians of each part), the low-level planner's iterations and rollouts (mean,
 median), the false accepts (the planner accepted, the world failed), the fallbacks (a kinematic
 planner that allowed contact with every object) and the grasps held after a reach success.
 Writes ``DIR/low_level_grid.json``, ``DIR/low_level_grid.csv`` and ``DIR/low_level_grid.png``.
@@ -49,6 +49,8 @@ def grid(rows: pd.DataFrame) -> pd.DataFrame:
                 "success_high_pct": high,
                 "time_mean_s": got.total_s.mean(),
                 "time_median_s": got.total_s.median(),
+                "init_median_s": got.init_s.median(),
+                "low_level_median_s": got.optimise_s.median(),
                 "iterations_mean": got.iterations.mean(),
                 "iterations_median": got.iterations.median(),
                 "rollouts_mean": got.rollouts.mean(),

@@ -83,6 +83,9 @@ class KinematicWorld:
             for name, instance in self.scene_models.objects.items()
             if name not in self.allowed
         }
+        self._touched: set[str] = set()
+        self._filters = np.array(self.checker.GetFilteredCollisionMatrix())
+        self._robot_indices = [int(body.index()) for body in self._robot_bodies]
         self._context = self.checker.MakeStandaloneModelContext()
         self._diagram_context = self.diagram.CreateDefaultContext()
         self.plant_context = self.plant.GetMyContextFromRoot(self._diagram_context)
@@ -90,21 +93,26 @@ class KinematicWorld:
 
     def touching(self, names: Iterable[str] = ()) -> None:
         """Let the robot touch the objects ``names`` besides ``allowed`` from now on (and no others)."""
-        names = set(names)
+        names = {name for name in names if name in self._others}
+        changed, self._touched = names ^ self._touched, names  # only what changes is filtered anew
         scene_graph = self.diagram.scene_graph()
         manager = scene_graph.collision_filter_manager(
             scene_graph.GetMyMutableContextFromRoot(self._diagram_context)
         )
-        for name, (bodies, geometries) in self._others.items():
-            touch = name in names
-            for robot in self._robot_bodies:
-                for body in bodies:
-                    self.checker.SetCollisionFilteredBetween(robot, body, touch)
+        if not changed:
+            return
+        matrix = self._filters.copy()  # the checker's: one update, not one per pair of bodies
+        for name in names:
+            for body in self._others[name][0]:
+                matrix[self._robot_indices, int(body.index())] = 1
+                matrix[int(body.index()), self._robot_indices] = 1
+        self.checker.SetCollisionFilterMatrix(matrix)
+        for name in changed:
             declaration = CollisionFilterDeclaration()
-            if touch:
-                declaration.ExcludeBetween(self._robot_geometries, geometries)
+            if name in names:
+                declaration.ExcludeBetween(self._robot_geometries, self._others[name][1])
             else:
-                declaration.AllowBetween(self._robot_geometries, geometries)
+                declaration.AllowBetween(self._robot_geometries, self._others[name][1])
             manager.Apply(declaration)
 
     @staticmethod

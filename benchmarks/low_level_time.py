@@ -22,7 +22,7 @@ from pathlib import Path
 import pandas as pd
 from tqdm import tqdm
 
-from hlp_drake.commands.parsing import run_cli
+from hlp_drake.commands.parsing import drake_logging, run_cli
 from hlp_drake.files.atomic import check_folder, write_text_atomic
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.systems.conditions import Conditions
@@ -64,6 +64,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=Path("benchmark-results"))
     args = parser.parse_args(argv)
     check_folder(args.out, *OUTPUTS).mkdir(exist_ok=True)
+    drake_logging(False)  # Drake's INFO lines off, as the commands have them
     rows = []
     for seed in tqdm(range(args.seed, args.seed + args.scenes), unit=" scenes"):
         scene = generate_scene(args.kind, seed, args.objects)

@@ -1,7 +1,7 @@
 """Planning time alone (no execution) of the kinematic low-level planners with either initialiser.
 
     python benchmarks/low_level_time.py [--kind gen2] [--objects 9] [--scenes 100] [--seed 0]
-        [--planners trajopt rrt] [--out DIR]
+        [--planners trajopt rrt] [--out DIR]   (--objects: gen2 only)
 
 For each scene (the experiments' seeds) and each low-level planner, both initialisers are timed
 side by side in this one process: init (the plan and the keypoint IK) and the low-level planner,
@@ -57,7 +57,7 @@ def _timed(scene, initial: str, low_level: str) -> dict:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--kind", default="gen2")
-    parser.add_argument("--objects", type=int, default=9)
+    parser.add_argument("--objects", type=int, default=None, help="gen2: 5, 7, 9 (gen1: 6, fixed)")
     parser.add_argument("--scenes", type=int, default=100)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--planners", nargs="+", default=["trajopt", "rrt"])

@@ -138,8 +138,8 @@ class KinematicPlanner:
 
     @property
     def budget(self) -> int:
-        """The iterations a plan may use in all."""
-        return int(getattr(self.config, "iterations", 1))
+        """The iterations a plan may use in all (its legs share them)."""
+        raise NotImplementedError
 
     def _attempt(self, scene: Scene, goals: np.ndarray, allowed, budget: int) -> _Attempt:
         """A path through ``goals`` touching nothing but ``allowed`` (and its iterations), or why not."""

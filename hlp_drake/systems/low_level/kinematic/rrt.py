@@ -94,6 +94,10 @@ class RrtPlanner(KinematicPlanner):
         _ompl()  # refuse now if OMPL is missing
         super().__init__(config, context)
 
+    @property
+    def budget(self) -> int:
+        return self.config.iterations
+
     def plan(self, problem: LowLevelProblem) -> LowLevelResult:
         with seeded(self.config.seed):
             return super().plan(problem)

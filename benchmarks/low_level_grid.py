@@ -93,7 +93,8 @@ def main(argv: list[str] | None = None) -> int:
         ax.set_xticks(np.arange(len(PLANNERS)), PLANNERS)
         ax.set_ylim(0, 118)
         ax.set_title(condition)
-        ax.set_ylabel("success in the reference world, %")
+        if k == 0:
+            ax.set_ylabel("success in the reference world, %")
         ax.legend(loc="upper right", fontsize=8, ncols=2)
     save_png(figure, args.out / OUTPUTS[2])
     print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))

@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 from collections.abc import Iterator
 from dataclasses import dataclass
+from functools import cache
 from typing import Annotated, Literal
 
 import numpy as np
@@ -105,8 +106,6 @@ class RrtPlanner(KinematicPlanner):
     def segment(self, world: KinematicWorld, start: np.ndarray, goal: np.ndarray, budget: int) -> Leg:
         base, geometric, _ = _ompl()
         config = self.config
-        if not (world.free(start) and world.free(goal)):  # RRT-Connect would wait for a valid end
-            return Leg(None, 0, "rrt: a leg's end touches an obstacle")
         columns = world.planned_columns
         lower, upper, _ = world.limits
         low = np.maximum(lower[columns], np.minimum(start[columns], goal[columns]) - config.margin)
@@ -127,7 +126,7 @@ class RrtPlanner(KinematicPlanner):
 
         setup.setStateValidityChecker(lambda state: world.free(positions(state)))
         information = setup.getSpaceInformation()
-        validator = _edge_validator(information, world, positions)
+        validator = _edge_validator_class()(information, world, positions)
         information.setMotionValidator(validator)
         ends = []
         for values in (start[columns], goal[columns]):
@@ -157,10 +156,8 @@ class RrtPlanner(KinematicPlanner):
         path[0], path[-1] = start, goal
         return Leg(shortcut(world, path) if config.shortcut else path, iterations)
 
-    def noun(self, iterations: int) -> str:
-        return f"rrt found no path in {iterations} iterations"
 
-
+@cache
 def _edge_validator_class():
     base, _, _ = _ompl()
 
@@ -176,13 +173,6 @@ def _edge_validator_class():
             return self._world.edge_free(self._positions(a), self._positions(b))
 
     return EdgeValidator
-
-
-def _edge_validator(information, world: KinematicWorld, positions):
-    cls = getattr(_edge_validator, "cls", None)
-    if cls is None:
-        cls = _edge_validator.cls = _edge_validator_class()
-    return cls(information, world, positions)
 
 
 def shortcut(world: KinematicWorld, path: np.ndarray, passes: int = 12) -> np.ndarray:

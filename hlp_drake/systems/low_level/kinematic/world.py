@@ -86,7 +86,6 @@ class KinematicWorld:
         self._touched: set[str] = set()
         self._filters = np.array(self.checker.GetFilteredCollisionMatrix())
         self._robot_indices = [int(body.index()) for body in self._robot_bodies]
-        self._context = self.checker.MakeStandaloneModelContext()
         self._diagram_context = self.diagram.CreateDefaultContext()
         self.plant_context = self.plant.GetMyContextFromRoot(self._diagram_context)
         """A context of the plant in its diagram (with the SceneGraph's): for distance constraints."""
@@ -137,21 +136,17 @@ class KinematicWorld:
         mimics = len(self.description.mimic_joints)
         return tuple(np.concatenate([a, np.repeat(a[-1:], mimics)]) for a in limits)
 
-    def full(self, q: np.ndarray) -> np.ndarray:
-        """The plant's positions with the robot at ``q`` (the objects are welded: the same)."""
-        return np.asarray(q, dtype=float)
-
     def free(self, q: np.ndarray) -> bool:
         """Whether the robot at ``q`` touches no obstacle."""
-        return bool(self.checker.CheckConfigCollisionFree(self.full(q)))
+        return bool(self.checker.CheckConfigCollisionFree(q))
 
     def edge_free(self, a: np.ndarray, b: np.ndarray) -> bool:
         """Whether the straight motion from ``a`` to ``b`` touches no obstacle (checked at ``edge_step``)."""
-        return bool(self.checker.CheckEdgeCollisionFree(self.full(a), self.full(b)))
+        return bool(self.checker.CheckEdgeCollisionFree(a, b))
 
     def contacts(self, q: np.ndarray, influence: float = 0.02) -> list[tuple[str, float]]:
         """The obstacles the robot at ``q`` touches (name, signed distance < 0), nearest first."""
-        report = self.checker.CalcRobotClearance(self.full(q), influence)
+        report = self.checker.CalcRobotClearance(q, influence)
         found: dict[str, float] = {}
         for distance, other in zip(report.distances(), report.other_indices()):
             if distance < 0:
@@ -161,12 +156,12 @@ class KinematicWorld:
 
     def clearance(self, q: np.ndarray, influence: float = 0.05) -> float:
         """The robot's smallest signed distance to an obstacle at ``q`` (``influence`` if none is nearer)."""
-        distances = self.checker.CalcRobotClearance(self.full(q), influence).distances()
+        distances = self.checker.CalcRobotClearance(q, influence).distances()
         return float(np.min(distances)) if len(distances) else influence
 
     def tcp(self, q: np.ndarray) -> np.ndarray:
         """The tcp's position in the world at ``q``."""
-        context = self._context.plant_context()
+        context = self.plant_context
         self.plant.SetPositions(context, self.robot, np.asarray(q, dtype=float))
         frame = self.plant.GetFrameByName(self.description.tcp_frame, self.robot)
         return frame.CalcPoseInWorld(context).translation()

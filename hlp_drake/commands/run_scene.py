@@ -103,6 +103,18 @@ def recording_title(result, ran: WhatRan) -> str:
     return f"scene {result.scene.name}, {planners} {seen}: {reach}{held}"
 
 
+def _planned(result) -> str:
+    """What a low-level planner that does not roll out did (its time, and its iterations and fallback
+    where it has them), or that none ran."""
+    record = result.optimisation
+    if not record:
+        return "not optimised"
+    said = [counted(result.iterations, "iteration")] if result.iterations else []
+    said += [record["fallback"]] if record.get("fallback") else []
+    detail = f" ({'; '.join(said)})" if said else ""
+    return f"{result.low_level} {result.timings['optimise_s']:.2f} s{detail}"
+
+
 def summary(result) -> str:
     """The run's summary: timings, the objects moved and dropped, the verdict (what ran is the
     header's ``run:`` line, printed before the run)."""
@@ -113,7 +125,7 @@ def summary(result) -> str:
         f"optimise {t['optimise_s']:.1f} s ({counted(result.iterations, 'iteration')}, "
         f"{counted(result.rollouts, 'rollout')}{alternative})"
         if result.rollouts
-        else "not optimised"
+        else _planned(result)
     )
     verified = (result.optimisation or {}).get("verifications", 0)
     if verified:

@@ -5,6 +5,7 @@ alone as a Drake block (fixed inputs, evaluated outputs), their fallback and bud
 from __future__ import annotations
 
 import json
+import re
 from itertools import pairwise
 
 import numpy as np
@@ -147,6 +148,8 @@ def test_run_scene_names_the_planner_and_succeeds_on_the_default_scene(kind, tmp
     assert report["planner"] == f"hlp+{kind}" and report["rollouts"] == 0
     assert status == 0 and report["success"], report["failure_reason"]
     assert low_level_entry(kind).rolls_out is False
+    timings = [line for line in capsys.readouterr().out.splitlines() if line.startswith("timings:")]
+    assert timings and re.search(rf", {kind} \d+\.\d\d s", timings[0]), timings
 
 
 @pytest.mark.parametrize(

@@ -158,7 +158,8 @@ def calibration(models: DecisionModels, rows: LabelledSet, bins: int = 10) -> di
     candidates within the demonstrations' range (novelty <= 1). Empty for the paper's planner."""
     if models.planner != "rows" or len(rows) == 0:
         return {}
-    p = models.row.predict_proba(rows.X)[:, 1]
+    X = rows.X[:, : models.row_features]
+    p = models.row.predict_proba(X)[:, 1]
     taken = rows.y > 0
     which = np.minimum((p * bins).astype(int), bins - 1)
     gap = sum(
@@ -169,7 +170,7 @@ def calibration(models: DecisionModels, rows: LabelledSet, bins: int = 10) -> di
     return {
         "ece": float(gap),
         "brier": float(np.mean((p - taken) ** 2)),
-        "in_distribution": float(np.mean(models.row.novelty(rows.X) <= 1.0)),
+        "in_distribution": float(np.mean(models.row.novelty(X) <= 1.0)),
     }
 
 

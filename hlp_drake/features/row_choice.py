@@ -40,6 +40,12 @@ ROW_CHOICE_FEATURES = (
     "route_detour", "next_best_offset", "next_corridor_block", "ahead", "distance",
     "target_offset", "target_beyond",
 )  # fmt: skip
+CONTEXT_FEATURES = ("came_by_move", "came_by_gap", "moves_before", "turn")
+"""The way the hand came (``RowChoiceScene.candidates``' ``previous``): how it reached its
+keypoint (releasing a moved obstacle, through a gap; neither: from the start), how many obstacles
+it moved on the way, and the angle between its heading there and its way to the candidate."""
+ROW_CONTEXT_FEATURES = ROW_CHOICE_FEATURES + CONTEXT_FEATURES
+"""Xr with the context (a model trained without it reads the first ``len(ROW_CHOICE_FEATURES)``)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -124,6 +130,8 @@ class RowChoiceScene:
         *,
         mirror: bool = False,
         limit: int | None = None,
+        previous: np.ndarray | None = None,
+        came_by: Sequence[str] | None = None,
     ) -> list[RowCandidates]:
         """The candidates of ``row`` and their features Xr, for each hand of ``hands`` heading for
         the target.
@@ -137,6 +145,10 @@ class RowChoiceScene:
                 serves both arms (the planner models a right arm).
             limit: keep only this many gaps and this many obstacles, those laterally nearest each
                 hand's line (all if None).
+            previous: (B, 2) per hand, the keypoint before it (its heading is from there to the
+                hand; None, or a hand at its own previous keypoint: heading for the target).
+            came_by: per hand, the action that brought it to its keypoint: "release" (an
+                obstacle moved), "gap", or anything else (the start).
 
         Returns:
             One ``RowCandidates`` per hand.
@@ -151,6 +163,7 @@ class RowChoiceScene:
         gap_union, obj_union = sorted(set().union(*gap_keep)), sorted(set().union(*obj_keep))
         points = candidate_points(geometry, gap_union, obj_union, line, self.width)
         X = self._features(row, hands, line, points, gap_union, obj_union, removed, mirror=mirror)
+        X = np.concatenate([X, self._context(hands, points, removed, previous, came_by)], axis=2)
         return self._per_hand(row, gap_union, obj_union, gap_keep, obj_keep, points, X)
 
     def _features(
@@ -212,6 +225,32 @@ class RowChoiceScene:
         X[:, :, 26] = np.minimum((goal[0] - geometry.x) / w, CAP)
         self._route_features(X, hands, points, members, n_gaps, removed)
         return X
+
+    def _context(
+        self,
+        hands: np.ndarray,
+        points: np.ndarray,
+        removed: list[frozenset[int]],
+        previous: np.ndarray | None,
+        came_by: Sequence[str] | None,
+    ) -> np.ndarray:
+        """(B, n, len(CONTEXT_FEATURES)) the way each hand came (see ``CONTEXT_FEATURES``)."""
+        B, n = points.shape[:2]
+        context = np.zeros((B, n, len(CONTEXT_FEATURES)))
+        if came_by is not None:
+            context[:, :, 0] = np.array([c == "release" for c in came_by], float)[:, None]
+            context[:, :, 1] = np.array([c == "gap" for c in came_by], float)[:, None]
+        context[:, :, 2] = np.array([min(len(r), CAP) for r in removed], float)[:, None]
+        heading = (
+            self.goal - hands if previous is None else hands - np.asarray(previous, float).reshape(-1, 2)
+        )
+        still = np.hypot(*heading.T) < 1e-9
+        heading[still] = (self.goal - hands)[still]
+        way = points - hands[:, None]
+        cross = heading[:, None, 0] * way[..., 1] - heading[:, None, 1] * way[..., 0]
+        dot = heading[:, None, 0] * way[..., 0] + heading[:, None, 1] * way[..., 1]
+        context[:, :, 3] = np.abs(np.arctan2(cross, dot))
+        return context
 
     def _per_hand(
         self,

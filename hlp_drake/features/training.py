@@ -9,7 +9,7 @@ import numpy as np
 
 from hlp_drake.features.arm import ARM_FEATURES, arm_features
 from hlp_drake.features.direction import DIRECTION_FEATURES, direction_features, direction_index
-from hlp_drake.features.row_choice import HUMAN_HAND_WIDTH, ROW_CHOICE_FEATURES, RowChoiceScene
+from hlp_drake.features.row_choice import HUMAN_HAND_WIDTH, ROW_CONTEXT_FEATURES, RowChoiceScene
 from hlp_drake.features.scene_features import GAP_FEATURES, OBJECT_FEATURES, gap_features, object_features
 from hlp_drake.features.segment import SEGMENT_FEATURES, segment_feature_matrix
 from hlp_drake.segmentation.demonstration import GAP, NONE, OBJECT, Demonstration
@@ -171,12 +171,15 @@ def row_choice_rows(
     """
     features = RowChoiceScene(space, hand_width)
     hand = np.asarray(demo.scene.start, float)
+    previous, came_by = hand, "start"
     removed: set[int] = set()
     rows = []
     for decision in demo.decisions:
         if decision.decision == NONE:
             continue
-        (candidates,) = features.candidates(decision.row, hand, [removed], mirror=demo.left_handed)
+        (candidates,) = features.candidates(
+            decision.row, hand, [removed], mirror=demo.left_handed, previous=previous, came_by=[came_by]
+        )
         names = space.obstacle_names
         chosen = [
             k
@@ -192,9 +195,11 @@ def row_choice_rows(
             region = relocated_array(space.obstacle_bounds[[obstacle]], space.alpha)[
                 0, DIRECTIONS.index(decision.direction)
             ]
+            previous, came_by = candidates.points[k], "release"
             hand = np.array([(region[0] + region[2]) / 2.0, (region[1] + region[3]) / 2.0])
             removed.add(obstacle)
         else:
+            previous, came_by = hand, "gap"
             hand = candidates.points[k]
     return rows
 
@@ -206,7 +211,7 @@ def _add_row_choice(builder: _Builder, demo: Demonstration, space: TaskSpace) ->
 
 def row_choice_set(demonstrations: Iterable[Demonstration]) -> LabelledSet:
     """The row-choice examples (``row_choice_rows``) of fixed-mode demonstrations."""
-    builder = _Builder(ROW_CHOICE_FEATURES)
+    builder = _Builder(ROW_CONTEXT_FEATURES)
     for demo in demonstrations:
         _add_row_choice(builder, demo, TaskSpace(demo.scene))
     return builder.build()
@@ -224,7 +229,7 @@ def training_data(demonstrations: Iterable[Demonstration], *, mode: Mode | None 
     - arm: consecutive keypoints (label: the next keypoint's (q1, q2));
     - row (fixed mode): every candidate of every row the person crossed (``row_choice_rows``).
     """
-    gap, obj, row_set = _Builder(GAP_FEATURES), _Builder(OBJECT_FEATURES), _Builder(ROW_CHOICE_FEATURES)
+    gap, obj, row_set = _Builder(GAP_FEATURES), _Builder(OBJECT_FEATURES), _Builder(ROW_CONTEXT_FEATURES)
     direction, segment, arm = _Builder(DIRECTION_FEATURES), _Builder(SEGMENT_FEATURES), _Builder(ARM_FEATURES)
     people = _Builder(("upper_arm", "forearm"))
     for demo in demonstrations:

@@ -32,7 +32,7 @@ import numpy as np
 from hlp_drake.errors import ModelError
 from hlp_drake.features.arm import ARM_FEATURES
 from hlp_drake.features.direction import DIRECTION_FEATURES
-from hlp_drake.features.row_choice import ROW_CHOICE_FEATURES
+from hlp_drake.features.row_choice import ROW_CHOICE_FEATURES, ROW_CONTEXT_FEATURES
 from hlp_drake.features.scene_features import GAP_FEATURES, OBJECT_FEATURES
 from hlp_drake.features.segment import SEGMENT_FEATURES
 from hlp_drake.files.documents import brief
@@ -80,6 +80,12 @@ FIXED = {
     "segment.n_features": len(SEGMENT_FEATURES),
 }
 """The learners' dimensions the feature code fixes (models of other sizes cannot plan)."""
+
+
+def fixed_sizes(row_context: bool) -> dict[str, int]:
+    """``FIXED`` for a row-choice classifier that reads the way the hand came too (``row_context``:
+    ``ROW_CONTEXT_FEATURES``) or not."""
+    return FIXED | {"row.n_features": len(ROW_CONTEXT_FEATURES if row_context else ROW_CHOICE_FEATURES)}
 
 
 def expected_arrays(planner: str, row_learner: str) -> dict[str, Spec]:
@@ -147,14 +153,17 @@ def _declared(dims: tuple[int | str, ...], sizes: dict[str, int]) -> str:
     return f"({', '.join(shown)}{',' if len(shown) == 1 else ''})"
 
 
-def read_arrays(payload: bytes, expected: dict[str, Spec]) -> dict[str, np.ndarray]:
-    """The arrays of the npz ``payload``, each checked against ``expected`` before it is read.
+def read_arrays(
+    payload: bytes, expected: dict[str, Spec], fixed: dict[str, int] | None = None
+) -> dict[str, np.ndarray]:
+    """The arrays of the npz ``payload``, each checked against ``expected`` (and the dimensions
+    ``fixed``, default ``FIXED``) before it is read.
 
     Raises:
         ValueError: any damage (a member missing, unexpected or of another dtype or shape, a size
             inconsistent with the others, a broken zip or header).
     """
-    sizes = dict(FIXED)
+    sizes = dict(FIXED if fixed is None else fixed)
     try:
         with zipfile.ZipFile(io.BytesIO(payload)) as archive:
             infos = archive.infolist()
@@ -204,7 +213,8 @@ def check_values(arrays: dict[str, np.ndarray]) -> None:
         _range(name, arrays[name], 1 / MAX_VALUE, MAX_VALUE)
     if "row.learner.feature" in arrays:
         nodes = arrays["row.learner.feature"].shape[1]
-        _range("row.learner.feature", arrays["row.learner.feature"], 0, FIXED["row.n_features"] - 1)
+        features = len(arrays["row.novelty.mean"])  # its shape checked: the model's n_features
+        _range("row.learner.feature", arrays["row.learner.feature"], 0, features - 1)
         for side in ("left", "right"):
             _range(f"row.learner.{side}", arrays[f"row.learner.{side}"], LEAF, nodes - 1)
         if np.any((arrays["row.learner.left"] == LEAF) != (arrays["row.learner.right"] == LEAF)):

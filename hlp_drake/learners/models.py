@@ -22,6 +22,7 @@ import numpy as np
 from hlp_drake.config.typed_yaml import document_problems
 from hlp_drake.dataset.records import STRUCTURED, UNSTRUCTURED, category_of
 from hlp_drake.errors import ModelError
+from hlp_drake.features.augment import mirrored_rows
 from hlp_drake.features.training import TrainingData
 from hlp_drake.files.atomic import atomic_path, write_text_atomic
 from hlp_drake.files.documents import brief, parse_json, read_bytes
@@ -38,6 +39,7 @@ from hlp_drake.learners.model_format import (
     check_values,
     digest,
     expected_arrays,
+    fixed_sizes,
     read_arrays,
 )
 from hlp_drake.learners.svm import RbfSvmClassifier
@@ -66,6 +68,10 @@ class LearnerSettings:
         structured_weight: weight of a structured trial's row-choice examples where unstructured
             trials are in the training set too (the structured trials are three times as many,
             and their people moved obstacles more often in the same situations).
+        row_context: the row-choice classifier reads the way the hand came too
+            (``features.row_choice.CONTEXT_FEATURES``), not only the row's candidates.
+        row_mirror: the row-choice classifier learns every example and its mirror image too
+            (``features.augment``).
         C, kernel_scale: the RBF SVMs' (the original: 1, 0.25).
         segment_max_per_class: caps the segment classifier's balanced training set (the full grid
             has ~70k rows of which 2 % positive; an RBF SVM on 140k oversampled rows takes many
@@ -81,6 +87,8 @@ class LearnerSettings:
     max_depth: int = 3
     learning_rate: float = 0.1
     structured_weight: float = 0.25
+    row_context: bool = False
+    row_mirror: bool = False
     C: float = 1.0
     kernel_scale: float = 0.25
     segment_max_per_class: int = 4000
@@ -172,6 +180,12 @@ def _settings(meta: Any, where: Path) -> LearnerSettings:
     return LearnerSettings(**settings)
 
 
+def row_feature_count(settings: LearnerSettings) -> int:
+    """The columns of Xr (``ROW_CONTEXT_FEATURES``, the first ones) a row-choice classifier of
+    ``settings`` reads."""
+    return fixed_sizes(settings.row_context)["row.n_features"]
+
+
 def model_digest(directory: str | os.PathLike[str]) -> str:
     """The SHA-256 (hex) of the ``models.json`` in ``directory``: what ``DecisionModels.load``'s
     ``sha256`` pins (``sha256sum models.json`` prints the same)."""
@@ -240,6 +254,11 @@ class DecisionModels:
     def planner(self) -> str:
         return self.settings.planner
 
+    @property
+    def row_features(self) -> int:
+        """The columns of Xr the row-choice classifier reads (the first ones)."""
+        return row_feature_count(self.settings)
+
     def fit(self, data: TrainingData) -> DecisionModels:
         """Fit the planner's learners on ``data``."""
         if self.planner == "rows" and is_faithful(data.mode):
@@ -254,12 +273,12 @@ class DecisionModels:
                 raise ModelError(f"no training rows for the {name} learner")
             estimator = getattr(self, name)
             if name == "row":
-                estimator.fit(
-                    labelled.X,
-                    labelled.y,
-                    groups=labelled.subjects,
-                    sample_weight=_category_weights(labelled.keys, self.settings.structured_weight),
-                )
+                X, y, groups = labelled.X[:, : self.row_features], labelled.y, labelled.subjects
+                weight = _category_weights(labelled.keys, self.settings.structured_weight)
+                if self.settings.row_mirror:
+                    weight = np.ones(len(y)) if weight is None else weight
+                    X, y, groups, weight = mirrored_rows(X, y, groups, weight)
+                estimator.fit(X, y, groups=groups, sample_weight=weight)
             else:
                 estimator.fit(labelled.X, labelled.y)
         self.mode_ = data.mode
@@ -328,7 +347,11 @@ class DecisionModels:
         if hashlib.sha256(payload).hexdigest() != meta["sha256"]:
             raise ModelError(f"{npz_path}: checksum mismatch (the file was modified or damaged)")
         try:
-            arrays = read_arrays(payload, expected_arrays(settings.planner, settings.row_learner))
+            arrays = read_arrays(
+                payload,
+                expected_arrays(settings.planner, settings.row_learner),
+                fixed_sizes(settings.row_context),
+            )
             check_values(arrays)
             check_declared(arrays, settings)
         except ValueError as error:

@@ -105,8 +105,10 @@ class _Expander:
             [p.removed for p in beam],
             mirror=self.mirror,
             limit=self.config.classify_per_row,
+            previous=np.array([p.keypoints[-2 if len(p.keypoints) > 1 else -1].position for p in beam]),
+            came_by=[p.keypoints[-1].action for p in beam],
         )
-        X = np.vstack([c.X for c in per_plan])
+        X = np.vstack([c.X for c in per_plan])[:, : self.models.row.n_features_in_]
         probability = self.models.row.predict_proba(X)[:, 1] if len(X) else np.zeros(0)
         novelty = self.models.row.novelty(X) if len(X) else np.zeros(0)
         result, start = [], 0

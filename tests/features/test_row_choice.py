@@ -3,13 +3,22 @@
 from __future__ import annotations
 
 from dataclasses import replace
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
-from hlp_drake.features.row_choice import ROUTE_OBSTACLES, ROW_CHOICE_FEATURES, RowChoiceScene
+from hlp_drake.features.row_choice import (
+    CONTEXT_FEATURES,
+    ROUTE_OBSTACLES,
+    ROW_CHOICE_FEATURES,
+    ROW_CONTEXT_FEATURES,
+    RowChoiceScene,
+)
+from hlp_drake.features.training import row_choice_rows
 from hlp_drake.scene.generators import generate_scene
 from hlp_drake.scene.model import Scene, SceneObject, Table
+from hlp_drake.segmentation.demonstration import RowDecision
 from hlp_drake.taskspace import TaskSpace
 from hlp_drake.taskspace.routes import FreeRoutes, segment_hits, segment_inside
 
@@ -151,3 +160,72 @@ def test_the_route_graph_holds_the_obstacles_nearest_the_reach_on_any_table():
     assert offset[routes.ids].max() <= np.sort(offset)[ROUTE_OBSTACLES - 1] + 1e-12
     vr_sized = generate_scene("gen2", 3, 6)  # six obstacles, as in every VR scene
     assert len(RowChoiceScene(TaskSpace(vr_sized), 0.08).routes.ids) == len(vr_sized.obstacles) == 6
+
+
+def _two_rows() -> Scene:
+    """Two rows of two boxes each (x = 0.35 and 0.65), a gap in the middle of each; the start and
+    the target on the centre line."""
+    table = Table(1.0, 1.0, 0.7)
+    boxes = (
+        SceneObject("a", "box", 0.35, 0.25, (0.05, 0.4, 0.1)),
+        SceneObject("b", "box", 0.35, -0.25, (0.05, 0.4, 0.1)),
+        SceneObject("c", "box", 0.65, 0.3, (0.05, 0.3, 0.1)),
+        SceneObject("d", "box", 0.65, -0.2, (0.05, 0.5, 0.1)),
+    )
+    return Scene(table, (0.1, 0.0), SceneObject("Target", "cylinder", 0.9, 0.0, (0.05, 0.05, 0.1)), boxes)
+
+
+def test_the_context_reads_the_way_the_hand_came():
+    """Where the hand came from: by a release or a gap (or from the start), after how many moves,
+    and how far it turns to each candidate from its heading."""
+    scene = _two_rows()
+    features = RowChoiceScene(TaskSpace(scene), 0.05)
+    hands = np.array([[0.1, 0.0], [0.35, 0.0], [0.4, 0.2]])
+    previous = np.array([[0.1, 0.0], [0.1, 0.0], [0.35, 0.3]])  # the last heads along -y
+    came_by = ["start", "gap", "release"]
+    X = [c.X for c in features.candidates(2, hands, [(), (), {0}], previous=previous, came_by=came_by)]
+    column = {name: k for k, name in enumerate(ROW_CONTEXT_FEATURES)}
+    move, gap, moves, turn = (column[n] for n in CONTEXT_FEATURES)
+    assert [x[0, move] for x in X] == [0.0, 0.0, 1.0] and [x[0, gap] for x in X] == [0.0, 1.0, 0.0]
+    assert [x[0, moves] for x in X] == [0.0, 0.0, 1.0]
+    # From the start the heading is the target's way; headed along +x, the turn to a candidate is
+    # its angle off the x axis, seen from the hand.
+    (start,) = features.candidates(2, hands[:1])
+    points = start.points - hands[0]
+    assert X[0][:, turn] == pytest.approx(np.abs(np.arctan2(points[:, 1], points[:, 0])))
+    np.testing.assert_allclose(X[0][:, : len(ROW_CHOICE_FEATURES)], start.X[:, : len(ROW_CHOICE_FEATURES)])
+    assert X[0][:, move].tolist() == start.X[:, move].tolist()  # the start, unsaid
+    # Heading from (0.35, 0.3) to (0.4, 0.2): the turn is the angle between that and the way on.
+    heading = hands[2] - previous[2]
+    ways = features.candidates(2, hands[2:], [{0}])[0].points - hands[2]
+    cosine = ways @ heading / (np.linalg.norm(ways, axis=1) * np.linalg.norm(heading))
+    assert X[2][:, turn] == pytest.approx(np.arccos(np.clip(cosine, -1.0, 1.0)))
+
+
+def test_the_training_rows_read_the_previous_rows_decision():
+    """The second row's examples say how the person left the first: through its gap, or by moving
+    an obstacle (then one move before, the hand at the release, heading the way it pushed)."""
+    scene = _two_rows()
+    space = TaskSpace(scene)
+    column = {name: k for k, name in enumerate(ROW_CONTEXT_FEATURES)}
+
+    def second_row(first: RowDecision):
+        demo = SimpleNamespace(
+            scene=scene, left_handed=False, decisions=(first, RowDecision(2, "gap", gap=1))
+        )
+        rows = row_choice_rows(demo, space)
+        assert len(rows) == 2
+        return rows[1][0]
+
+    through = second_row(RowDecision(1, "gap", gap=1))
+    assert np.all(through[:, column["came_by_gap"]] == 1.0) and np.all(
+        through[:, column["came_by_move"]] == 0.0
+    )
+    assert np.all(through[:, column["moves_before"]] == 0.0)
+    moved = second_row(RowDecision(1, "object", obstacle="b", direction="RR"))
+    assert np.all(moved[:, column["came_by_move"]] == 1.0) and np.all(moved[:, column["came_by_gap"]] == 0.0)
+    assert np.all(moved[:, column["moves_before"]] == 1.0)
+    first = row_choice_rows(
+        SimpleNamespace(scene=scene, left_handed=False, decisions=(RowDecision(1, "gap", gap=1),)), space
+    )[0][0]
+    assert np.all(first[:, column["came_by_gap"]] == 0.0) and np.all(first[:, column["came_by_move"]] == 0.0)

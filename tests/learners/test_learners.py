@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 import warnings
+from dataclasses import replace
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -12,6 +14,9 @@ from sklearn.exceptions import NotFittedError
 from sklearn.utils.estimator_checks import check_estimator
 
 from hlp_drake.errors import ModelError
+from hlp_drake.features.augment import mirror_features
+from hlp_drake.features.row_choice import ROW_CHOICE_FEATURES, ROW_CONTEXT_FEATURES
+from hlp_drake.features.training import LabelledSet
 from hlp_drake.learners import (
     ArmRegressor,
     DecisionModels,
@@ -21,6 +26,9 @@ from hlp_drake.learners import (
     expected_failed_checks,
 )
 from hlp_drake.learners.bundled import BUNDLED_DIRECTORY, default_models
+from hlp_drake.learners.models import PRESETS
+from hlp_drake.planner import plan
+from hlp_drake.scene.generators import generate_scene
 
 
 def _blobs(n: int = 300, seed: int = 0):
@@ -141,3 +149,55 @@ def test_row_choice_trees_calibration_and_novelty():
     assert again.predict_proba(X) == pytest.approx(model.predict_proba(X))
     with pytest.raises(NotFittedError):
         RowChoiceClassifier().predict(X)
+
+
+def _with_row_classifier(width: int, *, row_context: bool) -> DecisionModels:
+    """The bundled models with a small row-choice classifier on ``width`` random features, the
+    settings saying whether it reads the context."""
+    bundled = default_models()
+    settings = replace(bundled.settings, n_estimators=5, row_context=row_context)
+    models = DecisionModels(settings)
+    models.direction, models.arm = bundled.direction, bundled.arm
+    models.start_arm_, models.link_lengths_ = bundled.start_arm_, bundled.link_lengths_
+    models.subjects_ = bundled.subjects_
+    rng = np.random.default_rng(1)
+    X = rng.uniform(0.0, 3.0, (200, width))
+    models.row = RowChoiceClassifier(n_estimators=5, novelty_samples=50).fit(X, (X[:, 3] < 1.0).astype(float))
+    return models
+
+
+def test_a_row_classifier_with_the_context_saves_loads_and_plans(tmp_path):
+    models = _with_row_classifier(len(ROW_CONTEXT_FEATURES), row_context=True)
+    again = DecisionModels.load(models.save(tmp_path / "context"))
+    assert again.settings.row_context and again.row.n_features_in_ == again.row_features == 31
+    result = plan(generate_scene("unstructured", 4), again)
+    assert result.reason is None and len(result.keypoints) > 2
+    # A file whose classifier reads 27 columns but whose settings say it reads the context: refused.
+    wrong = _with_row_classifier(len(ROW_CHOICE_FEATURES), row_context=True).save(tmp_path / "wrong")
+    with pytest.raises(ModelError, match="row.novelty.mean"):
+        DecisionModels.load(wrong)
+
+
+def test_mirrored_training_doubles_the_row_examples_with_the_signed_columns_negated(monkeypatch):
+    seen = {}
+
+    def fit(self, X, y, sample_weight=None, groups=None):
+        seen.update(X=X, y=y, weight=sample_weight, groups=groups)
+        raise StopIteration
+
+    monkeypatch.setattr(RowChoiceClassifier, "fit", fit)
+    rng = np.random.default_rng(0)
+    X = rng.normal(size=(6, len(ROW_CONTEXT_FEATURES)))
+    y = np.array([1.0, 0.0, 0.0, 1.0, 0.0, 0.0])
+    keys = np.array(["s1/T050"] * 3 + ["s2/T101"] * 3, dtype=object)
+    row = LabelledSet(
+        ROW_CONTEXT_FEATURES, X, y, np.array(["s1"] * 3 + ["s2"] * 3, dtype=object), keys, y > -1
+    )
+    data = SimpleNamespace(mode="fixed", row=row)
+    settings = replace(PRESETS["boosted"], row_mirror=True)
+    with pytest.raises(StopIteration):
+        DecisionModels(settings).fit(data)
+    assert seen["X"].shape == (12, len(ROW_CHOICE_FEATURES))  # without the context: the first 27
+    np.testing.assert_array_equal(seen["X"][6:], mirror_features(X[:, : len(ROW_CHOICE_FEATURES)]))
+    assert seen["y"].tolist() == y.tolist() * 2 and seen["groups"].tolist() == row.subjects.tolist() * 2
+    assert seen["weight"].tolist() == [0.25] * 3 + [1.0] * 3 + [0.25] * 3 + [1.0] * 3

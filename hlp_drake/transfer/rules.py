@@ -10,7 +10,7 @@ into the clearances ``hlp_drake.transfer.push`` works with.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Annotated
 
 from hlp_drake.config.ranges import NonNegativeFloat, Positive, PositiveFloat
@@ -147,9 +147,10 @@ def length(value: float) -> float:
     return round(value, 6)
 
 
-def push_rules(config: TransferConfig, geometry: GripperGeometry) -> PushRules:
-    """The clearances of ``config`` for a robot of ``geometry``."""
-    g = geometry
+def push_rules(config: TransferConfig, geometry: GripperGeometry, *, closed: bool = True) -> PushRules:
+    """The clearances of ``config`` for a robot of ``geometry`` that pushes with its fingers
+    ``closed`` (``MotionConfig.closed_among_obstacles``), or else open."""
+    g = geometry if closed else replace(geometry, closed_half_width=geometry.finger_half_width)
     return PushRules(
         forward_clearance=length(g.fingertip_reach + config.forward_margin),
         sideways_clearance=length(g.closed_half_width + config.sideways_margin),

@@ -101,6 +101,8 @@ class RobotPlanTransfer(LeafSystem):
         transfer: the transfer's margins (a ``Scenario``'s ``transfer``).
         alternatives: at most this many alternative robot plans (a ``Scenario``'s
             ``planner.alternatives``).
+        pushes_closed: whether the hand pushes with its fingers closed (a ``Scenario``'s
+            ``motion.closed_among_obstacles``) or open.
     """
 
     def __init__(
@@ -109,9 +111,10 @@ class RobotPlanTransfer(LeafSystem):
         robot: RobotDescription = MOBILE_UR5,
         transfer: TransferConfig | None = None,
         alternatives: int = DEFAULT_ALTERNATIVES,
+        pushes_closed: bool = True,
     ) -> None:
         super().__init__()
-        rules = push_rules(transfer or TransferConfig(), gripper_geometry(robot))
+        rules = push_rules(transfer or TransferConfig(), gripper_geometry(robot), closed=pushes_closed)
         limit = alternatives
         self._rules = rules
         self._scene_port = declare_scene_input_port(self)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 
 import pytest
+from human_plans import GEN1_25, human_plan
 
 from hlp_drake.systems.planning.transfer import gripper_geometry
 from hlp_drake.taskspace import TaskSpace
@@ -74,3 +75,34 @@ def test_every_robot_pushes_with_its_closed_fingers_and_palm_as_its_model_has_th
     assert (
         palm_side + rules.travel_step >= space.rects["behind"].y_min - rules.object_margin - 1e-9
     )  # not sooner
+
+
+def test_a_hand_that_pushes_open_is_spaced_for_its_open_fingers_in_the_block_too():
+    """``motion.closed_among_obstacles: false``: the pushes are made with the fingers open, and the
+    push starts (``push_rules(closed=False)``, the transfer block of such a scenario) are spaced
+    for the open fingers."""
+    from hlp_drake.scene.generators import generate_scene
+    from hlp_drake.systems.planning.diagram import make_planning_diagram
+    from hlp_drake.systems.scenario import Scenario
+
+    geometry = gripper_geometry()
+    opened = push_rules(TransferConfig(), geometry, closed=False)
+    margin = TransferConfig().sideways_margin
+    assert opened.sideways_clearance == pytest.approx(geometry.finger_half_width + margin)
+    assert RULES.sideways_clearance == pytest.approx(geometry.closed_half_width + margin)
+    assert (
+        opened.hand[0][3] == geometry.finger_half_width
+        and opened.palm_sideways_clearance == RULES.palm_sideways_clearance
+    )
+
+    scene = generate_scene("gen1", 25)  # a push to the right first
+    starts = {}
+    for closed in (True, False):
+        scenario = Scenario(scene=scene).updated(f"motion: {{closed_among_obstacles: {str(closed).lower()}}}")
+        transfer = make_planning_diagram(scenario).GetSubsystemByName("robot_plan_transfer")
+        context = transfer.CreateDefaultContext()
+        transfer.GetInputPort("scene").FixValue(context, scene)
+        transfer.GetInputPort("plan").FixValue(context, human_plan(scene, GEN1_25))
+        plan = transfer.GetOutputPort("robot_plan").Eval(context)
+        starts[closed] = [k.position for k in plan.keypoints if k.action == "move"]
+    assert starts[True] and starts[True] != starts[False]

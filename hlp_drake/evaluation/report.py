@@ -119,8 +119,8 @@ def rows_csv(results: dict[str, list[SplitResult]]) -> str:
 
 def _plot(path: str, summaries: dict[str, dict[str, dict]], title: str) -> None:
     """Grouped bars: per result, each planner's sHLP (plan) and I(D), with the std over splits (the
-    ceiling's on its rows, zero where it has none)."""
-    figure, axes = new_figure(max(6.0, 2.2 * len(summaries)), 4.2)
+    ceiling's on its rows, zero where it has none, with the planner's on those rows marked)."""
+    figure, axes = new_figure(max(8.0, 2.6 * len(summaries)), 4.6)
     labels = list(summaries)
     planners = [p for p in NAMES if any(p in summaries[label] for label in labels)]
     width = 0.8 / (2 * len(planners))
@@ -140,11 +140,23 @@ def _plot(path: str, summaries: dict[str, dict[str, dict]], title: str) -> None:
                 color=f"C{p}",
                 alpha=1.0 if m == 0 else 0.55,
             )
+            same = [summaries[label].get(CEILING, {}).get("same_rows", {}).get("hlp") for label in labels]
+            if planner == CEILING:
+                axes.scatter(
+                    x,
+                    [s[metric]["mean"] if s else np.nan for s in same],
+                    marker="_",
+                    s=120,
+                    color="black",
+                    zorder=3,
+                    label="planner on the ceiling's rows" if m == 0 else None,
+                )
     axes.set_xticks(np.arange(len(labels)), labels)
-    axes.set_ylim(0.0, 1.0)
+    axes.set_ylim(0.0, 1.3)
+    axes.set_yticks(np.linspace(0.0, 1.0, 6))
     axes.set_ylabel("agreement with the held-out people")
     axes.grid(axis="y", alpha=0.3)
-    axes.legend(fontsize=7, ncol=len(planners))
+    axes.legend(fontsize=7, ncol=len(planners), loc="upper center", columnspacing=1.0)
     axes.set_title(title)
     save_png(figure, path)
 

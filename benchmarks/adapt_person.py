@@ -13,8 +13,10 @@ held-out trials, the same for every k. The models adapted on the first k demonst
 only) and the pooled models plan each held-out trial's scene; sHLP scores each plan against the
 person (as ``python -m hlp_drake.evaluate`` does). Nothing is tuned on the held-out trials.
 
-Beside them, the bundled models (trained on everyone, the scored trials too) on the same trials:
-how far the pooled learner gets when it has seen even the trials it is scored on.
+Beside them, two in-sample ceilings on the same trials (diagnostics, not results): the bundled
+models (trained on everyone, the scored trials too), and the pooled models with 40 trees boosted
+on the scored trials themselves: how far the learner and the added trees get when they have seen
+the answers.
 
 Writes ``DIR/adapt_person.json`` (per participant and k; the means over participants) and
 ``DIR/adapt_person.png``; the pooled models of each participant are kept in ``DIR/pooled/`` so a
@@ -42,6 +44,13 @@ from hlp_drake.learners.adapt import adapt_models
 from hlp_drake.learners.bundled import default_models
 from hlp_drake.segmentation import segment_dataset
 
+CEILINGS = {
+    "in_sample": "in sample: the bundled models, trained on the scored trials too",
+    "self_fit": "in sample: the pooled models with 40 trees boosted on the scored trials",
+}
+SELF_FIT_TREES = 40
+"""Trees of the self-fit ceiling (the most the cross-validation may choose)."""
+
 
 def without(subject: str):
     """Which trials (keys) are not ``subject``'s."""
@@ -62,6 +71,22 @@ def pooled_models(data, subject: str, folder: Path) -> DecisionModels:
 def shlp(models: DecisionModels, demonstrations, majority: str) -> list[float]:
     outcomes, _ = score_plans(models, demonstrations, majority)
     return [o.shlp for o in outcomes]
+
+
+def _ceilings(record: dict, folder: Path, held_out, data, subject: str) -> dict:
+    """In-sample ceilings on the held-out trials (diagnostics, not results): ``in_sample``, the
+    bundled models, which learnt from everyone's trials, these too (the pooled learner having seen
+    the very trials it is scored on); ``self_fit``, the pooled models with ``SELF_FIT_TREES`` trees
+    boosted on the held-out trials themselves (how far the added trees can move the prior towards
+    this person's choices, given every answer)."""
+    out = {}
+    majority = _majority(data.where(without(subject)))
+    if "in_sample" not in record:
+        out["in_sample"] = float(np.mean(shlp(default_models(), held_out, majority)))
+    if "self_fit" not in record:
+        fitted, _ = adapt_models(DecisionModels.load(folder), held_out, person=subject, trees=SELF_FIT_TREES)
+        out["self_fit"] = float(np.mean(shlp(fitted, held_out, majority)))
+    return out
 
 
 def main() -> int:
@@ -88,16 +113,15 @@ def main() -> int:
         order = np.random.default_rng([args.seed, int(subject.split("_")[1])]).permutation(len(own))
         shown, held_out = [own[i] for i in order[:n_demos]], [own[i] for i in order[n_demos:]]
         if subject in done:
-            if "in_sample" not in done[subject]:  # a report of an earlier version: the ceiling added
-                done[subject]["in_sample"] = float(np.mean(shlp(default_models(), held_out, "object")))
+            done[subject].update(
+                _ceilings(done[subject], args.out / "pooled" / subject, held_out, data, subject)
+            )
             continue
         pooled = pooled_models(data, subject, args.out / "pooled" / subject)
         majority = _majority(data.where(without(subject)))
         base = shlp(pooled, held_out, majority)
         record = {"trials": len(own), "held_out": len(held_out), "pooled": float(np.mean(base)), "k": {}}
-        # the bundled models learnt from everyone's trials, these held-out ones too: what the pooled
-        # learner reaches when it has seen the very trials it is scored on
-        record["in_sample"] = float(np.mean(shlp(default_models(), held_out, majority)))
+        record.update(_ceilings(record, args.out / "pooled" / subject, held_out, data, subject))
         for k in args.ks:
             adapted, adaptation = adapt_models(pooled, shown[:k], person=subject, seed=args.seed)
             scores = shlp(adapted, held_out, majority)
@@ -114,14 +138,14 @@ def main() -> int:
             flush=True,
         )
         write_text_atomic(report_path, json.dumps(_report(done, args), indent=2) + "\n")
+        _plot(_report(done, args), args.out / "adapt_person.png")  # a stopped run keeps its chart
     report = _report(done, args)
     write_text_atomic(report_path, json.dumps(report, indent=2) + "\n")
     _plot(report, args.out / "adapt_person.png")
     for k, row in report["summary"].items():
-        if k == "in_sample":
+        if k in CEILINGS:
             print(
-                f"bundled models, trained on the scored trials too: {row['shlp']:.3f} "
-                f"(pooled {row['pooled']:.3f}, {row['participants']} participants)"
+                f"{CEILINGS[k]}: {row['shlp']:.3f} (pooled {row['pooled']:.3f}, {row['participants']} participants)"
             )
             continue
         print(
@@ -150,13 +174,14 @@ def _report(done: dict, args) -> dict:
             "worse": int(np.sum(gain < -1e-9)),
             "trees_median": float(np.median([r["k"][str(k)]["trees"] for r in done.values()])),
         }
-    ceiling = [r["in_sample"] for r in done.values() if "in_sample" in r]
-    if ceiling:
-        summary["in_sample"] = {
-            "participants": len(ceiling),
-            "shlp": float(np.mean(ceiling)),
-            "pooled": float(np.mean([r["pooled"] for r in done.values() if "in_sample" in r])),
-        }
+    for name in ("in_sample", "self_fit"):
+        ceiling = [r[name] for r in done.values() if name in r]
+        if ceiling:
+            summary[name] = {
+                "participants": len(ceiling),
+                "shlp": float(np.mean(ceiling)),
+                "pooled": float(np.mean([r["pooled"] for r in done.values() if name in r])),
+            }
     return {
         "protocol": "leave one person out; adapted on k of the person's trials, scored on the rest",
         "seed": args.seed,
@@ -168,7 +193,7 @@ def _report(done: dict, args) -> dict:
 
 def _plot(report: dict, path: Path) -> None:
     figure, axes = new_figure(6.0, 4.0)
-    ks = [k for k in report["summary"] if k != "in_sample"]
+    ks = [k for k in report["summary"] if k not in CEILINGS]
     pooled = [report["summary"][k]["pooled"] for k in ks]
     adapted = [report["summary"][k]["adapted"] for k in ks]
     errors = [report["summary"][k]["gain_se"] for k in ks]
@@ -177,13 +202,9 @@ def _plot(report: dict, path: Path) -> None:
     axes.bar(x + 0.2, adapted, 0.4, yerr=errors, capsize=3, label="adapted on k of their trials")
     axes.set_xticks(x, [f"k = {k}" for k in ks])
     axes.set_ylabel("held-out sHLP (mean over participants)")
-    if "in_sample" in report["summary"]:
-        axes.axhline(
-            report["summary"]["in_sample"]["shlp"],
-            color="grey",
-            linestyle="--",
-            label="bundled, trained on the scored trials too",
-        )
+    for name, style in (("in_sample", "--"), ("self_fit", ":")):
+        if name in report["summary"]:
+            axes.axhline(report["summary"][name]["shlp"], color="grey", linestyle=style, label=CEILINGS[name])
     axes.set_ylim(min(pooled + adapted) - 0.1, 1.0)
     axes.legend(loc="lower right")
     n = report["summary"][ks[0]]["participants"] if ks else 0

@@ -183,9 +183,18 @@ def _appended(arrays: dict[str, np.ndarray], fitted: list[tuple], scale: float) 
 
 
 def adapt_models(
-    prior: DecisionModels, demonstrations: list[Demonstration], *, person: str = "", seed: int = 0
+    prior: DecisionModels,
+    demonstrations: list[Demonstration],
+    *,
+    person: str = "",
+    seed: int = 0,
+    trees: int | None = None,
 ) -> tuple[DecisionModels, Adaptation]:
     """``prior`` adapted to the person of ``demonstrations`` (fixed-mode, at least ``MIN_TRIALS``).
+
+    Args:
+        trees: add this many trees instead of the number the cross-validation chooses (a
+            diagnostic: how far the trees can move the prior towards these trials).
 
     Raises:
         ModelError: the prior is not the row-by-row planner's with boosted trees, or too few trials.
@@ -207,8 +216,11 @@ def adapt_models(
             f"{len(set(rows.trials))} of {person or 'the person'}'s trials have a row choice to learn from; "
             f"adapting needs at least {MIN_TRIALS}"
         )
-    scores, folds = _cross_validated(prior, rows, seed)
-    best = max(TREE_CHOICES, key=lambda n: (round(scores[n], 9), -n))
+    if trees is None:
+        scores, folds = _cross_validated(prior, rows, seed)
+        best = max(TREE_CHOICES, key=lambda n: (round(scores[n], 9), -n))
+    else:
+        scores, folds, best = {}, 0, trees
     X, y = rows.stacked()
     fitted = _boost(_calibrated_logit(prior, X), X, y, best, seed)
     models = copy.deepcopy(prior)

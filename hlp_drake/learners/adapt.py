@@ -211,7 +211,7 @@ def adapt_models(
             f"{len(trials)} usable trial(s) of {person or 'the person'}; adapting needs at least {MIN_TRIALS}"
         )
     rows = PersonRows.of(list(demonstrations))
-    if len({t for t in rows.trials}) < MIN_TRIALS:
+    if len(set(rows.trials)) < MIN_TRIALS:
         raise ModelError(
             f"{len(set(rows.trials))} of {person or 'the person'}'s trials have a row choice to learn from; "
             f"adapting needs at least {MIN_TRIALS}"
@@ -236,10 +236,9 @@ def adapt_models(
             max_depth=max(prior.settings.max_depth, int(arrays["depth"])),
         )
         models.row.n_estimators = models.settings.n_estimators
-    people = [d for d in demonstrations]
-    models.start_arm_ = np.median([d.keypoints[0].arm for d in people], axis=0)
+    models.start_arm_ = np.median([d.keypoints[0].arm for d in demonstrations], axis=0)
     models.link_lengths_ = np.median(
-        [(d.link_lengths.upper_arm, d.link_lengths.forearm) for d in people], axis=0
+        [(d.link_lengths.upper_arm, d.link_lengths.forearm) for d in demonstrations], axis=0
     )
     if person and person not in models.subjects_:
         models.subjects_ = [*models.subjects_, person]

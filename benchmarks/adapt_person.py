@@ -206,7 +206,7 @@ def _plot(report: dict, path: Path) -> None:
         if name in report["summary"]:
             axes.axhline(report["summary"][name]["shlp"], color="grey", linestyle=style, label=CEILINGS[name])
     axes.set_ylim(min(pooled + adapted) - 0.1, 1.0)
-    axes.legend(loc="lower right")
+    axes.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1), fontsize="small")
     n = report["summary"][ks[0]]["participants"] if ks else 0
     axes.set_title(f"One person's own demonstrations, leave one person out ({n} participants)")
     save_png(figure, path)

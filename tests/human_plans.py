@@ -135,6 +135,8 @@ GEN2_9_39_NEXT = [
 # gen1 seed 15: both moves; on the way to the first push start open fingers straddle a small obstacle.
 # gen1 seed 25: a push to the right in row 1, then a backward move in row 2.
 GEN1_25 = [("move", "FailOnTouchObstacleMed", "RR"), ("move", "FailOnTouchObstacleMed-1", "BB")]
+# gen1 seed 32: a backward move in row 1, then a forward-left one in row 2.
+GEN1_32 = [("move", "FailOnTouchObstacleLong", "BL"), ("move", "FailOnTouchObstacleShort-1", "FL")]
 
 
 def chain_first_rollout(scenario, human: HighLevelPlan):

@@ -6,7 +6,7 @@ import re
 
 import numpy as np
 import pytest
-from human_plans import GEN1_25, GEN2_9_30, GEN2_9_30_NEXT, chain_first_rollout, human_plan, laid_out_plan
+from human_plans import GEN1_32, GEN2_9_30, GEN2_9_30_NEXT, chain_first_rollout, human_plan, laid_out_plan
 from sto_support import on, short, spec, sto
 
 from hlp_drake.errors import HlpError
@@ -150,10 +150,11 @@ def test_rollouts_read_their_state_every_sample_period(scene, trajectories):
 
 
 def test_a_gripper_closed_among_the_obstacles_does_not_carry_one_into_the_target():
-    """Gen I seed 25: with the fingers open among the obstacles the way to the target sweeps the
-    target off the table; closed there, the same plan passes at its first rollout."""
-    scene = generate_scene("gen1", 25)
-    person = human_plan(scene, GEN1_25)
+    """Gen I seed 32: with the fingers open among the obstacles (and the pushes spaced for them) the
+    way to the target sweeps the target off the table; closed there, the same plan passes at its
+    first rollout."""
+    scene = generate_scene("gen1", 32)
+    person = human_plan(scene, GEN1_32)
     closed = chain_first_rollout(on(scene), person)
     assert closed.success, closed.failure_reason
     opened = chain_first_rollout(on(scene, "motion: {closed_among_obstacles: false}"), person)

@@ -171,3 +171,33 @@ def scene_texts(draw) -> tuple[str, str]:
     text = json.dumps(doc) if suffix == ".json" else yaml.dump(doc, Dumper=_DUMPER, sort_keys=False)
     cut = draw(st.one_of(st.none(), st.integers(0, len(text))))
     return suffix, text if cut is None else text[:cut]
+
+
+def damage_csv(text: str, draw) -> str:
+    """``text`` (a CSV file's) damaged one drawn way: a bad number, rows reversed or swapped, the
+    header alone, truncated, cut mid-line, invalid bytes, or empty."""
+    lines = text.splitlines()
+    how = draw(st.sampled_from(["nan", "reverse", "header", "truncate", "cut", "bytes", "empty", "swap"]))
+    if how == "nan" and len(lines) > 1:
+        row = draw(st.integers(1, len(lines) - 1))
+        fields = lines[row].split(",")
+        fields[draw(st.integers(0, len(fields) - 1))] = draw(
+            st.sampled_from(["NaN", "inf", "", "x", "1e999"])
+        )
+        lines[row] = ",".join(fields)
+    elif how == "reverse":
+        lines = lines[:1] + lines[1:][::-1]
+    elif how == "header":
+        lines = lines[:1]
+    elif how == "truncate":
+        lines = lines[: max(1, len(lines) // 2)]
+    elif how == "cut":
+        joined = "\n".join(lines)
+        return joined[: draw(st.integers(0, len(joined)))]
+    elif how == "bytes":
+        return text[: len(text) // 2] + "\udcff\x00" + text[len(text) // 2 :]
+    elif how == "empty":
+        return ""
+    elif how == "swap" and len(lines) > 2:
+        lines[1], lines[2] = lines[2], lines[1]
+    return "\n".join(lines) + "\n"

@@ -56,6 +56,51 @@ GEN2_9_12 = [
     ("gap", 5, 2),
 ]
 # gen2 seed 39, 9 objects, and its next four candidates.
+# gen2 seed 30, 9 objects, as the bundled models laid it out (every keypoint where they put it):
+# the robot's way to the row-4 push knocks the target off the table at the first rollout; its
+# first next candidate passes.
+GEN2_9_30 = (
+    ("start", (0.0, 0.0807), None, None, None),
+    ("gap", (0.2275, 0.16699), 1, "1", None),
+    ("move", (0.3573, 0.3417), 2, "obstacle_2", "BB"),
+    ("release", (0.25655, 0.3775), 2, "obstacle_2", "BB"),
+    ("gap", (0.4103, 0.354), 3, "1", None),
+    ("move", (0.5545, 0.4071), 4, "obstacle_9", "LL"),
+    ("release", (0.56782, 0.64085), 4, "obstacle_9", "LL"),
+    ("target", (0.6314, 0.3202), None, "Target", None),
+)
+GEN2_9_30_NEXT = (
+    (
+        ("start", (0.0, 0.0807), None, None, None),
+        ("gap", (0.2275, 0.16699), 1, "1", None),
+        ("gap", (0.33533, 0.2079), 2, "2", None),
+        ("gap", (0.4103, 0.23633), 3, "1", None),
+        ("move", (0.5545, 0.4071), 4, "obstacle_9", "BB"),
+        ("release", (0.47125, 0.4445), 4, "obstacle_9", "BB"),
+        ("target", (0.6314, 0.3202), None, "Target", None),
+    ),
+    (
+        ("start", (0.0, 0.0807), None, None, None),
+        ("gap", (0.2275, 0.16699), 1, "1", None),
+        ("gap", (0.33533, 0.2079), 2, "2", None),
+        ("gap", (0.4103, 0.23633), 3, "1", None),
+        ("move", (0.5162, 0.1165), 4, "obstacle_5", "FF"),
+        ("release", (0.5897, 0.15496), 4, "obstacle_5", "FF"),
+        ("target", (0.6314, 0.3202), None, "Target", None),
+    ),
+)
+
+
+def laid_out_plan(scene: Scene, keypoints, alternatives=()) -> HighLevelPlan:
+    """The plan of ``keypoints`` (action, position, row, element, direction), each where it is given,
+    and its next candidates ``alternatives``, best first."""
+    return HighLevelPlan(
+        scene.name,
+        tuple(PlanKeypoint(*k) for k in keypoints),
+        alternatives=tuple(PlanCandidate(tuple(PlanKeypoint(*k) for k in a), 0.0) for a in alternatives),
+    )
+
+
 GEN2_9_39 = [
     ("move", "obstacle_1", "FF"),
     ("move", "obstacle_9", "LL"),
@@ -88,7 +133,10 @@ GEN2_9_39_NEXT = [
     ],
 ]
 # gen1 seed 15: both moves; on the way to the first push start open fingers straddle a small obstacle.
-GEN1_15 = [("move", "FailOnTouchObstacleLong", "BL"), ("move", "FailOnTouchObstacleMed-1", "RR")]
+# gen1 seed 25: a push to the right in row 1, then a backward move in row 2.
+GEN1_25 = [("move", "FailOnTouchObstacleMed", "RR"), ("move", "FailOnTouchObstacleMed-1", "BB")]
+# gen1 seed 32: a backward move in row 1, then a forward-left one in row 2.
+GEN1_32 = [("move", "FailOnTouchObstacleLong", "BL"), ("move", "FailOnTouchObstacleShort-1", "FL")]
 
 
 def chain_first_rollout(scenario, human: HighLevelPlan):

@@ -10,7 +10,9 @@ participants who have unstructured trials, tested on those; trained in setting a
 participants' structured trials only, in setting b on their structured and unstructured trials).
 With --models, no training: the given models (a directory, or the bundled ones) plan every
 successful trial of --category. Every result scores the planner and the two baselines (the gap
-nearest the start-target line; the majority decision) on the same rows.
+nearest the start-target line; the majority decision) on the same rows, and beside them (not with
+--models) the human ceiling: the training people's choices in the same situation (a shared layout;
+in the unstructured protocol also the nearest matched row), on the rows it covers.
 """
 
 from __future__ import annotations
@@ -172,7 +174,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _run(data, structured, unstructured, settings, train, test, setting):
-    """One split (Table I, learning curve) or fold (unstructured, ``setting``)."""
+    """One split (Table I, learning curve) or fold (unstructured, ``setting``); the ceiling's votes
+    from the trials the models learn from."""
+    people = [*structured, *unstructured]
     if setting:
         return evaluate_split(
             data,
@@ -182,5 +186,7 @@ def _run(data, structured, unstructured, settings, train, test, setting):
             settings=settings,
             keep=transfer_filter(setting, test),
             setting=setting,
+            people=people,
+            match_rows=True,
         )
-    return evaluate_split(data, structured, train, test, settings=settings)
+    return evaluate_split(data, structured, train, test, settings=settings, people=people)

@@ -3,9 +3,11 @@
     python -m hlp_drake.run_scene [--scene FILE | --kind vr|gen1|gen2|unstructured --seed N [--objects K]]
         [--planner hlp|line] [--low-level sto] [--perception truth|camera] [--config SCENARIO.yaml]
         [--workers N] [--meshcat [--meshcat-wait SECONDS]] [--html FILE] [--contact-forces] [--execution open|closed]
-        [--uncertainty [SEED]] [--json FILE] [--quiet | --verbose]
+        [--uncertainty [SEED]] [--models DIR [--models-sha256 HEX]] [--json FILE] [--quiet | --verbose]
 
-With no arguments it runs the bundled default scene with the bundled models. --planner picks the
+With no arguments it runs the bundled default scene with the bundled models; --models DIR plans
+with trained or adapted ones (python -m hlp_drake.train --out DIR, or --adapt), refused unless
+their models.json has the SHA-256 --models-sha256 gives, when given. --planner picks the
 initialiser (hlp: the human-like plan; line, also accepted as sto: the straight line of the paper's
 baseline) and --low-level the planner that turns it into the robot's motion. With --perception camera
 the initialiser, IK and low-level planner work on the scene the world's cameras see
@@ -195,6 +197,16 @@ def _parser():
     )
     parser.add_argument("--html", metavar="FILE", help="write a self-contained MeshCat recording of the run")
     parser.add_argument("--contact-forces", action="store_true", help="draw the contact forces in MeshCat")
+    parser.add_argument(
+        "--models",
+        metavar="DIR",
+        help="the decision models (models.json and models.npz; default: the scenario's, else the bundled)",
+    )
+    parser.add_argument(
+        "--models-sha256",
+        metavar="HEX",
+        help="with --models: the SHA-256 of the trusted models.json (other files are refused)",
+    )
     parser.add_argument("--json", metavar="FILE", help="write the result as JSON")
     add_verbosity(parser)
     return parser
@@ -206,6 +218,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.kind is None and (args.seed is not None or args.objects is not None):
         parser.error("--seed and --objects describe a generated scene: give its --kind too")
+    if args.models_sha256 is not None and args.models is None:
+        parser.error("--models-sha256 pins the models of --models DIR: give --models too")
     if args.meshcat_wait is not None and not args.meshcat:
         parser.error("--meshcat-wait is how long --meshcat serves after the run: give --meshcat too")
     check_writable(args.json, args.html)
@@ -277,7 +291,16 @@ def _scenario(args):
         world=args.world,
         workers=args.workers,
     )
-    return conditions.applied(base, scene=scene)
+    scenario = conditions.applied(base, scene=scene)
+    if args.models is not None:
+        from dataclasses import replace
+
+        from hlp_drake.systems.planning.diagram import scenario_models
+
+        planner = replace(scenario.planner, models=args.models, models_sha256=args.models_sha256 or "")
+        scenario = replace(scenario, planner=planner)
+        scenario_models(scenario)  # a missing, damaged or unpinned model file: refused before any output
+    return scenario
 
 
 def _write(args, scenario, result, ran, meshcat) -> None:

@@ -137,8 +137,9 @@ def _plans(scene: Scene, robot: RobotDescription | None, scenario: Scenario | No
 
     human = plan(scene, default_models())
     geometry = gripper_geometry() if robot is None else gripper_geometry(robot)
-    transfer = (scenario or Scenario()).transfer
+    scenario = scenario or Scenario()
+    rules = push_rules(scenario.transfer, geometry, closed=scenario.motion.closed_among_obstacles)
     return {
         "human plan": human,
-        "robot plan": robot_plan(human, scene, push_rules(transfer, geometry)),
+        "robot plan": robot_plan(human, scene, rules),
     }

@@ -2,9 +2,20 @@
 
     python -m hlp_drake.train [--dataset PATH] [--preset boosted|svm|paper] [--mode fixed|faithful]
         [--categories structured unstructured] [--subjects sub_01 ...] --out DIR
+    python -m hlp_drake.train --adapt DEMOS [--base DIR] --out DIR
 
 By default every successful structured and unstructured trial there is (fixed mode; the faithful
 mode reads structured trials only) trains the default preset: what the bundled models are.
+
+With --adapt, no dataset: the bundled models (or --base DIR, the boosted preset's) are adapted to
+one person, from DEMOS, a folder of that person's VR logs in the dataset's layout
+(sub_XX/trial_results.csv, sub_XX/TYYY/scene and movement files; participant_list.csv for the
+handedness). Trials that are damaged, empty, name an object their layout lacks, failed or cannot be
+segmented are each named (file and line) and left out; fewer than 5 usable trials are refused (exit
+2). The row-choice classifier's trees are boosted on with the person's choices, as many trees as
+cross-validation on the person's own trials chooses (0: the base models stand); see
+hlp_drake.learners.adapt. The models are the usual models.json and models.npz; pin them with the
+SHA-256 printed (run_scene --models DIR --models-sha256 HEX, or planner.models_sha256).
 """
 
 from __future__ import annotations
@@ -12,6 +23,7 @@ from __future__ import annotations
 import time
 from collections import Counter
 from collections.abc import Sequence
+from pathlib import Path
 
 from hlp_drake.commands.parsing import DATASET_DEFAULT, add_quiet, make_parser
 from hlp_drake.dataset.dataset import Dataset
@@ -20,6 +32,7 @@ from hlp_drake.errors import HlpError
 from hlp_drake.features import training_data
 from hlp_drake.files.atomic import check_folder
 from hlp_drake.learners import DEFAULT_PRESET, PRESETS, DecisionModels
+from hlp_drake.learners.model_format import digest
 from hlp_drake.segmentation import DEFAULT_MODE, MODES, demonstration_records, segment_dataset
 
 
@@ -45,8 +58,27 @@ def main(argv: Sequence[str] | None = None) -> int:
         required=True,
         help="directory for models.json and models.npz, made if missing (its parent must exist)",
     )
+    parser.add_argument(
+        "--adapt",
+        metavar="DEMOS",
+        help="adapt the models to one person: a folder of their VR logs (the dataset's layout)",
+    )
+    parser.add_argument(
+        "--base",
+        metavar="DIR",
+        help="with --adapt: the models to adapt (default: the bundled ones; the boosted preset's)",
+    )
     add_quiet(parser)
     args = parser.parse_args(argv)
+    if args.base and not args.adapt:
+        parser.error("--base names the models --adapt starts from: give --adapt DEMOS too")
+    if args.adapt:
+        given = [f"--{n}" for n in ("dataset", "categories", "subjects") if getattr(args, n)]
+        if given or args.preset != DEFAULT_PRESET or args.mode != DEFAULT_MODE:
+            given += ["--preset"] * (args.preset != DEFAULT_PRESET) + ["--mode"] * (args.mode != DEFAULT_MODE)
+            parser.error(f"--adapt reads DEMOS and the base models, not {', '.join(given)}")
+        check_folder(args.out, "models.json", "models.npz")
+        return adapt(args.adapt, args.base, args.out)
     check_folder(args.out, "models.json", "models.npz")
     dataset = Dataset(args.dataset)
     if args.subjects:
@@ -76,4 +108,31 @@ def main(argv: Sequence[str] | None = None) -> int:
         + ", ".join(f"{name} {len(getattr(data, name))}" for name in models.learners)
     )
     print(f"wrote {args.out}/models.json and models.npz")
+    return 0
+
+
+def adapt(demos: str, base: str | None, out: str) -> int:
+    """``--adapt``: the base models adapted to the person of the folder ``demos``, saved in ``out``."""
+    import sys
+
+    from hlp_drake.learners.adapt import adapt_models
+    from hlp_drake.learners.bundled import default_models
+    from hlp_drake.segmentation.person import read_person
+
+    prior = DecisionModels.load(base) if base else default_models()  # a bad model file: before any work
+    person = read_person(demos)
+    for line in person.left_out:
+        print(f"left out: {line}", file=sys.stderr)
+    models, adaptation = adapt_models(prior, person.demonstrations, person=person.person)
+    models.save(out)
+    tried = ", ".join(f"{n} {score:.3f}" for n, score in adaptation.scores.items())
+    print(
+        f"adapted to {person.person} from {adaptation.trials} trials ({adaptation.rows} row choices, "
+        f"{len(person.left_out)} left out): {adaptation.trees} trees added"
+    )
+    print(
+        f"cross-validated row score by trees added ({adaptation.folds} folds of the person's trials): {tried}"
+    )
+    sha = digest((Path(out) / "models.json").read_bytes())
+    print(f"wrote {out}/models.json and models.npz (models.json SHA-256 {sha})")
     return 0

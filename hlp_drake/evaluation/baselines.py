@@ -25,10 +25,11 @@ from hlp_drake.taskspace import TaskSpace
 BASELINES = ("nearest_gap", "majority")
 
 
-def _plan(
+def choice_plan(
     scene: Scene, space: TaskSpace, choices: list[tuple[int, str, str, tuple[float, float]]]
 ) -> HighLevelPlan:
-    """A plan through ``choices`` (row, "gap"/"object", element, position) with one-hot raw labels."""
+    """A plan through ``choices`` (row, "gap"/"object", element, position) with one-hot raw labels
+    (a row without a choice gets none)."""
     keypoints = [PlanKeypoint("start", (float(scene.start[0]), float(scene.start[1])))]
     gap_scores = {f"{g.row}:{g.index}": -0.5 for gaps in space.gaps for g in gaps}
     object_scores = dict.fromkeys(space.obstacle_names, -0.5)
@@ -61,7 +62,7 @@ def nearest_gap_plan(scene: Scene) -> HighLevelPlan:
         offset = np.maximum(np.maximum(bounds[:, 0] - line, line - bounds[:, 1]), 0.0)
         gap = gaps[int(np.argmin(offset))]
         choices.append((row.index, GAP, str(gap.index), gap.center))
-    return _plan(scene, space, choices)
+    return choice_plan(scene, space, choices)
 
 
 def majority_decision(demonstrations: Iterable[Demonstration]) -> str:
@@ -80,4 +81,4 @@ def majority_plan(scene: Scene, decision: str) -> HighLevelPlan:
             choices.append((row.index, OBJECT, name, space.rects[name].center))
         elif gaps:
             choices.append((row.index, GAP, str(gaps[0].index), gaps[0].center))
-    return _plan(scene, space, choices)
+    return choice_plan(scene, space, choices)

@@ -18,12 +18,13 @@ def evaluate_models(
     """Plan and score every demonstration of ``category`` with ``models``.
 
     The majority baseline takes the majority decision of the other subjects' demonstrations (of
-    every category), or of all of them where every subject is tested.
+    every category), or of all of them where every subject is tested. No ceiling: the models'
+    training people are not known here.
     """
     tests = [d for d in demonstrations if category_of(d.trial) == category]
     tested = {d.subject for d in tests}
     others = [d for d in demonstrations if d.subject not in tested] or list(demonstrations)
-    outcomes, baselines = score_plans(models, tests, majority_decision(others), progress=progress)
+    outcomes, baselines, _, _ = score_plans(models, tests, majority_decision(others), progress=progress)
     rows = row_choice_set(tests) if models.planner == "rows" else None
     return SplitResult(
         sorted(models.subjects_),

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from dataclasses import dataclass
 
 import numpy as np
@@ -59,20 +60,35 @@ def planned_rows(plan: HighLevelPlan) -> dict[int, tuple[str, str]]:
     return rows
 
 
-def score_trial(demo: Demonstration, plan: HighLevelPlan, *, faithful: bool) -> TrialOutcome:
-    """Compare ``plan`` (made for ``demo.scene``) with what the person did."""
+def score_trial(
+    demo: Demonstration, plan: HighLevelPlan, *, faithful: bool, rows: Collection[int] | None = None
+) -> TrialOutcome:
+    """Compare ``plan`` (made for ``demo.scene``) with what the person did.
+
+    Args:
+        rows: score only these rows (and count only their gaps and obstacles in the gap and object
+            accuracies); every row by default.
+    """
     space = TaskSpace(demo.scene)
     gap_truth = np.array(gap_labels(demo, space, faithful=faithful)) > 0
     object_truth = np.array(object_labels(demo, space)) > 0
     gaps = [g for row in space.gaps for g in row]
+    if rows is not None:
+        gap_kept = np.array([g.row in rows for g in gaps], dtype=bool)
+        members = {n for r in space.rows if r.index in rows for n in r.members}
+        object_kept = np.array([n in members for n in space.obstacle_names], dtype=bool)
+    else:
+        gap_kept, object_kept = np.ones(len(gaps), dtype=bool), np.ones(len(object_truth), dtype=bool)
     gap_raw = np.array([plan.details.get("gap_scores", {}).get(f"{g.row}:{g.index}", -1.0) > 0 for g in gaps])
     object_raw = np.array(
         [plan.details.get("object_scores", {}).get(n, -1.0) > 0 for n in space.obstacle_names]
     )
     planned = planned_rows(plan)
-    rows = []
+    outcomes = []
     for decision in demo.decisions:
         if decision.decision == NONE:  # a row the person never crossed: no element, not scored
+            continue
+        if rows is not None and decision.row not in rows:
             continue
         hlp_decision, hlp_element = planned.get(decision.row, ("none", ""))
         if hlp_decision == GAP:
@@ -85,7 +101,7 @@ def score_trial(demo: Demonstration, plan: HighLevelPlan, *, faithful: bool) -> 
         else:
             element_ok = False
         decision_ok = hlp_decision == decision.decision
-        rows.append(
+        outcomes.append(
             RowOutcome(
                 decision.row,
                 decision.decision,
@@ -99,10 +115,10 @@ def score_trial(demo: Demonstration, plan: HighLevelPlan, *, faithful: bool) -> 
         )
     return TrialOutcome(
         demo.key,
-        tuple(rows),
-        int((gap_raw == gap_truth).sum()),
-        len(gaps),
-        int((object_raw == object_truth).sum()),
-        len(object_truth),
+        tuple(outcomes),
+        int((gap_raw == gap_truth)[gap_kept].sum()),
+        int(gap_kept.sum()),
+        int((object_raw == object_truth)[object_kept].sum()),
+        int(object_kept.sum()),
         plan.planning_time_s,
     )

@@ -1,12 +1,13 @@
 """Cross-subject evaluation (reference 1.8, 7): train on some subjects, plan for the others' scenes.
 
 Two protocols, each scoring the planner and the two baselines (``evaluation.baselines``) on the
-same rows:
+same rows, and the human ceiling (``evaluation.ceiling``: the training people's choices in the
+same situation) on the rows it covers, with the other planners scored on those rows too:
 - Table I (``subject_splits``): random splits of the subjects; train and test on structured trials.
 - Transfer to unstructured layouts (``transfer_folds``): folds of the participants who have
   unstructured trials; test on their unstructured trials, train on the other participants' trials,
   in setting "a" their structured trials only (zero-shot transfer), in "b" their structured and
-  unstructured trials.
+  unstructured trials. Its layouts are all different: the ceiling matches rows there.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from tqdm import tqdm
 
 from hlp_drake.dataset.records import STRUCTURED, category_of
 from hlp_drake.evaluation.baselines import BASELINES, majority_plan, nearest_gap_plan
+from hlp_drake.evaluation.ceiling import LAYOUT, MATCHED, Ceiling
 from hlp_drake.evaluation.metrics import TrialOutcome, score_trial
 from hlp_drake.features.training import LabelledSet, TrainingData
 from hlp_drake.learners.models import DecisionModels, LearnerSettings
@@ -43,7 +45,8 @@ METRICS = (
     "shlp_element_plan",
     "shlp_plan",
 )
-PLANNERS = ("hlp", *BASELINES)
+CEILING = "ceiling"
+PLANNERS = ("hlp", *BASELINES, CEILING)
 SETTINGS = {
     "a": "trained on structured trials only (zero-shot transfer)",
     "b": "trained on structured + unstructured trials of the training participants",
@@ -100,7 +103,14 @@ def metrics_of(outcomes: Sequence[TrialOutcome]) -> dict[str, float]:
 
 @dataclass
 class SplitResult:
-    """One split's (or fold's) trial outcomes per planner ("hlp" and the baselines)."""
+    """One split's (or fold's) trial outcomes per planner ("hlp", the baselines and, where there
+    is one, the ceiling).
+
+    Attributes:
+        same_rows: per planner but the ceiling, its outcomes on the ceiling's rows alone.
+        coverage: the ceiling's rows: "rows" scored, of "rows_total"; "layout" and "matched" of
+            them found on a shared layout and by matching; the matching "threshold" (if any).
+    """
 
     train: list[str]
     test: list[str]
@@ -108,9 +118,19 @@ class SplitResult:
     baselines: dict[str, list[TrialOutcome]] = field(default_factory=dict)
     setting: str = ""
     calibration: dict[str, float] = field(default_factory=dict)
+    same_rows: dict[str, list[TrialOutcome]] = field(default_factory=dict)
+    coverage: dict[str, float] = field(default_factory=dict)
+
+    def planner_outcomes(self, planner: str = "hlp") -> list[TrialOutcome]:
+        return self.outcomes if planner == "hlp" else self.baselines.get(planner, [])
 
     def metrics(self, planner: str = "hlp") -> dict[str, float]:
-        return metrics_of(self.outcomes if planner == "hlp" else self.baselines[planner])
+        return metrics_of(self.planner_outcomes(planner))
+
+
+def planners_of(results: Sequence[SplitResult]) -> list[str]:
+    """The planners of ``PLANNERS`` scored in ``results`` (the ceiling where it scored a row)."""
+    return [p for p in PLANNERS if any(r.planner_outcomes(p) for r in results)]
 
 
 def _majority(data: TrainingData) -> str:
@@ -131,6 +151,8 @@ def evaluate_split(
     keep: Callable[[str], bool] | None = None,
     setting: str = "",
     config: PlannerConfig | None = None,
+    people: Sequence[Demonstration] | None = None,
+    match_rows: bool = False,
     progress: bool = False,
 ) -> SplitResult:
     """Fit on the training trials, plan every ``test`` subject's demonstration, score against them.
@@ -142,14 +164,25 @@ def evaluate_split(
         keep: which trials (keys) to train on (default: those of the ``train`` subjects).
         setting: a label for the result (the transfer protocol's "a" or "b").
         config: the planner's settings (default: those of ``data.mode``).
+        people: every demonstration, for the ceiling: those of the trials the models train on
+            vote (none: no ceiling).
+        match_rows: the ceiling matches rows without a shared layout (``Ceiling``).
     """
     training = data.where(keep) if keep is not None else data.subset(train)
     models = DecisionModels(settings).fit(training)
     tests = [d for d in demonstrations if d.subject in test]
-    outcomes, baselines = score_plans(models, tests, _majority(training), config=config, progress=progress)
+    ceiling = None
+    if people is not None:
+        taught = keep if keep is not None else (lambda key: key.split("/")[0] in train)
+        ceiling = Ceiling.of([d for d in people if taught(d.key)], match=match_rows)
+    outcomes, baselines, same_rows, coverage = score_plans(
+        models, tests, _majority(training), config=config, ceiling=ceiling, progress=progress
+    )
     tested = {d.key for d in tests}
     held_out = data.where(lambda key: key in tested).row
-    return SplitResult(train, test, outcomes, baselines, setting, calibration(models, held_out))
+    return SplitResult(
+        train, test, outcomes, baselines, setting, calibration(models, held_out), same_rows, coverage
+    )
 
 
 def calibration(models: DecisionModels, rows: LabelledSet, bins: int = 10) -> dict[str, float]:
@@ -180,13 +213,22 @@ def score_plans(
     majority: str,
     *,
     config: PlannerConfig | None = None,
+    ceiling: Ceiling | None = None,
     progress: bool = False,
-) -> tuple[list[TrialOutcome], dict[str, list[TrialOutcome]]]:
-    """Plan every demonstration's scene with ``models`` (the person's own arm at the start) and
-    with the baselines (``majority``: the majority decision), and score each against the person."""
+) -> tuple[list[TrialOutcome], dict[str, list[TrialOutcome]], dict[str, list[TrialOutcome]], dict]:
+    """Plan every demonstration's scene with ``models`` (the person's own arm at the start), with
+    the baselines (``majority``: the majority decision) and with the ``ceiling`` (if given), and
+    score each against the person.
+
+    Returns:
+        The planner's outcomes; the baselines' (and the ceiling's, on its rows); every planner's
+        but the ceiling's on the ceiling's rows; the ceiling's coverage (``SplitResult.coverage``).
+    """
     config = config or PlannerConfig(mode=models.mode_)
     faithful = is_faithful(models.mode_)
     outcomes, baselines = [], {name: [] for name in BASELINES}
+    same_rows: dict[str, list[TrialOutcome]] = {}
+    found = {LAYOUT: 0, MATCHED: 0}
     for demo in tqdm(
         demonstrations,
         desc="planning test scenes",
@@ -196,17 +238,43 @@ def score_plans(
     ):
         lengths = (demo.link_lengths.upper_arm, demo.link_lengths.forearm)
         result = plan(demo.scene, models, config, start_arm=demo.keypoints[0].arm, link_lengths=lengths)
-        outcomes.append(score_trial(demo, result, faithful=faithful))
-        baselines["nearest_gap"].append(score_trial(demo, nearest_gap_plan(demo.scene), faithful=faithful))
-        baselines["majority"].append(
-            score_trial(demo, majority_plan(demo.scene, majority), faithful=faithful)
-        )
-    return outcomes, baselines
+        plans = {
+            "hlp": result,
+            "nearest_gap": nearest_gap_plan(demo.scene),
+            "majority": majority_plan(demo.scene, majority),
+        }
+        outcomes.append(score_trial(demo, plans["hlp"], faithful=faithful))
+        for name in BASELINES:
+            baselines[name].append(score_trial(demo, plans[name], faithful=faithful))
+        if ceiling is None:
+            continue
+        others, how = ceiling.plan(demo)
+        if not how:
+            continue
+        rows = set(how)
+        baselines.setdefault(CEILING, []).append(score_trial(demo, others, faithful=faithful, rows=rows))
+        for name, other in plans.items():
+            same_rows.setdefault(name, []).append(score_trial(demo, other, faithful=faithful, rows=rows))
+        for way in how.values():
+            found[way] += 1
+    coverage = {}
+    if ceiling is not None:
+        coverage = {
+            "rows": sum(len(o.rows) for o in baselines.get(CEILING, [])),
+            "rows_total": sum(len(o.rows) for o in outcomes),
+            **found,
+        }
+        if ceiling.threshold is not None:
+            coverage["threshold"] = ceiling.threshold
+    return outcomes, baselines, same_rows, coverage
 
 
 def summarise(results: Sequence[SplitResult], planner: str = "hlp") -> dict[str, dict[str, float]]:
     """Mean and standard deviation over splits of every metric of ``planner``, plus the planner's
-    planning time figures."""
+    planning time figures; for the ceiling (over the splits where it scored a row), its coverage
+    summed over splits (the threshold: its mean) and every other planner's metrics on its rows."""
+    if planner == CEILING:
+        results = [r for r in results if r.planner_outcomes(CEILING)]
     per_split = [r.metrics(planner) for r in results]
     summary = {
         m: {
@@ -215,6 +283,25 @@ def summarise(results: Sequence[SplitResult], planner: str = "hlp") -> dict[str,
         }
         for m in METRICS
     }
+    if planner == CEILING:
+        coverage: dict[str, float] = {}
+        for r in results:
+            for key, value in r.coverage.items():
+                coverage[key] = coverage.get(key, 0) + value
+        if "threshold" in coverage:
+            coverage["threshold"] /= len(results)
+        summary["coverage"] = coverage
+        summary["same_rows"] = {
+            name: {
+                m: {
+                    "mean": float(np.mean([metrics_of(r.same_rows[name])[m] for r in results])),
+                    "std": float(np.std([metrics_of(r.same_rows[name])[m] for r in results])),
+                }
+                for m in METRICS
+            }
+            for name in ("hlp", *BASELINES)
+        }
+        return summary
     for key in ("ece", "brier", "in_distribution"):
         values = [r.calibration[key] for r in results if key in r.calibration]
         if values and planner == "hlp":

@@ -10,7 +10,14 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from hlp_drake.evaluation.protocol import PAPER_TABLE_I, PLANNERS, SETTINGS, SplitResult, summarise
+from hlp_drake.evaluation.protocol import (
+    CEILING,
+    PAPER_TABLE_I,
+    SETTINGS,
+    SplitResult,
+    planners_of,
+    summarise,
+)
 from hlp_drake.files.atomic import write_text_atomic
 from hlp_drake.files.plotting import new_figure, save_png
 from hlp_drake.segmentation.demonstration import Demonstration
@@ -24,7 +31,7 @@ COLUMNS = (
     ("gap_accuracy", "Cg"),
     ("object_accuracy", "Co"),
 )
-NAMES = {"hlp": "planner", "nearest_gap": "nearest gap", "majority": "majority"}
+NAMES = {"hlp": "planner", "nearest_gap": "nearest gap", "majority": "majority", CEILING: "ceiling"}
 
 
 def table(label: str, summaries: dict[str, dict], paper: bool) -> str:
@@ -41,6 +48,18 @@ def table(label: str, summaries: dict[str, dict], paper: bool) -> str:
             + "".join(
                 f"{PAPER_TABLE_I[key]:>15.2f}" if key in PAPER_TABLE_I else f"{'-':>15}" for key, _ in COLUMNS
             )
+        )
+    if CEILING in summaries:
+        c = summaries[CEILING]["coverage"]
+        found = f"{c['layout']} on a shared layout"
+        if "threshold" in c:
+            found += f", {c['matched']} matched within {c['threshold']:.3f}"
+        same = summaries[CEILING]["same_rows"]
+        lines.append(
+            f"  ceiling: the training people's choices on {c['rows']} of the {c['rows_total']} rows "
+            f"({found}); on those rows sHLP "
+            + ", ".join(f"{NAMES[p]} {same[p]['shlp']['mean']:.3f}" for p in same)
+            + f", ceiling {summaries[CEILING]['shlp']['mean']:.3f}"
         )
     if "row_ece" in summaries["hlp"]:
         h = summaries["hlp"]
@@ -77,9 +96,8 @@ def rows_csv(results: dict[str, list[SplitResult]]) -> str:
     )
     for label, splits in results.items():
         for k, split in enumerate(splits, start=1):
-            for planner in PLANNERS:
-                outcomes = split.outcomes if planner == "hlp" else split.baselines[planner]
-                for outcome in outcomes:
+            for planner in planners_of([split]):
+                for outcome in split.planner_outcomes(planner):
                     subject, trial = outcome.key.split("/T")
                     for r in outcome.rows:
                         writer.writerow(
@@ -100,30 +118,45 @@ def rows_csv(results: dict[str, list[SplitResult]]) -> str:
 
 
 def _plot(path: str, summaries: dict[str, dict[str, dict]], title: str) -> None:
-    """Grouped bars: per result, each planner's sHLP (plan) and I(D), with the std over splits."""
-    figure, axes = new_figure(max(6.0, 2.2 * len(summaries)), 4.2)
+    """Grouped bars: per result, each planner's sHLP (plan) and I(D), with the std over splits (the
+    ceiling's on its rows, zero where it has none, with the planner's on those rows marked)."""
+    figure, axes = new_figure(max(8.0, 2.6 * len(summaries)), 4.6)
     labels = list(summaries)
-    width = 0.8 / (2 * len(PLANNERS))
-    for p, planner in enumerate(PLANNERS):
+    planners = [p for p in NAMES if any(p in summaries[label] for label in labels)]
+    width = 0.8 / (2 * len(planners))
+    nothing = {"mean": 0.0, "std": 0.0}
+    for p, planner in enumerate(planners):
         for m, (metric, name) in enumerate((("shlp_plan", "sHLP"), ("shlp_decision", "I(D)"))):
-            x = np.arange(len(labels)) + (2 * p + m - len(PLANNERS) + 0.5) * width
-            means = [summaries[label][planner][metric]["mean"] for label in labels]
-            stds = [summaries[label][planner][metric]["std"] for label in labels]
+            x = np.arange(len(labels)) + (2 * p + m - len(planners) + 0.5) * width
+            means = [summaries[label].get(planner, {}).get(metric, nothing)["mean"] for label in labels]
+            stds = [summaries[label].get(planner, {}).get(metric, nothing)["std"] for label in labels]
             axes.bar(
                 x,
                 means,
                 width,
                 yerr=stds,
                 capsize=2,
-                label=f"{NAMES[planner]}: {name}",
+                label=f"{NAMES[planner]}{' (its rows)' * (planner == CEILING)}: {name}",
                 color=f"C{p}",
                 alpha=1.0 if m == 0 else 0.55,
             )
+            same = [summaries[label].get(CEILING, {}).get("same_rows", {}).get("hlp") for label in labels]
+            if planner == CEILING:
+                axes.scatter(
+                    x,
+                    [s[metric]["mean"] if s else np.nan for s in same],
+                    marker="_",
+                    s=120,
+                    color="black",
+                    zorder=3,
+                    label="planner on the ceiling's rows" if m == 0 else None,
+                )
     axes.set_xticks(np.arange(len(labels)), labels)
-    axes.set_ylim(0.0, 1.0)
+    axes.set_ylim(0.0, 1.3)
+    axes.set_yticks(np.linspace(0.0, 1.0, 6))
     axes.set_ylabel("agreement with the held-out people")
     axes.grid(axis="y", alpha=0.3)
-    axes.legend(fontsize=7, ncol=3)
+    axes.legend(fontsize=7, ncol=len(planners), loc="upper center", columnspacing=1.0)
     axes.set_title(title)
     save_png(figure, path)
 
@@ -162,7 +195,7 @@ def write_report(
 ) -> int:
     """Print the tables and write the JSON (and CSV, PNG) ``args`` asks for; return 0."""
     summaries = {
-        label: {planner: summarise(splits, planner) for planner in PLANNERS}
+        label: {planner: summarise(splits, planner) for planner in planners_of(splits)}
         for label, splits in results.items()
     }
     protocol = "models" if args.models else args.protocol

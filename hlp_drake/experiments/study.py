@@ -173,7 +173,12 @@ def load_study(name: str) -> Study:
     from hlp_drake.files.documents import parse_yaml, read_document
 
     text = read_document(path, missing="study file not found")
-    study = load_typed(Study, parse_yaml(text, str(path)), defaults=Study(), where=str(path), top="study")
+    document = parse_yaml(text, str(path))
+    if document is None:
+        raise HlpError(
+            f"{path}: the file is empty; a study gives its scenes and the conditions to run on them"
+        )
+    study = load_typed(Study, document, defaults=Study(), where=str(path), top="study")
     problems = config_problems(study)  # the ranges, then the rules (Study.problems)
     if problems:
         raise HlpError(*(f"{path}: {p}" for p in problems))

@@ -9,10 +9,10 @@ import numpy as np
 
 from hlp_drake.features.arm import ARM_FEATURES, arm_features
 from hlp_drake.features.direction import DIRECTION_FEATURES, direction_features, direction_index
-from hlp_drake.features.row_choice import HUMAN_HAND_WIDTH, ROW_CONTEXT_FEATURES, RowChoiceScene
+from hlp_drake.features.row_choice import HUMAN_HAND_WIDTH, ROW_CONTEXT_FEATURES, RowCandidates, RowChoiceScene
 from hlp_drake.features.scene_features import GAP_FEATURES, OBJECT_FEATURES, gap_features, object_features
 from hlp_drake.features.segment import SEGMENT_FEATURES, segment_feature_matrix
-from hlp_drake.segmentation.demonstration import GAP, NONE, OBJECT, Demonstration
+from hlp_drake.segmentation.demonstration import GAP, NONE, OBJECT, Demonstration, RowDecision
 from hlp_drake.segmentation.modes import Mode, check_mode, is_faithful
 from hlp_drake.taskspace import DIRECTIONS, Node, TaskSpace
 from hlp_drake.taskspace.relocation import relocated_array
@@ -165,9 +165,31 @@ def row_choice_rows(
 ) -> list[tuple[np.ndarray, np.ndarray]]:
     """Per row the person crossed: the row's candidates' Xr and 0/1 labels (1: the person's).
 
+    The hand goes from row to row as the planner's does (``row_situations``).
+    """
+    return [
+        (candidates.X, (np.arange(len(candidates)) == k).astype(float))
+        for _, candidates, k in row_situations(demo, space, hand_width=hand_width, mirror=demo.left_handed)
+    ]
+
+
+def row_situations(
+    demo: Demonstration,
+    space: TaskSpace,
+    *,
+    hand_width: float = HUMAN_HAND_WIDTH,
+    mirror: bool = False,
+) -> list[tuple[RowDecision, RowCandidates, int]]:
+    """Per row the person crossed: the decision, the row's candidates as the person met them, and
+    the position of the person's choice among them.
+
     The hand goes from row to row as the planner's does: from the start to the passage point of
     the person's gap, or to where the person's obstacle is released (the centre of its relocated
-    region in the person's direction), which then no longer stands in its row.
+    region in the person's direction), which then no longer stands in its row. A row whose
+    obstacle was moved already (a second move in a row) is left out.
+
+    Args:
+        mirror: describe the rows as a left arm sees them (``RowChoiceScene.candidates``).
     """
     features = RowChoiceScene(space, hand_width)
     hand = np.asarray(demo.scene.start, float)
@@ -178,7 +200,7 @@ def row_choice_rows(
         if decision.decision == NONE:
             continue
         (candidates,) = features.candidates(
-            decision.row, hand, [removed], mirror=demo.left_handed, previous=previous, came_by=[came_by]
+            decision.row, hand, [removed], mirror=mirror, previous=previous, came_by=[came_by]
         )
         names = space.obstacle_names
         chosen = [
@@ -189,7 +211,7 @@ def row_choice_rows(
         if len(chosen) != 1:
             continue  # the person's obstacle was moved already (a second move in a row is not learnt)
         k = chosen[0]
-        rows.append((candidates.X, (np.arange(len(candidates)) == k).astype(float)))
+        rows.append((decision, candidates, k))
         if decision.decision == OBJECT:
             obstacle = int(candidates.obstacles[k])
             region = relocated_array(space.obstacle_bounds[[obstacle]], space.alpha)[

@@ -259,13 +259,18 @@ class DecisionModels:
         """The columns of Xr the row-choice classifier reads (the first ones)."""
         return row_feature_count(self.settings)
 
-    def fit(self, data: TrainingData) -> DecisionModels:
-        """Fit the planner's learners on ``data``."""
+    def fit(self, data: TrainingData, *, only: tuple[str, ...] | None = None) -> DecisionModels:
+        """Fit the planner's learners on ``data``.
+
+        Args:
+            only: fit only these learners; the others stay as they are (e.g. taken from other
+                fitted models).
+        """
         if self.planner == "rows" and is_faithful(data.mode):
             raise ModelError(
                 "the row-by-row planner's learners need fixed-mode data (the paper preset reads faithful)"
             )
-        for name in self.learners:
+        for name in self.learners if only is None else [n for n in self.learners if n in only]:
             labelled = getattr(data, name)
             if name in ("gap", "object") and not self.settings.gap_object_from_all_trials:
                 labelled = labelled.original_rows()

@@ -72,9 +72,9 @@ def _robot_direction(
 
     def blocking(side: str) -> float:  # how much of the corridor the obstacle still covers after the push
         unit = _unit(side)
-        travel = push_travel(
-            rules, space, scene, name, unit, _wanted(space, name, side), footprints=footprints
-        )
+        travel = robot_push(
+            rules, space, scene, name, side, space.rects if footprints is None else footprints
+        ).travel
         lateral = (corners + travel * unit - start) @ normal
         half = rules.corridor_half_width
         return max(0.0, min(lateral.max(), half) - max(lateral.min(), -half))
@@ -102,12 +102,14 @@ def push_travel(
     unit: np.ndarray,
     wanted: float,
     footprints: Mapping[str, Rect] | None = None,
+    tcp: tuple[float, float] | None = None,
 ) -> float:
     """How far (<= ``wanted``, in ``rules.travel_step`` steps) obstacle ``name`` can be pushed along
     ``unit`` before its footprint comes within ``rules.edge_margin`` of the table's edge or
-    ``rules.object_margin`` of another object, the objects' footprints being ``footprints`` (by default
-    where the scene has them). An edge or object already nearer than that only stops a push that
-    brings the obstacle closer to it."""
+    ``rules.object_margin`` of another object, or (from ``tcp``, the push's start) the pushing hand
+    (``rules.hand``) sweeps that close to another object, the objects' footprints being ``footprints``
+    (by default where the scene has them). An edge or object already nearer than that only stops a
+    push that brings the obstacle or the hand closer to it."""
     footprints = space.rects if footprints is None else footprints
     rect = space.rects[name]
     steps = np.arange(rules.travel_step, wanted + 1e-9, rules.travel_step)
@@ -121,21 +123,30 @@ def push_travel(
     )
     blocked = _nearing(edges, rules.edge_margin)
     others = rect_array([r for other, r in footprints.items() if other != name])
-    if others.size:  # the gap to each other object along the axis that separates them most
-        gaps = np.max(
-            [
-                others[None, :, 0] - boxes[:, None, 2],
-                boxes[:, None, 0] - others[None, :, 2],
-                others[None, :, 1] - boxes[:, None, 3],
-                boxes[:, None, 1] - others[None, :, 3],
-            ],
-            axis=0,
-        )
-        blocked |= _nearing(gaps, rules.object_margin)
+    if others.size:
+        blocked |= _nearing(_gaps(boxes, others), rules.object_margin)
+        shifts = np.vstack([np.zeros(2), np.outer(steps, unit)])
+        for part in rules.hand if tcp is not None else ():  # the hand, swept along from the push's start
+            hand = np.add(part, [tcp[0], tcp[1], tcp[0], tcp[1]]) + np.hstack([shifts, shifts])
+            blocked |= _nearing(_gaps(hand, others), rules.object_margin)
     stops = np.flatnonzero(blocked[1:])  # blocked[i + 1]: after steps[i]
     if stops.size == 0:
         return float(steps[-1])
     return float(steps[stops[0] - 1]) if stops[0] > 0 else 0.0
+
+
+def _gaps(boxes: np.ndarray, others: np.ndarray) -> np.ndarray:
+    """(len(boxes), len(others)): the gap between each box and each other box along the axis that
+    separates them most (negative: they overlap)."""
+    return np.max(
+        [
+            others[None, :, 0] - boxes[:, None, 2],
+            boxes[:, None, 0] - others[None, :, 2],
+            others[None, :, 1] - boxes[:, None, 3],
+            boxes[:, None, 1] - others[None, :, 3],
+        ],
+        axis=0,
+    )
 
 
 def _nearing(distances: np.ndarray, margin: float) -> np.ndarray:
@@ -159,14 +170,19 @@ def robot_push(
     rules: PushRules, space: TaskSpace, scene: Scene, name: str, direction: str, placed: Mapping[str, Rect]
 ) -> RobotPush:
     """The push of obstacle ``name`` towards ``direction``: towards its relocated place, short of
-    the edge and the other objects (at ``placed``), from just behind its face opposite the push."""
+    the edge and the other objects (at ``placed``) and of sweeping the hand into them, from just
+    behind its face opposite the push (the closed fingers', or beside a deep obstacle the palm's,
+    ``sideways_margin`` short of it)."""
     rect = space.rects[name]
     unit = _unit(direction)
-    travel = push_travel(rules, space, scene, name, unit, _wanted(space, name, direction), footprints=placed)
     # Distance from the centre to the face opposite the push, along the push direction.
-    clearance = abs(unit[0]) * rules.forward_clearance + abs(unit[1]) * rules.sideways_clearance
+    palm_beside = rect.depth / 2.0 > rules.palm_front  # the palm reaches the obstacle's depth
+    sideways = rules.palm_sideways_clearance if palm_beside else rules.sideways_clearance
+    clearance = abs(unit[0]) * rules.forward_clearance + abs(unit[1]) * sideways
     reach = abs(unit[0]) * rect.depth / 2.0 + abs(unit[1]) * rect.width / 2.0 + clearance
     start = np.array(rect.center) - reach * unit
+    wanted = _wanted(space, name, direction)
+    travel = push_travel(rules, space, scene, name, unit, wanted, footprints=placed, tcp=(start[0], start[1]))
     dx, dy = travel * unit
     return RobotPush(
         direction,

@@ -1,7 +1,7 @@
 """What the push transfer needs to know: its margins (a ``Scenario``'s ``transfer``) and the robot's sizes.
 
 The sizes (the tcp's offset from the flange, how far the fingertips reach ahead of the tcp, the open
-fingers' half-width, the wrist's radius) are read from the robot model's collision geometry, where
+and the closed fingers' half-widths, the palm's, the wrist's radius) are read from the robot model's collision geometry, where
 they live, and rounded up to ``SIZE_RESOLUTION`` (``hlp_drake.systems.planning.transfer.gripper_geometry``,
 on the Drake side); ``push_rules`` combines them with the margins
 into the clearances ``hlp_drake.transfer.push`` works with.
@@ -10,7 +10,7 @@ into the clearances ``hlp_drake.transfer.push`` works with.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Annotated
 
 from hlp_drake.config.ranges import NonNegativeFloat, Positive, PositiveFloat
@@ -29,10 +29,11 @@ class TransferConfig:
     Attributes:
         forward_margin: free approach between the fingertips and an obstacle's face at the start of
             a forward push (the arm comes down there from a transit waypoint, up to 20 degrees off level).
-        sideways_margin: the same between the open fingers' outer side and the face, sideways.
+        sideways_margin: the same between the pushing hand's side and the face, sideways: the closed
+            fingers', or the palm's where the palm overlaps the obstacle's depth.
         corridor_margin: a backward move (which the robot cannot push) becomes the sideways push
-            leaving the least of the obstacle in the corridor along the start-target line, the open
-            fingers' half-width plus this to either side.
+            leaving the least of the obstacle in the corridor along the start-target line, the
+            pushing hand's half-width (``GripperGeometry.hand_half_width``) plus this to either side.
         min_push_travel: a push that would move its obstacle less than this is left out.
         edge_margin, object_margin: a push stops this short of the table's edge and the other objects.
         travel_step: pushes are measured in steps of this.
@@ -40,7 +41,8 @@ class TransferConfig:
             object.
         wrist_shadow: how far the wrist reaches behind the flange along the approach axis, over the
             table at push height (with the tcp's offset the length of the ``arm_shadow``).
-        shadow_margin: the arm's shadow is the wrist's radius plus this to either side.
+        shadow_margin: the arm's shadow is the wrist's radius or the palm's half-width, the wider,
+            plus this to either side.
         path_clearance: a way whose tcp path passes this close to an object goes over it.
         approach_gap: the gripper slides onto the target from this far behind its back face ...
         approach_angle: ... where the way there would come in more than this off the approach axis.
@@ -67,17 +69,33 @@ class TransferConfig:
 class GripperGeometry:
     """The robot's sizes the transfer uses, m (``gripper_geometry`` reads them from the model).
 
+    The hand pushes closed (``MotionConfig.closed_among_obstacles``): in plan view, the approach axis
+    along +x, it is the closed fingers, ``closed_half_width`` to either side from ``palm_front``
+    behind the tcp to ``fingertip_reach`` ahead of it, and the palm, ``palm_half_width`` to either
+    side from the flange (``tcp_offset`` behind the tcp) to ``palm_front`` behind it.
+
     Attributes:
         tcp_offset: the tcp's distance from the flange along the approach axis.
         fingertip_reach: how far the fingertips reach ahead of the tcp.
-        finger_half_width: the open fingers' outer sides from the tcp, sideways.
+        finger_half_width: the open fingers' outer sides from the tcp, sideways (onto the target).
         wrist_radius: the radius of the wrist's links.
+        closed_half_width: the closed fingers' outer sides from the tcp, sideways.
+        palm_half_width: the palm's sides from the tcp, sideways.
+        palm_front: how far behind the tcp the palm's front face lies.
     """
 
     tcp_offset: float
     fingertip_reach: float
     finger_half_width: float
     wrist_radius: float
+    closed_half_width: float
+    palm_half_width: float
+    palm_front: float
+
+    @property
+    def hand_half_width(self) -> float:
+        """The pushing hand's widest half: its closed fingers' or its palm's."""
+        return max(self.closed_half_width, self.palm_half_width)
 
 
 @dataclass(frozen=True)
@@ -86,18 +104,27 @@ class PushRules:
 
     Attributes:
         forward_clearance, sideways_clearance: the tcp's distance from an obstacle's face at the
-            start of a push along x, along y.
+            start of a push along x, along y (the closed fingers' side); palm_sideways_clearance:
+            along y beside an obstacle deeper than ``2 * palm_front`` (the palm's side).
+        palm_front: how far behind the tcp the palm begins.
+        hand: the pushing hand's footprint around the tcp (approach along +x), each part's (x_min,
+            y_min, x_max, y_max): the closed fingers and the palm; a push stops ``object_margin``
+            short of sweeping it into another object.
         corridor_half_width: the corridor along the start-target line a backward move should clear.
         transit_clearance: the tcp's height over the tallest object on transit waypoints.
         arm_shadow_length, arm_shadow_half_width: the table area under the gripper and wrist behind
             the tcp at push height; the arm only comes down where nothing lies there.
         gripper_ahead, gripper_half_width, gripper_behind: the gripper's footprint around the tcp.
-        way_clearance: a push must not leave its obstacle this close to the way on to the target.
+        way_clearance: a push must not leave its obstacle this close to the way on to the target
+            (the pushing hand's half-width).
         The rest: as in ``TransferConfig``.
     """
 
     forward_clearance: float
     sideways_clearance: float
+    palm_sideways_clearance: float
+    palm_front: float
+    hand: tuple[tuple[float, float, float, float], ...]
     corridor_half_width: float
     transit_clearance: float
     arm_shadow_length: float
@@ -120,20 +147,27 @@ def length(value: float) -> float:
     return round(value, 6)
 
 
-def push_rules(config: TransferConfig, geometry: GripperGeometry) -> PushRules:
-    """The clearances of ``config`` for a robot of ``geometry``."""
-    g = geometry
+def push_rules(config: TransferConfig, geometry: GripperGeometry, *, closed: bool = True) -> PushRules:
+    """The clearances of ``config`` for a robot of ``geometry`` that pushes with its fingers
+    ``closed`` (``MotionConfig.closed_among_obstacles``), or else open."""
+    g = geometry if closed else replace(geometry, closed_half_width=geometry.finger_half_width)
     return PushRules(
         forward_clearance=length(g.fingertip_reach + config.forward_margin),
-        sideways_clearance=length(g.finger_half_width + config.sideways_margin),
-        corridor_half_width=length(g.finger_half_width + config.corridor_margin),
+        sideways_clearance=length(g.closed_half_width + config.sideways_margin),
+        palm_sideways_clearance=length(g.palm_half_width + config.sideways_margin),
+        palm_front=g.palm_front,
+        hand=(
+            (-g.palm_front, -g.closed_half_width, g.fingertip_reach, g.closed_half_width),
+            (-g.tcp_offset, -g.palm_half_width, -g.palm_front, g.palm_half_width),
+        ),
+        corridor_half_width=length(g.hand_half_width + config.corridor_margin),
         transit_clearance=length(g.wrist_radius + config.transit_margin),
         arm_shadow_length=length(g.tcp_offset + config.wrist_shadow),
-        arm_shadow_half_width=length(g.wrist_radius + config.shadow_margin),
+        arm_shadow_half_width=length(max(g.wrist_radius, g.palm_half_width) + config.shadow_margin),
         gripper_ahead=g.fingertip_reach,
         gripper_half_width=g.finger_half_width,
         gripper_behind=config.gripper_behind,
-        way_clearance=g.finger_half_width,
+        way_clearance=g.hand_half_width,
         min_push_travel=config.min_push_travel,
         edge_margin=config.edge_margin,
         object_margin=config.object_margin,

@@ -71,10 +71,10 @@ def test_failed_generation_writes_no_file(tmp_path):
 
 
 def test_show_draws_the_named_robots_plan_and_refuses_an_unknown_robot(tmp_path):
-    """The iiwa's wider fingers start its push elsewhere than the mobile UR5's (gen1 seed 5 on the
-    Panda's tables): the drawn robot plans differ."""
+    """The iiwa's wider palm and longer wrist push elsewhere than the mobile UR5's (gen1 seed 6 on
+    the Panda's tables): the drawn robot plans differ."""
     scene = tmp_path / "scene.yaml"
-    args = ["generate", "--kind", "gen1", "--seed", "5", "--robot", "panda", "--out", str(scene)]
+    args = ["generate", "--kind", "gen1", "--seed", "6", "--robot", "panda", "--out", str(scene)]
     assert run_module("hlp_drake.scene", *args).returncode == 0
     drawn = {}
     for robot in ("mobile_ur5", "iiwa14"):
@@ -83,7 +83,7 @@ def test_show_draws_the_named_robots_plan_and_refuses_an_unknown_robot(tmp_path)
             "hlp_drake.scene", "show", str(scene), "--png", str(png), "--plan", "--robot", robot
         )
         assert result.returncode == 0, result.stderr
-        assert "robot plan: start -> gap -> move -> release -> target" in result.stdout
+        assert "robot plan: start -> move -> release -> move -> release -> target" in result.stdout
         drawn[robot] = png.read_bytes()
     assert drawn["mobile_ur5"] != drawn["iiwa14"]
     png = tmp_path / "r2d2.png"

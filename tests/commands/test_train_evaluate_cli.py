@@ -61,7 +61,7 @@ def test_evaluate_one_split(dataset_path, tmp_path):
     figures = json.loads(report.read_text())
     assert list(figures["results"]) == ["19/5"]
     planners = figures["results"]["19/5"]
-    assert set(planners) == {"hlp", "nearest_gap", "majority"}
+    assert set(planners) == {"hlp", "nearest_gap", "majority", "ceiling"}
     for key in (
         "gap_accuracy",
         "object_accuracy",
@@ -78,11 +78,20 @@ def test_evaluate_one_split(dataset_path, tmp_path):
     )  # only the planner is timed
     assert hlp["shlp"]["mean"] > 0.6 and hlp["gap_accuracy"]["mean"] > 0.85  # well above chance
     assert hlp["shlp_plan"]["mean"] > rule["shlp_plan"]["mean"] + 0.2  # people mostly move obstacles here
+    ceiling = planners["ceiling"]  # the training people on the shared layouts; no row matching here
+    coverage = ceiling["coverage"]
+    assert 0 < coverage["layout"] == coverage["rows"] < coverage["rows_total"] and "threshold" not in coverage
+    same = ceiling["same_rows"]
+    assert set(same) == {"hlp", "nearest_gap", "majority"} and "planning_time_s" not in ceiling
+    assert ceiling["shlp"]["mean"] > same["hlp"]["shlp"]["mean"] > same["nearest_gap"]["shlp"]["mean"]
+    assert "ceiling: the training people's choices on" in result.stdout
     test_subjects = set(figures["splits_subjects"]["19/5"][0]["test"])
     assert len(test_subjects) == 5 and not test_subjects & set(figures["splits_subjects"]["19/5"][0]["train"])
     table = list(csv.DictReader(rows.open()))
     assert {r["subject"] for r in table} == test_subjects
-    assert {r["planner"] for r in table} == {"hlp", "nearest_gap", "majority"}
+    assert {r["planner"] for r in table} == {"hlp", "nearest_gap", "majority", "ceiling"}
+    ceiling_rows = [r for r in table if r["planner"] == "ceiling"]
+    assert len(ceiling_rows) == coverage["rows"]
     assert "Cg" in result.stdout and "0.95" in result.stdout  # the paper's figures beside
 
 

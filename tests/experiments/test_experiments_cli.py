@@ -98,6 +98,19 @@ def test_a_bad_study_file_is_one_line_naming_the_file_and_field(tmp_path, capsys
     assert not out.exists()
 
 
+@pytest.mark.parametrize("text", ["", "\n", "# nothing yet\n"])
+def test_an_empty_study_file_is_refused_not_read_as_the_default_study(tmp_path, capsys, text):
+    study = tmp_path / "study.yaml"
+    study.write_text(text)
+    out = tmp_path / "out"
+    assert run_cli(lambda a: main(a, job=never_called), [str(study), "--out", str(out)]) == 2
+    assert (
+        capsys.readouterr().err
+        == f"error: {study}: the file is empty; a study gives its scenes and the conditions to run on them\n"
+    )
+    assert not out.exists()
+
+
 def _bad_row(text: str, field: str, value: str) -> str:
     """``text`` (a results.csv) with ``field`` of its first row set to ``value``."""
     lines = text.splitlines()

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from fuzz_support import PROFILES, STATS, check_error, junk, run
+from fuzz_support import PROFILES, STATS, check_error, damage_csv, junk, run
 from hypothesis import strategies as st
 from synthetic_dataset import write_dataset
 
@@ -17,34 +17,6 @@ from hlp_drake.dataset import Dataset
 from hlp_drake.errors import DatasetError
 
 _TRIALS = {5: "Success", 10: "Success", 11: "ArmInteraction"}
-
-
-def _damage_csv(text: str, draw) -> str:
-    lines = text.splitlines()
-    how = draw(st.sampled_from(["nan", "reverse", "header", "truncate", "cut", "bytes", "empty", "swap"]))
-    if how == "nan" and len(lines) > 1:
-        row = draw(st.integers(1, len(lines) - 1))
-        fields = lines[row].split(",")
-        fields[draw(st.integers(0, len(fields) - 1))] = draw(
-            st.sampled_from(["NaN", "inf", "", "x", "1e999"])
-        )
-        lines[row] = ",".join(fields)
-    elif how == "reverse":
-        lines = lines[:1] + lines[1:][::-1]
-    elif how == "header":
-        lines = lines[:1]
-    elif how == "truncate":
-        lines = lines[: max(1, len(lines) // 2)]
-    elif how == "cut":
-        joined = "\n".join(lines)
-        return joined[: draw(st.integers(0, len(joined)))]
-    elif how == "bytes":
-        return text[: len(text) // 2] + "\udcff\x00" + text[len(text) // 2 :]
-    elif how == "empty":
-        return ""
-    elif how == "swap" and len(lines) > 2:
-        lines[1], lines[2] = lines[2], lines[1]
-    return "\n".join(lines) + "\n"
 
 
 _FILES = [
@@ -78,7 +50,7 @@ def _check_dataset_damage(case) -> None:
     with tempfile.TemporaryDirectory() as folder:
         root = write_dataset(Path(folder) / "dataset", _TRIALS)
         path = root / relative
-        path.write_text(_damage_csv(path.read_text(), data.draw), encoding="utf-8", errors="surrogateescape")
+        path.write_text(damage_csv(path.read_text(), data.draw), encoding="utf-8", errors="surrogateescape")
         dataset = _load(root, Path(folder) / "cache")
         if dataset is None:
             STATS["datasets refused"] += 1

@@ -32,9 +32,14 @@ PHASE = Positive(upper=MAX_DURATION)
 
 @dataclass(frozen=True)
 class GraspConfig:
-    """The grasp after a successful reach: close the fingers, then lift the tcp straight up.
+    """The grasp after a successful reach: slide the tcp onto the target's centre, close the
+    fingers, then lift the tcp straight up.
 
     Attributes:
+        align: before closing, slide the open hand level until the tcp is over the target's centre as
+            the world shows it at the reach's end (a wrist camera's last correction): the reach passes
+            with the tcp up to ``success``'s tolerance off it, more than short fingers close round.
+        align_s: time of that slide, s.
         close_s: time to close the fingers, s.
         lift_height: how far the tcp rises, m.
         lift_s: time of the lift, s.
@@ -42,11 +47,18 @@ class GraspConfig:
         held_height: the grasp held when the target rose at least this far, m.
     """
 
+    align: bool = True
+    align_s: Annotated[float, PHASE] = 0.5
     close_s: Annotated[float, PHASE] = 1.0
     lift_height: NonNegativeFloat = 0.10
     lift_s: Annotated[float, PHASE] = 1.5
     hold_s: Annotated[float, Positive(upper=MAX_DURATION, zero_ok=True)] = 0.5
     held_height: PositiveFloat = 0.05
+
+    @property
+    def duration(self) -> float:
+        """The grasp's simulated time at most, s."""
+        return (self.align_s if self.align else 0.0) + self.close_s + self.lift_s + self.hold_s
 
 
 class OpenLoopCommand:
@@ -97,11 +109,17 @@ __all__ = ["ClosedLoopCommand", "GraspConfig", "OpenLoopCommand"]
 
 
 # The grasp after a reach: close the fingers round the target, lift it, and check that it held.
-def lifted_configuration(
-    q: np.ndarray, height: float, robot: RobotDescription = MOBILE_UR5, *, max_iterations: int = 200
+def moved_configuration(
+    q: np.ndarray,
+    robot: RobotDescription = MOBILE_UR5,
+    *,
+    by: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    level_to: tuple[float, float] | None = None,
+    max_iterations: int = 200,
 ) -> np.ndarray | None:
-    """Robot positions with the tcp ``height`` higher than at ``q``, same orientation, the base
-    and the fingers unchanged; None if the arm cannot."""
+    """Robot positions with the tcp moved ``by`` from where it is at ``q`` (first, if given, level to
+    the world point ``level_to``: same height), same orientation, the base and the fingers
+    unchanged; None if the arm cannot."""
     plant, instance = kinematic_robot(robot)
     context = plant.CreateDefaultContext()
     plant.SetPositions(context, instance, q)
@@ -111,7 +129,10 @@ def lifted_configuration(
     fixed = [*robot.base_columns, *robot.finger_columns]
     prog = ik.get_mutable_prog()
     prog.AddBoundingBoxConstraint(q[fixed], q[fixed], ik.q()[fixed])
-    target = pose.translation() + np.array([0.0, 0.0, height])
+    target = pose.translation().copy()
+    if level_to is not None:
+        target[:2] = level_to
+    target += by
     ik.AddPositionConstraint(tcp, np.zeros(3), plant.world_frame(), target - 1e-3, target + 1e-3)
     ik.AddOrientationConstraint(plant.world_frame(), pose.rotation(), tcp, RotationMatrix(), 0.05)
     prog.AddQuadraticErrorCost(np.eye(len(q)), q, ik.q())
@@ -120,17 +141,34 @@ def lifted_configuration(
 
 
 def grasp_knots(
-    q_end: np.ndarray, grasp: GraspConfig, robot: RobotDescription = MOBILE_UR5
+    q_end: np.ndarray,
+    grasp: GraspConfig,
+    robot: RobotDescription = MOBILE_UR5,
+    *,
+    centre: tuple[float, float] | None = None,
 ) -> tuple[np.ndarray, np.ndarray] | None:
-    """Times (after the reach's end) and robot positions of the grasp: close the fingers at the end
-    pose, lift the tcp by ``grasp.lift_height``, hold. None if the lift has no IK solution."""
-    closed = np.array(q_end, dtype=float)
+    """Times (after the reach's end) and robot positions of the grasp: slide the open hand level
+    onto the target's ``centre`` (world x, y; if given and ``grasp.align``, where the arm can),
+    close the fingers, lift the tcp by ``grasp.lift_height``, hold. None if the lift has no IK
+    solution."""
+    aligned = None
+    if grasp.align and centre is not None:
+        aligned = moved_configuration(np.asarray(q_end, dtype=float), robot, level_to=centre)
+    start = np.array(q_end if aligned is None else aligned, dtype=float)
+    closed = start.copy()
     closed[list(robot.finger_columns)] = robot.gripper_closed
-    lifted = lifted_configuration(closed, grasp.lift_height, robot) if grasp.lift_height > 0 else closed
+    lifted = (
+        moved_configuration(closed, robot, by=(0.0, 0.0, grasp.lift_height))
+        if grasp.lift_height > 0
+        else closed
+    )
     if lifted is None:
         return None
-    times = np.cumsum([grasp.close_s, grasp.lift_s, max(grasp.hold_s, 1e-3)])
-    return times, np.vstack([closed, lifted, lifted])
+    phases = [grasp.close_s, grasp.lift_s, max(grasp.hold_s, 1e-3)]
+    knots = [closed, lifted, lifted]
+    if aligned is not None:
+        phases, knots = [grasp.align_s, *phases], [aligned, *knots]
+    return np.cumsum(phases), np.vstack(knots)
 
 
 def advance_through_reach(
@@ -161,16 +199,17 @@ def grasp_and_lift(
     grasp: GraspConfig,
     robot: RobotDescription = MOBILE_UR5,
 ) -> bool:
-    """Close the fingers at the reach's end pose (from ``t0``) and lift (``grasp``); whether the object
-    ``target`` of ``plant`` rose with the gripper."""
+    """Slide onto the target, close the fingers and lift (``grasp``, from ``t0``, the reach's end
+    pose); whether the object ``target`` of ``plant`` rose with the gripper."""
     root = simulator.get_mutable_context()
-    knots = grasp_knots(command.final(root), grasp, robot)
+    body = object_body(plant, target)
+    plant_context = plant.GetMyContextFromRoot(root)
+    centre = body.EvalPoseInWorld(plant_context).translation()
+    knots = grasp_knots(command.final(root), grasp, robot, centre=(float(centre[0]), float(centre[1])))
     if knots is None:
         return False
     times, knots = knots
     command.then(root, t0, times, knots)
-    body = object_body(plant, target)
-    plant_context = plant.GetMyContextFromRoot(root)
-    z0 = body.EvalPoseInWorld(plant_context).translation()[2]
+    z0 = centre[2]
     simulator.AdvanceTo(t0 + times[-1])
     return bool(body.EvalPoseInWorld(plant_context).translation()[2] - z0 >= grasp.held_height)

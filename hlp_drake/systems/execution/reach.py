@@ -50,7 +50,7 @@ def execute_reach(
     simulator.Initialize()
     root = simulator.get_mutable_context()
     grasp, settle_s = scenario.grasp, scenario.success.settle_s
-    listener.executing(command.end(root) + settle_s + grasp.close_s + grasp.lift_s + grasp.hold_s)
+    listener.executing(command.end(root) + settle_s + grasp.duration)
     plant_context = plant.GetMyContextFromRoot(simulator.get_context())
     tcp_frame = plant.GetFrameByName(scenario.robot.tcp_frame, robot)
     track: list[tuple[float, np.ndarray]] = []  # recorded: the tcp over time, to time the pushes

@@ -80,7 +80,10 @@ def make_planning_diagram(
     transfer = builder.AddNamedSystem(
         "robot_plan_transfer",
         RobotPlanTransfer(
-            robot=scenario.robot, transfer=scenario.transfer, alternatives=scenario.planner.alternatives
+            robot=scenario.robot,
+            transfer=scenario.transfer,
+            alternatives=scenario.planner.alternatives,
+            pushes_closed=scenario.motion.closed_among_obstacles,
         ),
     )
     kind = "given" if plan is not None else scenario.planner.initial

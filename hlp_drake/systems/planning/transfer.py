@@ -56,18 +56,28 @@ def _extent(plant, scene_graph, context, bodies, frame) -> np.ndarray:
 
 @functools.lru_cache(maxsize=4)
 def gripper_geometry(robot: RobotDescription = MOBILE_UR5) -> GripperGeometry:
-    """The robot's sizes, read from its model's collision geometry with the fingers open (once per robot)."""
+    """The robot's sizes, read from its model's collision geometry (once per robot): the fingers open
+    (the way onto the target) and closed (the pushes), the palm (the other ``gripper_links``)."""
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
     instance = add_robot(plant, robot)
     plant.Finalize()
     diagram = builder.Build()
     context = plant.GetMyMutableContextFromRoot(diagram.CreateDefaultContext())
-    for name in robot.gripper_joints:
-        plant.GetJointByName(name, instance).set_translation(context, robot.gripper_open)
     tcp = plant.GetFrameByName(robot.tcp_frame, instance)
     fingers = [plant.GetBodyByName(name, instance) for name in robot.finger_links]
-    finger_box = _extent(plant, scene_graph, context, fingers, tcp)
+
+    def fingers_at(opening: float) -> np.ndarray:
+        for name in robot.gripper_joints:
+            plant.GetJointByName(name, instance).set_translation(context, opening)
+        return _extent(plant, scene_graph, context, fingers, tcp)
+
+    closed_box = fingers_at(robot.gripper_closed)
+    finger_box = fingers_at(robot.gripper_open)
+    palm = [
+        plant.GetBodyByName(name, instance) for name in robot.gripper_links if name not in robot.finger_links
+    ]
+    palm_box = _extent(plant, scene_graph, context, palm, tcp) if palm else closed_box
     flange = plant.GetFrameByName(robot.flange_frame, instance)
     offset = flange.CalcPose(context, tcp).translation()
     wrist = plant.GetBodyByName(robot.wrist_link, instance)
@@ -77,6 +87,9 @@ def gripper_geometry(robot: RobotDescription = MOBILE_UR5) -> GripperGeometry:
         fingertip_reach=_rounded_up(float(finger_box[1, 2])),
         finger_half_width=_rounded_up(float(np.max(np.abs(finger_box[:, 1])))),
         wrist_radius=_rounded_up(float(np.max(wrist_box[1, :2]))),
+        closed_half_width=_rounded_up(float(np.max(np.abs(closed_box[:, 1])))),
+        palm_half_width=_rounded_up(float(np.max(np.abs(palm_box[:, 1])))),
+        palm_front=length(max(math.floor(-palm_box[1, 2] / SIZE_RESOLUTION + 1e-6) * SIZE_RESOLUTION, 0.0)),
     )
 
 
@@ -88,6 +101,8 @@ class RobotPlanTransfer(LeafSystem):
         transfer: the transfer's margins (a ``Scenario``'s ``transfer``).
         alternatives: at most this many alternative robot plans (a ``Scenario``'s
             ``planner.alternatives``).
+        pushes_closed: whether the hand pushes with its fingers closed (a ``Scenario``'s
+            ``motion.closed_among_obstacles``) or open.
     """
 
     def __init__(
@@ -96,9 +111,10 @@ class RobotPlanTransfer(LeafSystem):
         robot: RobotDescription = MOBILE_UR5,
         transfer: TransferConfig | None = None,
         alternatives: int = DEFAULT_ALTERNATIVES,
+        pushes_closed: bool = True,
     ) -> None:
         super().__init__()
-        rules = push_rules(transfer or TransferConfig(), gripper_geometry(robot))
+        rules = push_rules(transfer or TransferConfig(), gripper_geometry(robot), closed=pushes_closed)
         limit = alternatives
         self._rules = rules
         self._scene_port = declare_scene_input_port(self)

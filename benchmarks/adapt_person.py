@@ -69,7 +69,7 @@ def pooled_models(data, subject: str, folder: Path) -> DecisionModels:
 
 
 def shlp(models: DecisionModels, demonstrations, majority: str) -> list[float]:
-    outcomes, _ = score_plans(models, demonstrations, majority)
+    outcomes = score_plans(models, demonstrations, majority)[0]
     return [o.shlp for o in outcomes]
 
 

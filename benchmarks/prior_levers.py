@@ -302,6 +302,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.workers > 1:
         with multiprocessing.get_context("fork").Pool(args.workers) as pool:
             records = pool.map(run_fold, jobs, chunksize=1)
+            pool.close()  # the workers finish: none is terminated mid-wait when the pool exits
+            pool.join()
     else:
         records = [run_fold(job) for job in jobs]
     results = summary(records, args.levers)

@@ -9,7 +9,12 @@ import numpy as np
 
 from hlp_drake.features.arm import ARM_FEATURES, arm_features
 from hlp_drake.features.direction import DIRECTION_FEATURES, direction_features, direction_index
-from hlp_drake.features.row_choice import HUMAN_HAND_WIDTH, ROW_CONTEXT_FEATURES, RowCandidates, RowChoiceScene
+from hlp_drake.features.row_choice import (
+    HUMAN_HAND_WIDTH,
+    ROW_CONTEXT_FEATURES,
+    RowCandidates,
+    RowChoiceScene,
+)
 from hlp_drake.features.scene_features import GAP_FEATURES, OBJECT_FEATURES, gap_features, object_features
 from hlp_drake.features.segment import SEGMENT_FEATURES, segment_feature_matrix
 from hlp_drake.segmentation.demonstration import GAP, NONE, OBJECT, Demonstration, RowDecision

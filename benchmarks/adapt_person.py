@@ -9,7 +9,7 @@ the bundled one, which saw everyone: it only breaks ties between equally likely 
 pooled and adapted models share it). The participant's successful trials are shuffled (seed
 ``--seed`` and the participant); the first ``max(ks)`` are their demonstrations, the rest their
 held-out trials, the same for every k. The models adapted on the first k demonstrations
-(``learners.adapt``: the number of added trees chosen by cross-validation on those k trials
+(``learners.adapt``: the person's bias and the added trees chosen by cross-validation on those k trials
 only) and the pooled models plan each held-out trial's scene; sHLP scores each plan against the
 person (as ``python -m hlp_drake.evaluate`` does). Nothing is tuned on the held-out trials.
 
@@ -128,7 +128,8 @@ def main() -> int:
             record["k"][str(k)] = {
                 "adapted": float(np.mean(scores)),
                 "trees": adaptation.trees,
-                "cv_row_score": {str(n): s for n, s in adaptation.scores.items()},
+                "bias": adaptation.bias,
+                "cv_row_score": adaptation.scores,
             }
         done[subject] = record
         gains = ", ".join(f"k={k} {record['k'][str(k)]['adapted']:.3f}" for k in args.ks)
@@ -173,6 +174,7 @@ def _report(done: dict, args) -> dict:
             "improved": int(np.sum(gain > 1e-9)),
             "worse": int(np.sum(gain < -1e-9)),
             "trees_median": float(np.median([r["k"][str(k)]["trees"] for r in done.values()])),
+            "bias_chosen": sum(bool(r["k"][str(k)].get("bias")) for r in done.values()),
         }
     for name in ("in_sample", "self_fit"):
         ceiling = [r[name] for r in done.values() if name in r]

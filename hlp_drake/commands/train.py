@@ -12,9 +12,9 @@ one person, from DEMOS, a folder of that person's VR logs in the dataset's layou
 (sub_XX/trial_results.csv, sub_XX/TYYY/scene and movement files; participant_list.csv for the
 handedness). Trials that are damaged, empty, name an object their layout lacks, failed or cannot be
 segmented are each named (file and line) and left out; fewer than 5 usable trials are refused (exit
-2). The row-choice classifier's trees are boosted on with the person's choices, as many trees as
-cross-validation on the person's own trials chooses (0: the base models stand); see
-hlp_drake.learners.adapt. The models are the usual models.json and models.npz; pin them with the
+2). The row-choice classifier learns the person's bias (gaps or obstacles) and boosts more trees
+on their choices, as cross-validation on the person's own trials chooses (none: the base models
+stand); see hlp_drake.learners.adapt. The models are the usual models.json and models.npz; pin them with the
 SHA-256 printed (run_scene --models DIR --models-sha256 HEX, or planner.models_sha256).
 """
 
@@ -115,7 +115,7 @@ def adapt(demos: str, base: str | None, out: str) -> int:
     """``--adapt``: the base models adapted to the person of the folder ``demos``, saved in ``out``."""
     import sys
 
-    from hlp_drake.learners.adapt import adapt_models
+    from hlp_drake.learners.adapt import adapt_models, choice_name
     from hlp_drake.learners.bundled import default_models
     from hlp_drake.segmentation.person import read_person
 
@@ -125,14 +125,13 @@ def adapt(demos: str, base: str | None, out: str) -> int:
         print(f"left out: {line}", file=sys.stderr)
     models, adaptation = adapt_models(prior, person.demonstrations, person=person.person)
     models.save(out)
-    tried = ", ".join(f"{n} {score:.3f}" for n, score in adaptation.scores.items())
+    tried = ", ".join(f"{name} {score:.3f}" for name, score in adaptation.scores.items())
+    chosen = choice_name(adaptation.bias, adaptation.trees)
     print(
         f"adapted to {person.person} from {adaptation.trials} trials ({adaptation.rows} row choices, "
-        f"{len(person.left_out)} left out): {adaptation.trees} trees added"
+        f"{len(person.left_out)} left out): {'the prior kept' if chosen == 'prior' else chosen + ' added'}"
     )
-    print(
-        f"cross-validated row score by trees added ({adaptation.folds} folds of the person's trials): {tried}"
-    )
+    print(f"cross-validated row score ({adaptation.folds} folds of the person's trials): {tried}")
     sha = digest((Path(out) / "models.json").read_bytes())
     print(f"wrote {out}/models.json and models.npz (models.json SHA-256 {sha})")
     return 0

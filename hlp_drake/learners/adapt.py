@@ -2,13 +2,15 @@
 
 The row-choice classifier Cr of the default models is a sum of boosted trees on the candidates'
 features, turned into a probability by a Platt calibration: p = expit(a * F(x) + b). Adapting
-starts from those models (the prior, trained on the 24 people of the VR study) and adds a few
-shallow trees fitted to the person's own choices by the same log-loss boosting, each a Newton step
-from where the prior and the trees before it left the person's candidates. With no tree added the
-adapted models are the prior; each tree moves them towards the person. How many trees
-(``TREE_CHOICES``) is chosen by cross-validation on the person's own trials only (folds of whole
-trials): the number whose held-out rows the classifier chooses best, scored per row as sHLP scores
-a row (the decision, then the element); a tie goes to fewer trees, so the prior stands unless the
+starts from those models (the prior, trained on the 24 people of the VR study) and can add, fitted
+to the person's own choices: first the person's bias (one tree of depth 1 on the candidate's kind:
+a logit offset for gaps and one for obstacles, the ridge-regularised log-loss optimum from the
+prior's logits; people differ most in how often they move an obstacle), then a few shallow trees
+by the same log-loss boosting, each a Newton step from where the prior and the trees before it left
+the person's candidates. Which (``CHOICES``: the prior, with or without the bias, with 0 to 40
+trees) is chosen by cross-validation on the person's own trials only (folds of whole trials): the
+choice whose held-out rows the classifier chooses best, scored per row as sHLP scores a row (the
+decision, then the element); a tie goes to the simpler choice, so the prior stands unless the
 person's trials show it should move.
 
 The direction classifier Cd and the arm regressor Ra are the prior's; the arm priors (the start
@@ -21,6 +23,7 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass, replace
+from types import SimpleNamespace
 
 import numpy as np
 from scipy.special import expit
@@ -37,7 +40,15 @@ from hlp_drake.taskspace import TaskSpace
 MIN_TRIALS = 5
 """Fewest usable trials of a person that models are adapted on (fewer: refused)."""
 TREE_CHOICES = (0, 5, 10, 20, 40)
-"""The numbers of added trees the person's cross-validation chooses from (0: the prior)."""
+"""The numbers of added trees the person's cross-validation chooses from."""
+CHOICES = tuple(
+    sorted(((bias, n) for bias in (False, True) for n in TREE_CHOICES), key=lambda c: (c[1], c[0]))
+)
+"""(the person's kind bias first, trees added after it) choices, simplest first ((False, 0): the prior)."""
+BIAS_L2 = 1.0
+"""Ridge on each of the kind bias's two offsets (logit units)."""
+BIAS_STEPS = 20
+"""Newton steps of the kind bias (to convergence)."""
 TREE_DEPTH = 2
 """Depth of each added tree."""
 LEARNING_RATE = 0.1
@@ -86,15 +97,17 @@ class PersonRows:
 
 @dataclass(frozen=True)
 class Adaptation:
-    """What adapting did: the person, their trials and rows, the trees added, and the
-    cross-validated per-row score (sHLP's row score) of each number of trees tried."""
+    """What adapting did: the person, their trials and rows, the trees added (after the kind bias
+    if ``bias``), and the cross-validated per-row score (sHLP's row score) of each choice tried
+    (``choice_name``)."""
 
     person: str
     trials: int
     rows: int
     trees: int
     folds: int
-    scores: dict[int, float]
+    scores: dict[str, float]
+    bias: bool = False
 
 
 def row_score(p: np.ndarray, taken: int, is_object: np.ndarray) -> float:
@@ -134,28 +147,75 @@ def _boost(z: np.ndarray, X: np.ndarray, y: np.ndarray, trees: int, seed: int) -
     return fitted
 
 
+class _KindStump:
+    """A tree of depth 1 on the candidate's kind (column 0 of Xr: an obstacle), laid out as a
+    fitted ``DecisionTreeRegressor``'s: node 1 the gaps, node 2 the obstacles."""
+
+    tree_ = SimpleNamespace(
+        feature=np.array([0, -2, -2]),
+        threshold=np.array([0.5, -2.0, -2.0]),
+        children_left=np.array([1, LEAF, LEAF]),
+        children_right=np.array([2, LEAF, LEAF]),
+        node_count=3,
+    )
+
+    def apply(self, X: np.ndarray) -> np.ndarray:
+        return np.where(X[:, 0] <= 0.5, 1, 2)
+
+    def get_depth(self) -> int:
+        return 1
+
+
+def _kind_bias(z: np.ndarray, X: np.ndarray, y: np.ndarray) -> tuple[_KindStump, np.ndarray]:
+    """The person's bias from the logits ``z``: a logit offset for gaps and one for obstacles,
+    minimising the log loss plus ``BIAS_L2`` / 2 times each offset squared (Newton steps)."""
+    stump = _KindStump()
+    leaves = stump.apply(X)
+    values = np.zeros(3)
+    for _ in range(BIAS_STEPS):
+        p = expit(z + values[leaves])
+        for leaf in (1, 2):
+            mask = leaves == leaf
+            gradient = float(np.sum(y[mask] - p[mask])) - BIAS_L2 * values[leaf]
+            values[leaf] += gradient / (float(np.sum(p[mask] * (1.0 - p[mask]))) + BIAS_L2)
+    return stump, values
+
+
+def _fitted(z: np.ndarray, X: np.ndarray, y: np.ndarray, bias: bool, trees: int, seed: int) -> list[tuple]:
+    """The added trees of a choice: the kind bias (if ``bias``), then ``trees`` boosted trees."""
+    fitted = [_kind_bias(z, X, y)] if bias else []
+    return fitted + _boost(_logits_after(z, X, fitted), X, y, trees, seed)
+
+
+def choice_name(bias: bool, trees: int) -> str:
+    """How a choice of ``CHOICES`` is shown: "prior", "bias", "5 trees", "bias + 5 trees"."""
+    parts = (["bias"] if bias else []) + ([f"{trees} trees"] if trees else [])
+    return " + ".join(parts) or "prior"
+
+
 def _logits_after(z: np.ndarray, X: np.ndarray, fitted: list[tuple]) -> np.ndarray:
     return z + sum((values[tree.apply(X)] for tree, values in fitted), np.zeros(len(X)))
 
 
-def _cross_validated(models: DecisionModels, rows: PersonRows, seed: int) -> tuple[dict[int, float], int]:
-    """Mean row score of each ``TREE_CHOICES`` over folds of the person's trials, and the folds."""
+def _cross_validated(models: DecisionModels, rows: PersonRows, seed: int) -> tuple[dict[tuple, float], int]:
+    """Mean row score of each of ``CHOICES`` over folds of the person's trials, and the folds."""
     trials = np.array(rows.trials)
     folds = min(MAX_FOLDS, len(set(rows.trials)))
-    totals = {n: [] for n in TREE_CHOICES}
+    totals = {choice: [] for choice in CHOICES}
     for train, test in GroupKFold(n_splits=folds).split(trials, groups=trials):
         X, y = rows.select(train).stacked()
         held = rows.select(test)
         Xt, _ = held.stacked()
-        fitted = _boost(_calibrated_logit(models, X), X, y, max(TREE_CHOICES), seed)
-        zt = _calibrated_logit(models, Xt)
-        for n in TREE_CHOICES:
-            p = expit(_logits_after(zt, Xt, fitted[:n]))
-            start = 0
-            for x, taken in zip(held.X, held.taken):
-                totals[n].append(row_score(p[start : start + len(x)], taken, x[:, 0] > 0.5))
-                start += len(x)
-    return {n: float(np.mean(v)) for n, v in totals.items()}, folds
+        z, zt = _calibrated_logit(models, X), _calibrated_logit(models, Xt)
+        for bias in (False, True):
+            fitted = _fitted(z, X, y, bias, max(TREE_CHOICES), seed)
+            for n in TREE_CHOICES:
+                p = expit(_logits_after(zt, Xt, fitted[: n + bias]))
+                start = 0
+                for x, taken in zip(held.X, held.taken):
+                    totals[bias, n].append(row_score(p[start : start + len(x)], taken, x[:, 0] > 0.5))
+                    start += len(x)
+    return {choice: float(np.mean(v)) for choice, v in totals.items()}, folds
 
 
 def _appended(arrays: dict[str, np.ndarray], fitted: list[tuple], scale: float) -> dict[str, np.ndarray]:
@@ -219,21 +279,21 @@ def adapt_models(
         )
     if trees is None:
         scores, folds = _cross_validated(prior, rows, seed)
-        best = max(TREE_CHOICES, key=lambda n: (round(scores[n], 9), -n))
+        bias, best = max(CHOICES, key=lambda c: (round(scores[c], 9), -CHOICES.index(c)))
     else:
-        scores, folds, best = {}, 0, trees
+        scores, folds, bias, best = {}, 0, False, trees
     X, y = rows.stacked()
-    fitted = _boost(_calibrated_logit(prior, X), X, y, best, seed)
+    fitted = _fitted(_calibrated_logit(prior, X), X, y, bias, best, seed)
     models = copy.deepcopy(prior)
     a = float(prior.row.calibration_[0])
-    if best:
+    if fitted:
         if a <= 0:
             raise ModelError("the base models' row calibration is not increasing: cannot adapt them")
         arrays = _appended(prior.row._learner_.arrays, fitted, a)
         models.row._learner_ = BoostedTrees(arrays)
         models.settings = replace(
             prior.settings,
-            n_estimators=prior.settings.n_estimators + best,
+            n_estimators=prior.settings.n_estimators + len(fitted),
             max_depth=max(prior.settings.max_depth, int(arrays["depth"])),
         )
         models.row.n_estimators = models.settings.n_estimators
@@ -243,4 +303,5 @@ def adapt_models(
     )
     if person and person not in models.subjects_:
         models.subjects_ = [*models.subjects_, person]
-    return models, Adaptation(person, len(trials), len(rows), best, folds, scores)
+    named = {choice_name(*choice): score for choice, score in scores.items()}
+    return models, Adaptation(person, len(trials), len(rows), best, folds, named, bias)

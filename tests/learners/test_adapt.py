@@ -12,12 +12,16 @@ from hlp_drake.errors import ModelError
 from hlp_drake.features.row_choice import ROW_CHOICE_FEATURES
 from hlp_drake.learners import PRESETS, DecisionModels
 from hlp_drake.learners.adapt import (
+    CHOICES,
     MIN_TRIALS,
     _appended,
     _boost,
     _calibrated_logit,
+    _fitted,
+    _kind_bias,
     _logits_after,
     adapt_models,
+    choice_name,
     row_score,
 )
 from hlp_drake.learners.bundled import default_models
@@ -84,3 +88,32 @@ def test_fewer_than_the_minimum_of_trials_are_refused():
     with pytest.raises(ModelError) as error:
         adapt_models(default_models(), [], person="sub_99")
     assert error.value.problems == (f"0 usable trial(s) of sub_99; adapting needs at least {MIN_TRIALS}",)
+
+
+def test_the_kind_bias_moves_a_person_who_always_moves_obstacles_towards_obstacles(tmp_path):
+    prior = default_models()
+    X, y = _candidates()
+    z = _calibrated_logit(prior, X)
+    stump, values = _kind_bias(z, X, y)
+    assert values[2] > 0.5 and values[1] < -0.5  # obstacles up, gaps down, in logit units
+    loss = lambda logits: np.mean(np.logaddexp(0.0, logits) - y * logits)
+    biased = _logits_after(z, X, [(stump, values)])
+    assert loss(biased) < loss(z) - 0.05
+    np.testing.assert_allclose(biased - z, np.where(X[:, 0] > 0.5, values[2], values[1]))
+    # in the model file: one more tree of depth 1, the same logits once loaded
+    fitted = _fitted(z, X, y, True, 5, seed=0)
+    models = copy.deepcopy(prior)
+    a, b = prior.row.calibration_
+    models.row._learner_ = BoostedTrees(_appended(prior.row._learner_.arrays, fitted, float(a)))
+    models.settings = replace(prior.settings, n_estimators=prior.settings.n_estimators + len(fitted))
+    models.save(tmp_path)
+    loaded = DecisionModels.load(tmp_path)
+    np.testing.assert_allclose(
+        a * loaded.row._learner_.decision_function(X) + b, _logits_after(z, X, fitted), atol=1e-6
+    )
+
+
+def test_the_choices_run_from_the_prior_to_the_most_trees_and_are_named():
+    assert CHOICES[0] == (False, 0) and CHOICES[1] == (True, 0) and CHOICES[-1] == (True, 40)
+    names = [choice_name(*c) for c in CHOICES]
+    assert names[:4] == ["prior", "bias", "5 trees", "bias + 5 trees"] and len(set(names)) == len(names)

@@ -8,10 +8,11 @@ By default every successful structured and unstructured trial there is (fixed mo
 mode reads structured trials only) trains the default preset: what the bundled models are.
 
 With --adapt, no dataset: the bundled models (or --base DIR, the boosted preset's) are adapted to
-one person, from DEMOS, a folder of that person's VR logs in the dataset's layout
+one person, from DEMOS: a folder of that person's VR logs in the dataset's layout
 (sub_XX/trial_results.csv, sub_XX/TYYY/scene and movement files; participant_list.csv for the
-handedness). Trials that are damaged, empty, name an object their layout lacks, failed or cannot be
-segmented are each named (file and line) and left out; fewer than 5 usable trials are refused (exit
+handedness), or a person file (.yaml: scene files and the gaps and obstacles the person chose; see
+hlp_drake.segmentation.person_file). Trials that are damaged, empty, name an object their layout
+lacks, failed or cannot be segmented are each named (file and line) and left out; fewer than 5 usable trials are refused (exit
 2). The row-choice classifier learns the person's bias (gaps or obstacles) and boosts more trees
 on their choices, as cross-validation on the person's own trials chooses (none: the base models
 stand); see hlp_drake.learners.adapt. The models are the usual models.json and models.npz; pin them with the
@@ -61,7 +62,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument(
         "--adapt",
         metavar="DEMOS",
-        help="adapt the models to one person: a folder of their VR logs (the dataset's layout)",
+        help="adapt the models to one person: a folder of their VR logs (the dataset's layout), or a "
+        "person file (.yaml: scenes and the person's choices)",
     )
     parser.add_argument(
         "--base",
@@ -118,9 +120,10 @@ def adapt(demos: str, base: str | None, out: str) -> int:
     from hlp_drake.learners.adapt import adapt_models, choice_name
     from hlp_drake.learners.bundled import default_models
     from hlp_drake.segmentation.person import read_person
+    from hlp_drake.segmentation.person_file import is_person_file, read_person_file
 
     prior = DecisionModels.load(base) if base else default_models()  # a bad model file: before any work
-    person = read_person(demos)
+    person = read_person_file(demos) if is_person_file(demos) else read_person(demos)
     for line in person.left_out:
         print(f"left out: {line}", file=sys.stderr)
     models, adaptation = adapt_models(prior, person.demonstrations, person=person.person)

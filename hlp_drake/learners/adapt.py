@@ -35,6 +35,7 @@ from hlp_drake.features.training import row_choice_rows
 from hlp_drake.learners.models import DecisionModels
 from hlp_drake.learners.trees import LEAF, BoostedTrees
 from hlp_drake.segmentation.demonstration import Demonstration
+from hlp_drake.segmentation.person_file import StatedTrial
 from hlp_drake.taskspace import TaskSpace
 
 MIN_TRIALS = 5
@@ -71,7 +72,7 @@ class PersonRows:
     trials: list[str]
 
     @classmethod
-    def of(cls, demonstrations: list[Demonstration], n_features: int) -> PersonRows:
+    def of(cls, demonstrations: list[Demonstration | StatedTrial], n_features: int) -> PersonRows:
         """The rows of ``demonstrations``, each candidate's first ``n_features`` of Xr."""
         X, taken, trials = [], [], []
         for demo in demonstrations:
@@ -245,7 +246,7 @@ def _appended(arrays: dict[str, np.ndarray], fitted: list[tuple], scale: float) 
 
 def adapt_models(
     prior: DecisionModels,
-    demonstrations: list[Demonstration],
+    demonstrations: list[Demonstration | StatedTrial],
     *,
     person: str = "",
     seed: int = 0,
@@ -297,10 +298,12 @@ def adapt_models(
             max_depth=max(prior.settings.max_depth, int(arrays["depth"])),
         )
         models.row.n_estimators = models.settings.n_estimators
-    models.start_arm_ = np.median([d.keypoints[0].arm for d in demonstrations], axis=0)
-    models.link_lengths_ = np.median(
-        [(d.link_lengths.upper_arm, d.link_lengths.forearm) for d in demonstrations], axis=0
-    )
+    recorded = [d for d in demonstrations if isinstance(d, Demonstration)]  # a stated trial has no arm
+    if recorded:
+        models.start_arm_ = np.median([d.keypoints[0].arm for d in recorded], axis=0)
+        models.link_lengths_ = np.median(
+            [(d.link_lengths.upper_arm, d.link_lengths.forearm) for d in recorded], axis=0
+        )
     if person and person not in models.subjects_:
         models.subjects_ = [*models.subjects_, person]
     named = {choice_name(*choice): score for choice, score in scores.items()}

@@ -23,7 +23,7 @@ from hlp_drake.segmentation.demonstration import Demonstration
 
 LEARNT = (STRUCTURED, UNSTRUCTURED)
 """The trial categories a person's models are adapted on."""
-LAYOUT = "one person's VR logs: sub_XX/trial_results.csv and a sub_XX/TYYY/ folder per trial"
+LAYOUT = "one person's VR logs: sub_XX/trial_results.csv and a sub_XX/TYYY/ folder per trial; or a person file, .yaml"
 
 
 @dataclass

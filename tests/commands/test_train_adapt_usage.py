@@ -30,5 +30,5 @@ def test_a_demos_path_that_is_a_file_is_refused(tmp_path):
     assert result.returncode == 2 and result.stdout == ""
     assert result.stderr == (
         f"error: {demos}: not a folder (expected one person's VR logs: sub_XX/trial_results.csv and a "
-        "sub_XX/TYYY/ folder per trial)\n"
+        "sub_XX/TYYY/ folder per trial; or a person file, .yaml)\n"
     )

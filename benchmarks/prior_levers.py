@@ -36,7 +36,7 @@ import json
 import multiprocessing
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -49,7 +49,7 @@ from hlp_drake.dataset.records import STRUCTURED, UNSTRUCTURED, category_of
 from hlp_drake.evaluation.protocol import _majority, metrics_of, score_plans, transfer_filter, transfer_folds
 from hlp_drake.features.augment import mirrored_rows, perturbed_scene, same_layout
 from hlp_drake.features.row_choice import ROW_CHOICE_FEATURES, ROW_CONTEXT_FEATURES
-from hlp_drake.features.training import LabelledSet, row_choice_rows, training_data
+from hlp_drake.features.training import LabelledSet, row_choice_rows, row_choice_set, training_data
 from hlp_drake.files.atomic import write_text_atomic
 from hlp_drake.files.plotting import new_figure, save_png
 from hlp_drake.learners import PRESETS, DecisionModels
@@ -64,31 +64,12 @@ SEQUENCE = BASE + 3  # came by a release, came through a gap, obstacles moved be
 CONTEXT = len(ROW_CONTEXT_FEATURES)  # and the turn from the hand's heading
 
 
-@dataclass(frozen=True)
-class Rows:
-    """Row-choice training rows: Cr's candidates, labels, people, trials."""
-
-    X: np.ndarray
-    y: np.ndarray
-    subjects: np.ndarray
-    keys: np.ndarray
-
-    @classmethod
-    def of(cls, labelled: LabelledSet) -> Rows:
-        return cls(labelled.X, labelled.y, labelled.subjects, labelled.keys)
-
-    def where(self, mask: np.ndarray) -> Rows:
-        return Rows(self.X[mask], self.y[mask], self.subjects[mask], self.keys[mask])
-
-    def plus(self, other: Rows) -> Rows:
-        return Rows(
-            *(
-                np.concatenate([a, b])
-                for a, b in zip(
-                    (self.X, self.y, self.subjects, self.keys), (other.X, other.y, other.subjects, other.keys)
-                )
-            )
-        )
+def joined(a: LabelledSet, b: LabelledSet) -> LabelledSet:
+    """The rows of ``a`` followed by those of ``b``."""
+    return LabelledSet(
+        a.columns,
+        *(np.concatenate([getattr(a, n), getattr(b, n)]) for n in ("X", "y", "subjects", "keys", "original")),
+    )
 
 
 class Ensemble:
@@ -105,19 +86,19 @@ class Ensemble:
         return self.members[0].novelty(X)
 
 
-def _weights(rows: Rows, structured_weight: float = 0.25) -> np.ndarray:
+def _weights(rows: LabelledSet, structured_weight: float = 0.25) -> np.ndarray:
     weight = _category_weights(rows.keys, structured_weight)
     return np.ones(len(rows.y)) if weight is None else weight
 
 
-def _fit(rows: Rows, columns: int = BASE, weight: np.ndarray | None = None, seed: int = 0):
+def _fit(rows: LabelledSet, columns: int = BASE, weight: np.ndarray | None = None, seed: int = 0):
     weight = _weights(rows) if weight is None else weight
     return RowChoiceClassifier(random_state=seed).fit(
         rows.X[:, :columns], rows.y, groups=rows.subjects, sample_weight=weight
     )
 
 
-def _novelty_weights(rows: Rows, seed: int) -> np.ndarray:
+def _novelty_weights(rows: LabelledSet, seed: int) -> np.ndarray:
     """Unstructured rows 1; a structured row the density ratio p(unstructured | x) / p(structured | x)
     of its candidate's features (prior-corrected), clipped to [0.05, 1]: rows like the new
     layouts count fully, rows only the repeated structured layouts have count little."""
@@ -132,12 +113,12 @@ def _novelty_weights(rows: Rows, seed: int) -> np.ndarray:
     return np.where(unstructured, 1.0, np.clip(ratio, 0.05, 1.0))
 
 
-def _mirror(rows: Rows) -> RowChoiceClassifier:
+def _mirror(rows: LabelledSet) -> RowChoiceClassifier:
     X, y, groups, weight = mirrored_rows(rows.X[:, :BASE], rows.y, rows.subjects, _weights(rows))
     return RowChoiceClassifier().fit(X, y, groups=groups, sample_weight=weight)
 
 
-LEVERS: dict[str, tuple[str, Callable[[Rows, Rows], object]]] = {
+LEVERS: dict[str, tuple[str, Callable[[LabelledSet, LabelledSet], object]]] = {
     "today": ("today's preset (structured rows weighted 0.25)", lambda r, p: _fit(r)),
     "structured_half": ("structured rows weighted 0.5", lambda r, p: _fit(r, weight=_weights(r, 0.5))),
     "novelty": ("rows weighted by how new they are", lambda r, p: _fit(r, weight=_novelty_weights(r, 0))),
@@ -145,40 +126,34 @@ LEVERS: dict[str, tuple[str, Callable[[Rows, Rows], object]]] = {
     "sequence": ("the previous rows' decisions as features", lambda r, p: _fit(r, SEQUENCE)),
     "context": ("previous decisions + approach direction", lambda r, p: _fit(r, CONTEXT)),
     "mirror": ("mirror augmentation", lambda r, p: _mirror(r)),
-    "perturb": ("perturbation augmentation (1 cm, 10 %)", lambda r, p: _fit(r.plus(p))),
+    "perturb": ("perturbation augmentation (1 cm, 10 %)", lambda r, p: _fit(joined(r, p))),
 }  # fmt: skip
 
 
-def perturbed_rows(demonstrations, seed: int) -> Rows:
-    """One perturbed copy of every demonstration whose layout keeps its rows and gaps."""
-    X, y, subjects, keys = [], [], [], []
+def perturbed_rows(demonstrations, seed: int) -> LabelledSet:
+    """The row-choice rows of one perturbed copy of every demonstration whose layout keeps its rows
+    and gaps (so each decision keeps its label)."""
+    copies = []
     for index, demo in enumerate(demonstrations):
-        rng = np.random.default_rng([seed, index])
-        scene = perturbed_scene(demo.scene, rng)
-        space = TaskSpace(scene)
-        if not same_layout(TaskSpace(demo.scene), space):
-            continue
-        for features, labels in row_choice_rows(replace(demo, scene=scene), space):
-            X.append(features)
-            y.append(labels)
-            subjects += [demo.subject] * len(labels)
-            keys += [demo.key] * len(labels)
-    return Rows(np.vstack(X), np.concatenate(y), np.array(subjects), np.array(keys))
+        scene = perturbed_scene(demo.scene, np.random.default_rng([seed, index]))
+        if same_layout(TaskSpace(demo.scene), TaskSpace(scene)):
+            copies.append(replace(demo, scene=scene))
+    return row_choice_set(copies)
 
 
-def inner_score(lever, rows: Rows, perturbed: Rows, demos_by_subject, k: int) -> float:
-    """Mean row score on inner-held-out people's unstructured rows (see the module's docstring)."""
-    people = np.array(sorted(s for s, demos in demos_by_subject.items() if demos))
+def inner_score(lever, training: LabelledSet, perturbed: LabelledSet, held_rows, k: int) -> float:
+    """Mean row score on inner-held-out people's unstructured rows (see the module's docstring);
+    ``held_rows``: per person with unstructured trials, their rows (candidates' Xr, the taken one)."""
+    people = np.array(sorted(held_rows))
     scores = []
     for _, held in GroupKFold(n_splits=k).split(people, groups=people):
-        held_people = set(people[held])
-        model = lever(rows.where(~np.isin(rows.subjects, list(held_people))),
-                      perturbed.where(~np.isin(perturbed.subjects, list(held_people))))  # fmt: skip
-        for person in held_people:
-            for demo in demos_by_subject[person]:
-                for features, labels in row_choice_rows(demo, TaskSpace(demo.scene)):
-                    p = model.predict_proba(features[:, : model.n_features_in_])[:, 1]
-                    scores.append(row_score(p, int(np.argmax(labels)), features[:, 0] > 0.5))
+        out = list(people[held])
+        model = lever(
+            training.rows(~np.isin(training.subjects, out)), perturbed.rows(~np.isin(perturbed.subjects, out))
+        )
+        for features, taken in (row for person in out for row in held_rows[person]):
+            p = model.predict_proba(features[:, : model.n_features_in_])[:, 1]
+            scores.append(row_score(p, taken, features[:, 0] > 0.5))
     return float(np.mean(scores))
 
 
@@ -194,21 +169,24 @@ def run_fold(job) -> dict:
     record = json.loads(path.read_text()) if path.is_file() else {"test": test, "levers": {}}
     keep = transfer_filter("b", test)
     training = data.where(keep)
-    rows = Rows.of(training.row)
-    perturbed = perturbed_all.where(np.array([keep(k) for k in perturbed_all.keys], dtype=bool))
+    rows = training.row
+    perturbed = perturbed_all.rows(np.array([keep(k) for k in perturbed_all.keys], dtype=bool))
     models = DecisionModels(PRESETS["boosted"]).fit(training, only=("direction", "arm"))
     majority = _majority(training)
     tests = [d for d in demonstrations if d.subject in test and category_of(d.trial) == UNSTRUCTURED]
-    train_unstructured = {
-        s: [d for d in demonstrations if d.subject == s and category_of(d.trial) == UNSTRUCTURED]
-        for s in sorted({str(s) for s in rows.subjects})
-    }
+    training_people = {str(s) for s in rows.subjects}
+    held_rows: dict[str, list] = {}
+    for demo in demonstrations:
+        if demo.subject in training_people and category_of(demo.trial) == UNSTRUCTURED:
+            held_rows.setdefault(demo.subject, []).extend(
+                (X, int(np.argmax(y))) for X, y in row_choice_rows(demo, TaskSpace(demo.scene))
+            )
     for name in levers:
         if name in record["levers"]:
             continue
         started = time.perf_counter()
         lever = LEVERS[name][1]
-        score = inner_score(lever, rows, perturbed, train_unstructured, inner)
+        score = inner_score(lever, rows, perturbed, held_rows, inner)
         models.row = lever(rows, perturbed)
         outcomes, baselines, _, _ = score_plans(models, tests, majority)
         metrics = metrics_of(outcomes)

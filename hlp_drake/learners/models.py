@@ -180,12 +180,6 @@ def _settings(meta: Any, where: Path) -> LearnerSettings:
     return LearnerSettings(**settings)
 
 
-def row_feature_count(settings: LearnerSettings) -> int:
-    """The columns of Xr (``ROW_CONTEXT_FEATURES``, the first ones) a row-choice classifier of
-    ``settings`` reads."""
-    return fixed_sizes(settings.row_context)["row.n_features"]
-
-
 def model_digest(directory: str | os.PathLike[str]) -> str:
     """The SHA-256 (hex) of the ``models.json`` in ``directory``: what ``DecisionModels.load``'s
     ``sha256`` pins (``sha256sum models.json`` prints the same)."""
@@ -256,8 +250,8 @@ class DecisionModels:
 
     @property
     def row_features(self) -> int:
-        """The columns of Xr the row-choice classifier reads (the first ones)."""
-        return row_feature_count(self.settings)
+        """The columns of Xr (``ROW_CONTEXT_FEATURES``, the first ones) the row-choice classifier reads."""
+        return fixed_sizes(self.settings.row_context)["row.n_features"]
 
     def fit(self, data: TrainingData, *, only: tuple[str, ...] | None = None) -> DecisionModels:
         """Fit the planner's learners on ``data``.
